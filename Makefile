@@ -1,0 +1,37 @@
+# The two commands of the README:
+#   make run   install missing Debian packages, build (Release), reproduce the paper's Tables 1 and 2
+#   make test  install missing Debian packages, build (Release), run every test with ctest
+BUILD_DIR ?= build
+JOBS ?= 2
+LEVELS ?= 7-10
+DEBIAN_PACKAGES = cmake g++ make pkg-config libfftw3-dev libeigen3-dev libcli11-dev \
+                  nlohmann-json3-dev libfmt-dev libgtest-dev libbenchmark-dev
+
+.PHONY: deps configure build run test bench clean
+
+deps:
+	@missing=""; for p in $(DEBIAN_PACKAGES); do \
+	  dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing Debian packages:$$missing"; \
+	  SUDO=""; [ "$$(id -u)" -eq 0 ] || SUDO=sudo; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $$missing; \
+	fi
+
+configure: deps
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release
+
+build: configure
+	cmake --build $(BUILD_DIR) -j $(JOBS)
+
+run: build
+	$(BUILD_DIR)/apps/fictus reproduce --table both --levels $(LEVELS) --out results
+
+test: build
+	cd $(BUILD_DIR) && ctest --output-on-failure -LE slow
+
+bench: build
+	$(BUILD_DIR)/bench/fictus_bench --out bench/results
+
+clean:
+	rm -rf $(BUILD_DIR)

@@ -1,0 +1,70 @@
+#pragma once
+// Uniform Q1 grid on the box Ω = [x0,x1]×[y0,y1] with square cells of side h.
+//
+// Nodes are (i, j), i = 0..nx, j = 0..ny, at (x0 + i·h, y0 + j·h). With homogeneous Dirichlet
+// conditions the unknowns are the interior nodes i = 1..nx−1, j = 1..ny−1, stored x-fastest:
+//     index(i, j) = (j − 1)·(nx − 1) + (i − 1).
+// Cell (ix, iy), ix = 0..nx−1, iy = 0..ny−1, is [x0 + ix·h, x0 + (ix+1)·h] × [y0 + iy·h, …].
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "fictus/aligned_vector.hpp"
+
+namespace fictus {
+
+struct Point {
+  double x = 0.0;
+  double y = 0.0;
+};
+
+inline Point operator+(Point a, Point b) { return {a.x + b.x, a.y + b.y}; }
+inline Point operator-(Point a, Point b) { return {a.x - b.x, a.y - b.y}; }
+inline Point operator*(double s, Point a) { return {s * a.x, s * a.y}; }
+inline double dot(Point a, Point b) { return a.x * b.x + a.y * b.y; }
+inline double norm(Point a) { return std::hypot(a.x, a.y); }
+
+struct Box {
+  double x0 = 0.0, x1 = 1.0, y0 = 0.0, y1 = 1.0;
+};
+
+class Grid {
+ public:
+  /// nx cells along x; the cell side is h = (x1 − x0)/nx and (y1 − y0)/h must be an integer
+  /// (to 1e-9); throws std::invalid_argument naming the field otherwise. nx ≥ 2 and ny ≥ 2.
+  Grid(const Box& box, int nx);
+
+  const Box& box() const { return box_; }
+  int nx() const { return nx_; }
+  int ny() const { return ny_; }
+  double h() const { return h_; }
+  double x(int i) const { return box_.x0 + i * h_; }
+  double y(int j) const { return box_.y0 + j * h_; }
+
+  /// Interior unknowns (nx − 1)(ny − 1) and all nodes (nx + 1)(ny + 1) (the paper's n).
+  std::size_t n_unknowns() const { return std::size_t(nx_ - 1) * std::size_t(ny_ - 1); }
+  std::size_t n_nodes() const { return std::size_t(nx_ + 1) * std::size_t(ny_ + 1); }
+
+  bool is_interior(int i, int j) const { return i > 0 && i < nx_ && j > 0 && j < ny_; }
+  /// Storage index of interior node (i, j); precondition is_interior(i, j).
+  std::size_t index(int i, int j) const {
+    return std::size_t(j - 1) * std::size_t(nx_ - 1) + std::size_t(i - 1);
+  }
+
+  /// Cell containing (x, y), clamped to the grid: cells are half-open [x_i, x_{i+1}).
+  int cell_x(double x) const;
+  int cell_y(double y) const;
+
+ private:
+  Box box_;
+  int nx_, ny_;
+  double h_;
+};
+
+/// Nodal values at the interior nodes, in Grid::index order, aligned for FFTW.
+using GridVector = AlignedVector<double>;
+
+/// Value at (x, y) of the Q1 function with interior nodal values u (zero on ∂Ω).
+double evaluate_q1(const Grid& grid, const GridVector& u, Point p);
+
+}  // namespace fictus

@@ -1,0 +1,47 @@
+#include "fftw_plan.hpp"
+
+#include <mutex>
+#include <new>
+#include <stdexcept>
+
+#include "fictus/aligned_vector.hpp"
+
+namespace fictus {
+namespace detail {
+
+namespace {
+std::mutex& planner_mutex() {  // the FFTW planner is not thread-safe
+  static std::mutex m;
+  return m;
+}
+void init_threads_once() {
+  static const bool ok = fftw_init_threads() != 0;
+  if (!ok) throw std::runtime_error("FFTW: fftw_init_threads failed");
+}
+}  // namespace
+
+void* fftw_aligned_malloc(std::size_t bytes) { return fftw_malloc(bytes); }
+void fftw_aligned_free(void* p) noexcept { fftw_free(p); }
+
+R2rPlan2d::R2rPlan2d(int n_slow, int n_fast, R2rKind kind, int threads) {
+  std::lock_guard lock(planner_mutex());
+  init_threads_once();
+  fftw_plan_with_nthreads(threads < 1 ? 1 : threads);
+  const std::size_t n = std::size_t(n_slow) * std::size_t(n_fast);
+  double* scratch = static_cast<double*>(fftw_malloc(sizeof(double) * (n == 0 ? 1 : n)));
+  if (scratch == nullptr) throw std::bad_alloc();
+  const fftw_r2r_kind k = kind == R2rKind::dst1 ? FFTW_RODFT00 : FFTW_REDFT00;
+  plan_ = fftw_plan_r2r_2d(n_slow, n_fast, scratch, scratch, k, k, FFTW_ESTIMATE);
+  fftw_free(scratch);
+  if (plan_ == nullptr) throw std::runtime_error("FFTW: could not plan the transform");
+}
+
+R2rPlan2d::~R2rPlan2d() {
+  std::lock_guard lock(planner_mutex());
+  fftw_destroy_plan(plan_);
+}
+
+void R2rPlan2d::execute(double* data) const { fftw_execute_r2r(plan_, data, data); }
+
+}  // namespace detail
+}  // namespace fictus
