@@ -1,0 +1,126 @@
+#include "results_io.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <unistd.h>
+
+namespace fictus::cli {
+
+using nlohmann::json;
+
+json options_to_json(const SolverOptions& o) {
+  return json{{"variant", to_string(o.variant)},
+              {"multipliers", o.multipliers},
+              {"offset", o.offset},
+              {"rho", o.rho},
+              {"normal_shift", o.normal_shift},
+              {"start", o.start_all_active ? "all" : "zero"},
+              {"schur", to_string(o.inner)},
+              {"krylov_tolerance", o.krylov_tolerance},
+              {"krylov_max_iterations", o.krylov_max_iterations},
+              {"newton_tolerance", o.newton_tolerance},
+              {"max_newton", o.max_newton},
+              {"load_quadrature", o.load_quadrature},
+              {"error_quadrature", o.error_quadrature},
+              {"condition_number", o.condition_number},
+              {"threads", o.threads}};
+}
+
+json solution_to_json(const Problem& problem, const Solution& s) {
+  json j;
+  j["version"] = FICTUS_VERSION;
+  j["problem"] = problem.name;
+  j["options"] = options_to_json(s.options);
+  j["options"]["N"] = problem.N;
+  j["options"]["c"] = problem.c;
+  j["options"]["box"] = {problem.box.x0, problem.box.x1, problem.box.y0, problem.box.y1};
+  j["grid"] = {{"N", s.grid.nx()}, {"Ny", s.grid.ny()}, {"h", s.grid.h()}, {"n_nodes", s.grid.n_nodes()},
+               {"n_unknowns", s.grid.n_unknowns()}};
+  j["multipliers"] = s.collocation.m;
+  j["curve"] = {{"length", s.collocation.length}, {"spacing", s.collocation.spacing}, {"delta", s.delta}};
+  json history = json::array();
+  for (const NewtonStep& step : s.newton.history)
+    history.push_back({{"n_active", step.n_active}, {"inner_iterations", step.inner_iterations},
+                       {"residual", step.residual}, {"n_changed", step.n_changed}});
+  j["newton"] = {{"iterations", s.newton.iterations},
+                 {"converged", s.newton.converged},
+                 {"n_active", std::count(s.newton.active.begin(), s.newton.active.end(), 1)},
+                 {"residual", s.newton.residual},
+                 {"history", history}};
+  if (!s.newton.converged) j["newton"]["failure"] = s.newton.failure;
+  j["inner"] = {{"solver", to_string(s.options.inner)}, {"fast_solves", s.fast_solves},
+                {"krylov_iterations", s.inner_iterations}};
+  json timings;
+  for (const auto& [phase, seconds] : s.timings.phases) timings[phase] = seconds;
+  timings["total"] = s.timings.total;
+  j["timings"] = timings;
+  j["condition_number"] = s.condition_number ? json(*s.condition_number) : json(nullptr);
+  j["signorini"] = {{"min_gap", s.signorini.min_gap},
+                    {"min_normal_derivative", s.signorini.min_normal_derivative},
+                    {"max_complementarity", s.signorini.max_complementarity}};
+  if (s.errors) {
+    const ErrorNorms& e = *s.errors;
+    j["errors"] = {{"l2_omega", e.l2_omega},         {"h1_omega", e.h1_omega},
+                   {"h1semi_omega", e.h1semi_omega}, {"l2_gamma", e.l2_gamma},
+                   {"rel_l2_omega", e.rel_l2_omega}, {"rel_h1_omega", e.rel_h1_omega},
+                   {"rel_h1semi_omega", e.rel_h1semi_omega}, {"rel_l2_gamma", e.rel_l2_gamma}};
+  }
+  j["peak_memory_bytes"] = s.peak_memory_bytes;
+  return j;
+}
+
+LevelResult level_result(const Solution& s) {
+  LevelResult r;
+  r.N = s.grid.nx();
+  r.n_nodes = s.grid.n_nodes();
+  r.m = s.collocation.m;
+  r.it0 = s.newton.iterations;
+  r.it1 = s.fast_solves;
+  r.time = s.timings.total;
+  if (s.errors) {
+    r.l2_omega = s.errors->rel_l2_omega;
+    r.h1_omega = s.errors->rel_h1_omega;
+    r.l2_gamma = s.errors->rel_l2_gamma;
+  }
+  return r;
+}
+
+void write_atomically(const std::filesystem::path& path, const std::string& text) {
+  const std::filesystem::path tmp = path.string() + ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) throw std::runtime_error("output: cannot write " + tmp.string());
+    out << text;
+    out.flush();
+    if (!out) {
+      std::filesystem::remove(tmp);
+      throw std::runtime_error("output: cannot write " + tmp.string());
+    }
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+std::string points_csv(const Solution& s) {
+  std::ostringstream out;
+  out.precision(17);
+  out << "i,x,y,nx,ny,g,u,dudn,lambda,contact\n";
+  for (int i = 0; i < s.collocation.m; ++i)
+    out << i << ',' << s.collocation.point[i].x << ',' << s.collocation.point[i].y << ',' << s.collocation.normal[i].x
+        << ',' << s.collocation.normal[i].y << ',' << s.g[i] << ',' << s.trace[i] << ',' << s.normal_derivative[i]
+        << ',' << s.lambda[i] << ',' << int(s.newton.active[i]) << '\n';
+  return out.str();
+}
+
+std::string levels_csv(const std::vector<LevelResult>& rows) {
+  std::ostringstream out;
+  out.precision(10);
+  out << "N,h,n_nodes,m,it0,it1,time,rel_l2_omega,rel_h1_omega,rel_l2_gamma\n";
+  for (const LevelResult& r : rows)
+    out << r.N << ',' << 1.0 / r.N << ',' << r.n_nodes << ',' << r.m << ',' << r.it0 << ',' << r.it1 << ',' << r.time
+        << ',' << r.l2_omega << ',' << r.h1_omega << ',' << r.l2_gamma << '\n';
+  return out.str();
+}
+
+}  // namespace fictus::cli

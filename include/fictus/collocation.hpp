@@ -1,0 +1,28 @@
+#pragma once
+// m collocation points on γ equally spaced in arc length: point i sits at s_i = (i + ½)·L/m and
+// owns the arc [i·L/m, (i+1)·L/m] between the midpoints to its neighbours.
+#include <vector>
+
+#include "fictus/curve.hpp"
+
+namespace fictus {
+
+struct Collocation {
+  int m = 0;
+  double length = 0.0;   // L = |γ|
+  double spacing = 0.0;  // s = L/m
+  std::vector<double> t;                     // parameter of point i
+  std::vector<double> arc_begin, arc_end;    // parameters bounding arc i, arc_begin[0] = 0
+  std::vector<Point> point, normal;          // x_i and the outward unit normal n_i
+
+  int n_points() const { return m; }
+};
+
+Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m);
+
+/// Default number of multipliers: the paper's m ≈ 34·(N/128)^0.85 on its ellipse (length
+/// L_ref = 1.93768… in the unit box), scaled with the curve length relative to the box width:
+///   m = round(34 · (L/W) / L_ref · (W/(128 h))^0.85),  W = x1 − x0.   At least 8.
+int default_multipliers(double curve_length, double box_width, double h);
+
+}  // namespace fictus

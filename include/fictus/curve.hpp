@@ -1,0 +1,77 @@
+#pragma once
+// Closed curves γ = ∂ω: a parametrization p(t), t ∈ [0, 2π), 2π-periodic, counter-clockwise
+// (ω on the left), with first and second derivatives. The outward normal is
+// n = (y', −x')/|p'|, the curvature κ = (x'y'' − y'x'')/|p'|³ (> 0 on a convex curve).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fictus/grid.hpp"
+
+namespace fictus {
+
+class Curve {
+ public:
+  virtual ~Curve() = default;
+  virtual Point position(double t) const = 0;
+  virtual Point derivative(double t) const = 0;
+  virtual Point second_derivative(double t) const = 0;
+  /// A point inside ω used for the polar angle φ of user data (the ellipse's center).
+  virtual Point center() const = 0;
+
+  double speed(double t) const { return norm(derivative(t)); }
+  Point outward_normal(double t) const;
+  double curvature(double t) const;
+};
+
+/// Ellipse with center c, semi-axes a (along the rotated x axis) and b, rotated by `angle`:
+/// p(t) = c + R(angle)·(a cos t, b sin t).
+class Ellipse final : public Curve {
+ public:
+  Ellipse(Point center, double a, double b, double angle = 0.0);
+  Point position(double t) const override;
+  Point derivative(double t) const override;
+  Point second_derivative(double t) const override;
+  Point center() const override { return center_; }
+  double a() const { return a_; }
+  double b() const { return b_; }
+
+ private:
+  Point rotate(Point v) const { return {cos_ * v.x - sin_ * v.y, sin_ * v.x + cos_ * v.y}; }
+  Point center_;
+  double a_, b_, cos_, sin_;
+};
+
+/// Normal offset curve Γ(t) = γ(t) + δ·n(t) (δ > 0: outside ω), same parameter t as γ, so the
+/// arcs of Γ are the images of the arcs of γ. Its speed is |γ'|(1 + δκ).
+class OffsetCurve final : public Curve {
+ public:
+  OffsetCurve(std::shared_ptr<const Curve> base, double delta);
+  Point position(double t) const override;
+  Point derivative(double t) const override;
+  /// By central differences of derivative() (used only for diagnostics of Γ's curvature).
+  Point second_derivative(double t) const override;
+  Point center() const override { return base_->center(); }
+  double delta() const { return delta_; }
+
+ private:
+  std::shared_ptr<const Curve> base_;
+  double delta_;
+};
+
+/// Cumulative arc length s(t) on [0, 2π] by composite Gauss–Legendre, and its inverse.
+class ArcLengthTable {
+ public:
+  explicit ArcLengthTable(const Curve& curve, int panels = 2048);
+  double length() const { return cumulative_.back(); }
+  double s_of_t(double t) const;  // t ∈ [0, 2π]
+  double t_of_s(double s) const;  // s ∈ [0, L] (Newton, safeguarded by the panel bracket)
+
+ private:
+  double partial(int panel, double t) const;  // ∫_{t_panel}^{t} |p'|
+  const Curve& curve_;
+  double dt_;
+  std::vector<double> cumulative_;  // s at panel starts, size panels + 1
+};
+
+}  // namespace fictus

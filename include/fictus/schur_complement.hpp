@@ -1,0 +1,85 @@
+#pragma once
+// The Schur complement of the discrete problem (3) with respect to λ:
+//   u(λ) = u₀ + A⁻¹ B_Γᵀ λ,   S_B = B_γ A⁻¹ B_Γᵀ,   S_C = C_γ A⁻¹ B_Γᵀ   (m × m).
+// The Newton matrix for an active set 𝒜 takes row i of S_B if i ∈ 𝒜 and row i of S_C otherwise.
+// Two implementations behind one interface:
+//   ImplicitSchur  the paper's: never formed, one fast A⁻¹ per application, GMRES per step;
+//   ExplicitSchur  ours: S_B and S_C assembled from the discrete Green's function, dense LU.
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "fictus/dst_solver.hpp"
+#include "fictus/gmres.hpp"
+#include "fictus/green_table.hpp"
+#include "fictus/trace_operators.hpp"
+
+namespace fictus {
+
+using ActiveSet = std::vector<char>;  // 1: contact row (B_γ u = g), 0: free row (C_γ u = 0)
+
+struct LinearSolveReport {
+  int inner_iterations = 0;  // Krylov operator applications (0 for a direct solve)
+  double relative_residual = 0.0;
+  bool converged = true;
+};
+
+class SchurComplement {
+ public:
+  virtual ~SchurComplement() = default;
+  virtual int size() const = 0;
+  /// sb = S_B λ, sc = S_C λ.
+  virtual void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const = 0;
+  /// Solves S_𝒜 λ = d; λ holds the starting guess on entry.
+  virtual LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, Eigen::VectorXd& lambda) const = 0;
+  /// Applications of A⁻¹ so far (the paper's it₁).
+  virtual std::size_t fast_solves() const = 0;
+  /// 2-norm condition number of S_𝒜, where it is available without extra fast solves.
+  virtual std::optional<double> condition_number(const ActiveSet& active) const = 0;
+};
+
+class ImplicitSchur final : public SchurComplement {
+ public:
+  ImplicitSchur(const DstSolver& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
+                const SparseRows& B_Gamma, const GmresOptions& options);
+  int size() const override { return B_Gamma_.n_rows(); }
+  void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override;
+  LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, Eigen::VectorXd& lambda) const override;
+  std::size_t fast_solves() const override { return fast_solves_; }
+  std::optional<double> condition_number(const ActiveSet&) const override { return std::nullopt; }
+
+ private:
+  const DstSolver& solver_;
+  const SparseRows &B_gamma_, &C_gamma_, &B_Gamma_;
+  GmresOptions options_;
+  mutable GridVector work_;
+  mutable std::vector<double> lambda_, rows_;
+  mutable std::size_t fast_solves_ = 0;
+};
+
+class ExplicitSchur final : public SchurComplement {
+ public:
+  /// Assembles S_B and S_C from the Green's table (threaded over columns).
+  ExplicitSchur(const GreenTable& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
+                const SparseRows& B_Gamma, int threads = 1);
+  /// From given blocks (tests).
+  ExplicitSchur(Eigen::MatrixXd S_B, Eigen::MatrixXd S_C) : S_B_(std::move(S_B)), S_C_(std::move(S_C)) {}
+  int size() const override { return int(S_B_.rows()); }
+  void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override;
+  LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, Eigen::VectorXd& lambda) const override;
+  std::size_t fast_solves() const override { return 0; }
+  std::optional<double> condition_number(const ActiveSet& active) const override;
+  const Eigen::MatrixXd& S_B() const { return S_B_; }
+  const Eigen::MatrixXd& S_C() const { return S_C_; }
+
+ private:
+  Eigen::MatrixXd newton_matrix(const ActiveSet& active) const;
+  Eigen::MatrixXd S_B_, S_C_;
+};
+
+/// Dense (rows × cols) block R G Qᵀ from sparse rows and the Green's table.
+Eigen::MatrixXd green_block(const GreenTable& green, const SparseRows& R, const SparseRows& Q, int threads = 1);
+
+}  // namespace fictus

@@ -1,0 +1,51 @@
+#pragma once
+// Semismooth Newton method for the boundary equation of the paper's eq. (3), in λ alone:
+//   u(λ) = u₀ + A⁻¹B_Γᵀλ,  b(λ) = B_γ u = b₀ + S_B λ,  c(λ) = C_γ u = c₀ + S_C λ,
+//   F(λ) = c(λ) − max{0, c(λ) − ρ(b(λ) − g)} = 0.
+// Algorithm (numbered as in the code):
+//   0. λ = 0; 𝒜 = all points ("all" start) or 𝒜 = {i : (c₀ − ρ(b₀ − g))_i > 0} ("zero" start).
+//   1. Linear solve: S_𝒜 λ = d, rows i ∈ 𝒜: (S_B λ)_i = g_i − b₀_i (contact, u = g),
+//                               rows i ∉ 𝒜: (S_C λ)_i = −c₀_i     (free, ∂u/∂n = 0).
+//   2. Residual: b, c at the new λ and F(λ).
+//   3. Active set: 𝒜' = {i : (c − ρ(b − g))_i > 0}.
+//   4. Stop when 𝒜' = 𝒜 and ‖F‖∞ ≤ tol·scale (finite termination); fail when 𝒜' repeats an
+//      older set (cycling) or after max_iterations.
+// λ is not sign-constrained: the B/C rows carry the Signorini conditions.
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "fictus/schur_complement.hpp"
+
+namespace fictus {
+
+struct NewtonOptions {
+  double rho = 1.0;            // ρ > 0 of the projection
+  int max_iterations = 50;     // linear solves
+  bool start_all_active = true;
+  double tolerance = 1e-9;     // ‖F‖∞ ≤ tolerance · max(‖b‖∞, ‖c‖∞, ‖g‖∞)
+};
+
+struct NewtonStep {
+  int n_active = 0;           // |𝒜| used in this step's linear solve
+  int inner_iterations = 0;   // Krylov applications in this step
+  double residual = 0.0;      // ‖F(λ)‖∞ after the step
+  int n_changed = 0;          // points whose status changed after the step
+};
+
+struct NewtonResult {
+  Eigen::VectorXd lambda;
+  ActiveSet active;
+  int iterations = 0;         // linear solves (the paper's it₀)
+  bool converged = false;
+  std::string failure;        // why not, when not converged
+  double residual = 0.0;
+  std::vector<NewtonStep> history;
+};
+
+NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::VectorXd& b0,
+                                     const Eigen::VectorXd& c0, const Eigen::VectorXd& g,
+                                     const NewtonOptions& options);
+
+}  // namespace fictus

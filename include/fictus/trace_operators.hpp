@@ -1,0 +1,43 @@
+#pragma once
+// The trace matrices of the paper's eq. (3) as sparse rows over the interior grid nodes:
+//   B_γ  (m × n): u(x_i), bilinear interpolation at the collocation points (4 entries a row);
+//   C_γ  (m × n): n_i·∇u_h at x_i − shift·n_i, the gradient of the cell holding that point;
+//   B_Γ  (m × n): ∫_{arc_j of Γ} φ_k ds, piecewise-constant multipliers, split at grid lines,
+//                 Gauss on each piece (exact up to the curve's own non-polynomial shape).
+// Boundary nodes of the box carry no unknown (u = 0 there) and are dropped.
+#include <cstddef>
+#include <vector>
+
+#include "fictus/curve_grid_intersection.hpp"
+#include "fictus/grid.hpp"
+
+namespace fictus {
+
+struct SparseRows {
+  struct Entry {
+    std::size_t index;  // Grid::index of the node
+    int i, j;           // the node
+    double value;
+  };
+  std::vector<std::size_t> row_begin{0};  // entries of row r: [row_begin[r], row_begin[r+1])
+  std::vector<Entry> entries;
+
+  int n_rows() const { return int(row_begin.size()) - 1; }
+  /// out = R u  (out resized to n_rows)
+  void multiply(const GridVector& u, std::vector<double>& out) const;
+  /// u += Rᵀ λ
+  void add_transposed(const std::vector<double>& lambda, GridVector& u) const;
+};
+
+SparseRows point_value_rows(const Grid& grid, const std::vector<Point>& points);
+
+/// shift: distance (length units) from x_i into ω along −n_i where the gradient is taken.
+SparseRows normal_derivative_rows(const Grid& grid, const std::vector<Point>& points,
+                                  const std::vector<Point>& normals, double shift);
+
+/// One row per arc [arc_begin[r], arc_end[r]] of the curve of `geometry` (q Gauss points on every
+/// piece of the arc inside one cell).
+SparseRows arc_integral_rows(const CurveGridIntersection& geometry, const std::vector<double>& arc_begin,
+                             const std::vector<double>& arc_end, int q = 6);
+
+}  // namespace fictus

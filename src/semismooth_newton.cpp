@@ -1,0 +1,75 @@
+#include "fictus/semismooth_newton.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace fictus {
+
+NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::VectorXd& b0,
+                                     const Eigen::VectorXd& c0, const Eigen::VectorXd& g,
+                                     const NewtonOptions& options) {
+  if (!(options.rho > 0)) throw std::invalid_argument("formulation.rho: must be > 0");
+  if (options.max_iterations < 1) throw std::invalid_argument("solver.max_newton: must be >= 1");
+  const int m = schur.size();
+  const double rho = options.rho;
+  NewtonResult result;
+  result.lambda = Eigen::VectorXd::Zero(m);
+
+  // 0. Start.
+  ActiveSet active(m, 1);
+  if (!options.start_all_active)
+    for (int i = 0; i < m; ++i) active[i] = (c0(i) - rho * (b0(i) - g(i))) > 0;
+  std::vector<ActiveSet> seen{active};
+
+  Eigen::VectorXd d(m), sb, sc;
+  for (int k = 0; k < options.max_iterations; ++k) {
+    // 1. Linear solve for the current active set.
+    for (int i = 0; i < m; ++i) d(i) = active[i] ? g(i) - b0(i) : -c0(i);
+    const LinearSolveReport linear = schur.solve(active, d, result.lambda);
+    ++result.iterations;
+
+    // 2. Residual at the new λ.
+    schur.apply(result.lambda, sb, sc);
+    const Eigen::VectorXd b = b0 + sb, c = c0 + sc;
+    const Eigen::VectorXd shifted = c - rho * (b - g);
+    const Eigen::VectorXd F = c - shifted.cwiseMax(0.0);
+    result.residual = F.lpNorm<Eigen::Infinity>();
+    const double scale = std::max({b.lpNorm<Eigen::Infinity>(), c.lpNorm<Eigen::Infinity>(),
+                                   g.lpNorm<Eigen::Infinity>(), 1e-300});
+
+    // 3. New active set.
+    ActiveSet next(m);
+    int changed = 0;
+    for (int i = 0; i < m; ++i) {
+      next[i] = shifted(i) > 0;
+      changed += next[i] != active[i];
+    }
+    result.history.push_back({int(std::count(active.begin(), active.end(), 1)), linear.inner_iterations,
+                              result.residual, changed});
+
+    // 4. Stopping test.
+    if (changed == 0) {
+      result.active = active;
+      if (result.residual <= options.tolerance * scale) {
+        result.converged = true;
+      } else {
+        result.failure = "the active set repeats but the residual " + std::to_string(result.residual) +
+                         " is above the tolerance (inner solver " +
+                         (linear.converged ? "converged" : "did not converge") + ")";
+      }
+      return result;
+    }
+    if (std::find(seen.begin(), seen.end(), next) != seen.end()) {
+      result.active = next;
+      result.failure = "the active sets cycle (step " + std::to_string(k + 1) + " returns to an earlier set)";
+      return result;
+    }
+    seen.push_back(next);
+    active = std::move(next);
+  }
+  result.active = active;
+  result.failure = "no convergence in " + std::to_string(options.max_iterations) + " Newton steps";
+  return result;
+}
+
+}  // namespace fictus

@@ -1,0 +1,66 @@
+// Curves: arc length, normals, offset curves, collocation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "fictus/collocation.hpp"
+#include "fictus/curve.hpp"
+
+namespace {
+
+constexpr double pi = std::numbers::pi;
+
+double ellipse_perimeter(double a, double b) {  // 4a E(e), e² = 1 − b²/a²
+  return 4.0 * a * std::comp_ellint_2(std::sqrt(1.0 - b * b / (a * a)));
+}
+
+TEST(Curve, EllipsePerimeterMatchesEllipticIntegral) {
+  const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2, 0.3);
+  const fictus::ArcLengthTable table(e);
+  EXPECT_NEAR(table.length(), ellipse_perimeter(0.4, 0.2), 1e-12);
+}
+
+TEST(Curve, ArcLengthInverse) {
+  const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2);
+  const fictus::ArcLengthTable table(e);
+  for (double t : {0.0, 0.1, 1.0, 2.5, 4.0, 6.2})
+    EXPECT_NEAR(table.t_of_s(table.s_of_t(t)), t, 1e-12);
+}
+
+TEST(Curve, OutwardNormalAndCurvature) {
+  const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2);
+  const fictus::Point n0 = e.outward_normal(0.0), n1 = e.outward_normal(pi / 2);
+  EXPECT_NEAR(n0.x, 1.0, 1e-15);
+  EXPECT_NEAR(n1.y, 1.0, 1e-15);
+  EXPECT_NEAR(e.curvature(0.0), 0.4 / (0.2 * 0.2), 1e-12);  // a/b² at the end of the major axis
+}
+
+TEST(Curve, OffsetCurveLengthGrowsByTwoPiDelta) {
+  auto e = std::make_shared<fictus::Ellipse>(fictus::Point{0.5, 0.5}, 0.4, 0.2);
+  const double delta = 0.03;
+  const fictus::OffsetCurve gamma(e, delta);
+  EXPECT_NEAR(fictus::ArcLengthTable(gamma).length(), ellipse_perimeter(0.4, 0.2) + 2 * pi * delta, 1e-11);
+  const fictus::Point p = gamma.position(1.0), q = e->position(1.0), n = e->outward_normal(1.0);
+  EXPECT_NEAR(fictus::dot(p - q, n), delta, 1e-15);
+}
+
+TEST(Collocation, EquallySpacedInArcLength) {
+  const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2);
+  const fictus::ArcLengthTable table(e);
+  const fictus::Collocation c = fictus::make_collocation(e, table, 34);
+  for (int i = 0; i < c.m; ++i) {
+    EXPECT_NEAR(table.s_of_t(c.t[i]), (i + 0.5) * c.spacing, 1e-12);
+    EXPECT_NEAR(table.s_of_t(c.arc_end[i]) - table.s_of_t(c.arc_begin[i]), c.spacing, 1e-12);
+  }
+}
+
+TEST(Collocation, DefaultRuleFollowsThePaper) {
+  const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2);
+  const double L = fictus::ArcLengthTable(e).length();
+  const int paper[] = {34, 62, 110, 198, 360};
+  for (int k = 0; k < 5; ++k)
+    EXPECT_NEAR(fictus::default_multipliers(L, 1.0, 1.0 / (128 << k)), paper[k], 2) << "N = " << (128 << k);
+}
+
+}  // namespace

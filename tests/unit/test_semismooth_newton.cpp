@@ -1,0 +1,77 @@
+// Newton on the paper's problem: convergence, discrete Signorini conditions, agreement of the
+// explicit (Green) and implicit (Krylov) Schur complements and of the two starts.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/paper_problem.hpp"
+
+namespace {
+
+fictus::Solution solve_paper(int N, fictus::Variant variant, fictus::InnerSolver inner, bool all_active = true) {
+  fictus::SolverOptions o;
+  o.variant = variant;
+  o.inner = inner;
+  o.start_all_active = all_active;
+  o.multipliers = fictus::paper_multipliers(N);
+  return fictus::solve(fictus::paper_problem(N), o);
+}
+
+class NewtonTest : public ::testing::TestWithParam<fictus::Variant> {};
+
+TEST_P(NewtonTest, ConvergesAndSatisfiesSignorini) {
+  const fictus::Solution s = solve_paper(128, GetParam(), fictus::InnerSolver::green);
+  ASSERT_TRUE(s.newton.converged) << s.newton.failure;
+  EXPECT_LE(s.newton.iterations, 12);
+  constexpr double tol = 1e-10;  // the B/C rows are solved by a dense LU: round-off level
+  EXPECT_GE(s.signorini.min_gap, -tol);
+  EXPECT_GE(s.signorini.min_normal_derivative, -tol);
+  EXPECT_LE(s.signorini.max_complementarity, tol);
+  // The contact set is γ₁ = γ minus the quarter x < ½, y < ½: about three quarters of the points.
+  const long active = std::count(s.newton.active.begin(), s.newton.active.end(), 1);
+  EXPECT_NEAR(double(active) / s.collocation.m, 0.75, 0.1);
+}
+
+TEST_P(NewtonTest, GreenAndKrylovAgree) {
+  const fictus::Solution green = solve_paper(128, GetParam(), fictus::InnerSolver::green);
+  const fictus::Solution krylov = solve_paper(128, GetParam(), fictus::InnerSolver::krylov);
+  ASSERT_TRUE(green.newton.converged && krylov.newton.converged);
+  EXPECT_EQ(green.newton.active, krylov.newton.active);
+  EXPECT_EQ(green.newton.iterations, krylov.newton.iterations);
+  double diff = 0, size = 0;
+  for (std::size_t i = 0; i < green.lambda.size(); ++i) {
+    diff = std::max(diff, std::abs(green.lambda[i] - krylov.lambda[i]));
+    size = std::max(size, std::abs(green.lambda[i]));
+  }
+  // GMRES stops at 1e-10 relative residual; cond(S) ≤ 1e4 here.
+  EXPECT_LE(diff / size, 1e-6);
+  EXPECT_NEAR(green.errors->rel_l2_omega, krylov.errors->rel_l2_omega, 1e-6 * green.errors->rel_l2_omega);
+  EXPECT_GT(krylov.fast_solves, std::size_t(krylov.newton.iterations));
+}
+
+TEST_P(NewtonTest, BothStartsReachTheSameSolution) {
+  const fictus::Solution all = solve_paper(128, GetParam(), fictus::InnerSolver::green, true);
+  const fictus::Solution zero = solve_paper(128, GetParam(), fictus::InnerSolver::green, false);
+  ASSERT_TRUE(all.newton.converged && zero.newton.converged);
+  EXPECT_EQ(all.newton.active, zero.newton.active);
+  for (std::size_t i = 0; i < all.lambda.size(); ++i)
+    EXPECT_NEAR(all.lambda[i], zero.lambda[i], 1e-8 * (1 + std::abs(all.lambda[i])));
+}
+
+INSTANTIATE_TEST_SUITE_P(Variants, NewtonTest, ::testing::Values(fictus::Variant::nonsmooth, fictus::Variant::smooth),
+                         [](const auto& info) { return std::string(fictus::to_string(info.param)); });
+
+TEST(Solve, RejectsBadOptions) {
+  fictus::SolverOptions o;
+  o.rho = -1;
+  EXPECT_THROW(fictus::solve(fictus::paper_problem(64), o), std::invalid_argument);
+  o = {};
+  o.multipliers = 500;  // spacing < 2h at N = 64
+  EXPECT_THROW(fictus::solve(fictus::paper_problem(64), o), std::invalid_argument);
+  o = {};
+  EXPECT_THROW(fictus::solve(fictus::paper_problem(4), o), std::invalid_argument);
+}
+
+}  // namespace
