@@ -3,7 +3,7 @@
 #   make test  install missing Debian packages, build (Release), run every test with ctest
 BUILD_DIR ?= build
 JOBS ?= 2
-LEVELS ?= 7-10
+LEVELS ?= 7-12
 DEBIAN_PACKAGES = cmake g++ make pkg-config libfftw3-dev libeigen3-dev libcli11-dev \
                   nlohmann-json3-dev libfmt-dev libgtest-dev libbenchmark-dev
 

@@ -162,12 +162,14 @@ int main(int argc, char** argv) {
   SolveArguments solve_args;
   CLI::App* solve_cmd = app.add_subcommand("solve", "solve the paper's problem on one grid");
   solve_cmd->add_option("--N", solve_args.N, "cells per side (h = 1/N)")->capture_default_str();
-  solve_cmd->add_option("--out", solve_args.out, "write results.json and points.csv into this folder");
+  solve_args.out = "results/solve";
+  solve_cmd->add_option("--out", solve_args.out, "write results.json and points.csv into this folder (\"\": none)")
+      ->capture_default_str();
   add_solver_options(*solve_cmd, solve_options, solve_args);
 
   fictus::SolverOptions reproduce_options;
   SolveArguments reproduce_args;
-  std::string table = "both", levels = "7-10";
+  std::string table = "both", levels = "7-12";
   CLI::App* reproduce_cmd = app.add_subcommand("reproduce", "reproduce the paper's Table 1 and/or Table 2");
   reproduce_cmd->add_option("--table", table, "1 (non-smooth), 2 (smooth) or both")->capture_default_str();
   reproduce_cmd->add_option("--levels", levels, "levels A-B, h = 2^-level")->capture_default_str();

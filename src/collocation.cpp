@@ -30,7 +30,7 @@ Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_lengt
 }
 
 int default_multipliers(double curve_length, double box_width, double h) {
-  constexpr double paper_length = 1.9376820378525;  // perimeter of the 0.4 × 0.2 ellipse
+  constexpr double paper_length = 1.9376896441095;  // perimeter of the 0.4 × 0.2 ellipse
   const double m = 34.0 * (curve_length / box_width) / paper_length *
                    std::pow(box_width / (128.0 * h), 0.85);
   return std::max(8, int(std::lround(m)));

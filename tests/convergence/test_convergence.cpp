@@ -27,9 +27,10 @@ std::vector<fictus::LevelResult> run_levels(fictus::Variant variant, int first, 
 }
 
 TEST(Convergence, NonSmoothVariant) {
-  const auto rows = run_levels(fictus::Variant::nonsmooth, 6, 9);
+  const auto rows = run_levels(fictus::Variant::nonsmooth, 6, 10);
   const auto fit = fictus::fitted_rates(rows);
-  // Paper: 1.03 / 0.51 / 0.93. Bands: ±0.25 around the theory (1, ½, 1).
+  // Paper: 1.03 / 0.51 / 0.93 (fit over 1/128 … 1/4096). Bands: ±0.25 around the theory (1, ½, 1);
+  // single pairs of levels scatter by ±0.3 (the kink of û crosses cells differently per level).
   EXPECT_NEAR(fit[0], 1.0, 0.25);
   EXPECT_NEAR(fit[1], 0.5, 0.25);
   EXPECT_NEAR(fit[2], 1.0, 0.25);
@@ -39,12 +40,20 @@ TEST(Convergence, NonSmoothVariant) {
 }
 
 TEST(Convergence, SmoothVariant) {
-  const auto rows = run_levels(fictus::Variant::smooth, 6, 9);
-  const auto fit = fictus::fitted_rates(rows);
-  // At least the paper's 1.76 / 0.88 / 1.5 (less a 0.1 margin for the fit over 4 levels).
-  EXPECT_GE(fit[0], 1.76 - 0.1);
-  EXPECT_GE(fit[1], 0.88 - 0.1);
-  EXPECT_GE(fit[2], 1.50 - 0.1);
+  // Level 6 is left out: with the paper's m (19 points) Γ at δ = L/m ≈ 0.1 would leave the box.
+  const auto rows = run_levels(fictus::Variant::smooth, 7, 10);
+  const auto rates = fictus::observed_rates(rows);
+  // On the two finest pairs: at least the paper's 1.76 / 0.88 / 1.5 and at most the Q1 optimum
+  // (2 / 1 / 2) plus 0.3. The coarsest pair (1/128 → 1/256) is pre-asymptotic (Γ is 5 cells
+  // from ∂Ω there) and is only printed.
+  for (std::size_t k = rates.size() - 2; k < rates.size(); ++k) {
+    EXPECT_GE(rates[k][0], 1.76);
+    EXPECT_LE(rates[k][0], 2.3);
+    EXPECT_GE(rates[k][1], 0.88);
+    EXPECT_LE(rates[k][1], 1.3);
+    EXPECT_GE(rates[k][2], 1.50);
+    EXPECT_LE(rates[k][2], 2.3);
+  }
 }
 
 }  // namespace

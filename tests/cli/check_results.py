@@ -1,0 +1,46 @@
+#!/usr/bin/env python3
+"""Checks a results.json written by `fictus solve` against the documented keys and the
+discrete Signorini conditions. Usage: check_results.py DIR"""
+import json
+import math
+import sys
+
+REQUIRED = {
+    "version": str, "options": dict, "grid": dict, "multipliers": int, "newton": dict,
+    "inner": dict, "timings": dict, "signorini": dict, "errors": dict, "peak_memory_bytes": int,
+}
+
+
+def main(folder):
+    with open(f"{folder}/results.json") as handle:
+        results = json.load(handle)
+    for key, kind in REQUIRED.items():
+        assert key in results, f"missing key {key}"
+        assert isinstance(results[key], kind), f"{key} is not {kind.__name__}"
+    assert "condition_number" in results
+    for key in ("N", "h", "n_nodes", "n_unknowns"):
+        assert key in results["grid"], f"grid.{key} missing"
+    n = results["grid"]["N"]
+    assert results["grid"]["n_nodes"] == (n + 1) ** 2
+    assert results["grid"]["n_unknowns"] == (n - 1) ** 2
+    assert results["newton"]["converged"] is True
+    assert 1 <= results["newton"]["iterations"] <= 20
+    assert results["inner"]["fast_solves"] >= 2
+    assert results["timings"]["total"] > 0
+    signorini = results["signorini"]
+    assert signorini["min_gap"] >= -1e-10, signorini
+    assert signorini["min_normal_derivative"] >= -1e-10, signorini
+    assert signorini["max_complementarity"] <= 1e-10, signorini
+    for key in ("l2_omega", "h1_omega", "h1semi_omega", "l2_gamma",
+                "rel_l2_omega", "rel_h1_omega", "rel_l2_gamma"):
+        value = results["errors"][key]
+        assert math.isfinite(value) and 0 < value < 1, f"errors.{key} = {value}"
+    with open(f"{folder}/points.csv") as handle:
+        rows = handle.read().strip().splitlines()
+    assert rows[0] == "i,x,y,nx,ny,g,u,dudn,lambda,contact"
+    assert len(rows) == results["multipliers"] + 1
+    print("results.json and points.csv OK")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])
