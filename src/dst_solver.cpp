@@ -8,20 +8,29 @@
 
 namespace fictus {
 
-SineSpectrum1d::SineSpectrum1d(int n_cells, double h) {
-  stiffness.resize(n_cells - 1);
-  mass.resize(n_cells - 1);
-  for (int p = 1; p < n_cells; ++p) {
-    const double cp = std::cos(std::numbers::pi * p / n_cells);
-    stiffness[p - 1] = (2.0 / h) * (1.0 - cp);
-    mass[p - 1] = (h / 3.0) * (2.0 + cp);
+Spectrum1d::Spectrum1d(int n_cells, double h, Boundary boundary) {
+  const bool periodic = boundary == Boundary::periodic;
+  const int count = periodic ? n_cells : n_cells - 1;
+  stiffness.resize(count);
+  mass.resize(count);
+  for (int k = 0; k < count; ++k) {
+    const double angle = periodic ? 2.0 * std::numbers::pi * k / n_cells : std::numbers::pi * (k + 1) / n_cells;
+    const double cp = std::cos(angle);
+    stiffness[k] = (2.0 / h) * (1.0 - cp);
+    mass[k] = (h / 3.0) * (2.0 + cp);
   }
 }
 
+std::unique_ptr<FastSolver> make_fast_solver(const Grid& grid, double c, int threads) {
+  if (grid.periodic()) return std::make_unique<PeriodicSolver>(grid, c, threads);
+  return std::make_unique<DstSolver>(grid, c, threads);
+}
+
 DstSolver::DstSolver(const Grid& grid, double c, int threads)
-    : grid_(grid), c_(c), threads_(threads < 1 ? 1 : threads), sx_(grid.nx(), grid.h()),
-      sy_(grid.ny(), grid.h()) {
+    : grid_(grid), c_(c), threads_(threads < 1 ? 1 : threads), sx_(grid.nx(), grid.h(), Boundary::dirichlet),
+      sy_(grid.ny(), grid.h(), Boundary::dirichlet) {
   if (!(c >= 0.0) || !std::isfinite(c)) throw std::invalid_argument("data.c: must be finite and >= 0");
+  if (grid.periodic()) throw std::invalid_argument("DstSolver: needs a Dirichlet box");
   plan_ = std::make_unique<detail::R2rPlan2d>(grid.ny() - 1, grid.nx() - 1, detail::R2rKind::dst1,
                                               threads_);
 }
@@ -48,6 +57,8 @@ void DstSolver::solve_in_place(GridVector& r) const {
   scale_by(r, true);
   plan_->execute(r.data());
 }
+
+void DstSolver::transform(GridVector& v) const { plan_->execute(v.data()); }
 
 void DstSolver::apply(const GridVector& x, GridVector& y) const {
   y = x;

@@ -12,7 +12,7 @@ GradientField numerical_gradient(ScalarField u, double scale) {
 }
 
 Q1Sample sample_q1(const Grid& grid, const GridVector& u_h, int ix, int iy, double x, double y) {
-  auto node = [&](int i, int j) { return grid.is_interior(i, j) ? u_h[grid.index(i, j)] : 0.0; };
+  auto node = [&](int i, int j) { return grid.has_unknown(i, j) ? u_h[grid.index(i, j)] : 0.0; };
   const double h = grid.h();
   const double xi = (x - grid.x(ix)) / h, eta = (y - grid.y(iy)) / h;
   const double u00 = node(ix, iy), u10 = node(ix + 1, iy), u01 = node(ix, iy + 1), u11 = node(ix + 1, iy + 1);

@@ -43,5 +43,39 @@ R2rPlan2d::~R2rPlan2d() {
 
 void R2rPlan2d::execute(double* data) const { fftw_execute_r2r(plan_, data, data); }
 
+RealDft2d::RealDft2d(int n_slow, int n_fast, int threads) {
+  std::lock_guard lock(planner_mutex());
+  init_threads_once();
+  fftw_plan_with_nthreads(threads < 1 ? 1 : threads);
+  const std::size_t n_real = std::size_t(n_slow) * std::size_t(n_fast);
+  const std::size_t n_complex = std::size_t(n_slow) * std::size_t(n_fast / 2 + 1);
+  double* real = static_cast<double*>(fftw_malloc(sizeof(double) * n_real));
+  fftw_complex* spectrum = static_cast<fftw_complex*>(fftw_malloc(sizeof(fftw_complex) * n_complex));
+  if (real == nullptr || spectrum == nullptr) {
+    fftw_free(real);
+    fftw_free(spectrum);
+    throw std::bad_alloc();
+  }
+  forward_ = fftw_plan_dft_r2c_2d(n_slow, n_fast, real, spectrum, FFTW_ESTIMATE);
+  backward_ = fftw_plan_dft_c2r_2d(n_slow, n_fast, spectrum, real, FFTW_ESTIMATE);
+  fftw_free(real);
+  fftw_free(spectrum);
+  if (forward_ == nullptr || backward_ == nullptr) throw std::runtime_error("FFTW: could not plan the real DFT");
+}
+
+RealDft2d::~RealDft2d() {
+  std::lock_guard lock(planner_mutex());
+  fftw_destroy_plan(forward_);
+  fftw_destroy_plan(backward_);
+}
+
+void RealDft2d::forward(double* real, std::complex<double>* spectrum) const {
+  fftw_execute_dft_r2c(forward_, real, reinterpret_cast<fftw_complex*>(spectrum));
+}
+
+void RealDft2d::backward(std::complex<double>* spectrum, double* real) const {
+  fftw_execute_dft_c2r(backward_, reinterpret_cast<fftw_complex*>(spectrum), real);
+}
+
 }  // namespace detail
 }  // namespace fictus

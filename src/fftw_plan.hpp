@@ -3,6 +3,7 @@
 // executed on caller arrays that come from the FFTW allocator (same alignment as at planning).
 #include <fftw3.h>
 
+#include <complex>
 #include <cstddef>
 
 namespace fictus::detail {
@@ -23,6 +24,22 @@ class R2rPlan2d {
 
  private:
   fftw_plan plan_ = nullptr;
+};
+
+/// Out-of-place 2-D real DFT pair (FFTW r2c / c2r, unnormalized) of an n_slow × n_fast real array
+/// and its n_slow × (n_fast/2 + 1) half spectrum.
+class RealDft2d {
+ public:
+  RealDft2d(int n_slow, int n_fast, int threads);
+  ~RealDft2d();
+  RealDft2d(const RealDft2d&) = delete;
+  RealDft2d& operator=(const RealDft2d&) = delete;
+
+  void forward(double* real, std::complex<double>* spectrum) const;   // keeps `real`
+  void backward(std::complex<double>* spectrum, double* real) const;  // overwrites `spectrum`
+
+ private:
+  fftw_plan forward_ = nullptr, backward_ = nullptr;
 };
 
 }  // namespace fictus::detail

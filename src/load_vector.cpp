@@ -31,7 +31,7 @@ GridVector assemble_load(const Grid& grid, const ScalarField& f, int q, int thre
           }
         }
         auto add = [&](int i, int j, double w) {
-          if (grid.is_interior(i, j)) load[grid.index(i, j)] += w;
+          if (grid.has_unknown(i, j)) load[grid.index(i, j)] += w;
         };
         add(ix, iy, w00);
         add(ix + 1, iy, w10);

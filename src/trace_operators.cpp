@@ -14,13 +14,14 @@ class RowBuilder {
  public:
   RowBuilder(const Grid& grid, SparseRows& rows) : grid_(grid), rows_(rows) {}
   void add(int i, int j, double value) {
-    if (!grid_.is_interior(i, j)) return;
+    if (!grid_.has_unknown(i, j)) return;
+    const std::size_t index = grid_.index(i, j);  // periodic boxes: (0, j) and (nx, j) are one node
     for (std::size_t k = rows_.row_begin.back(); k < rows_.entries.size(); ++k)
-      if (rows_.entries[k].i == i && rows_.entries[k].j == j) {
+      if (rows_.entries[k].index == index) {
         rows_.entries[k].value += value;
         return;
       }
-    rows_.entries.push_back({grid_.index(i, j), i, j, value});
+    rows_.entries.push_back({index, i, j, value});
   }
   /// Bilinear weights of point p in cell (ix, iy), scaled by w.
   void add_bilinear(int ix, int iy, Point p, double w) {

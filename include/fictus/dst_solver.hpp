@@ -9,6 +9,7 @@
 #include <memory>
 #include <vector>
 
+#include "fictus/fast_solver.hpp"
 #include "fictus/grid.hpp"
 
 namespace fictus {
@@ -17,34 +18,27 @@ namespace detail {
 class R2rPlan2d;
 }
 
-/// 1-D P1 stiffness and consistent mass eigenvalues k_p, m_p, p = 1..n−1 (index p−1) on n cells.
-struct SineSpectrum1d {
-  std::vector<double> stiffness, mass;
-  SineSpectrum1d(int n_cells, double h);
-};
-
-class DstSolver {
+class DstSolver final : public FastSolver {
  public:
   /// c ≥ 0 (c = 0 is fine: the Dirichlet Laplacian is positive definite). threads ≥ 1.
   DstSolver(const Grid& grid, double c, int threads = 1);
-  ~DstSolver();
+  ~DstSolver() override;
   DstSolver(const DstSolver&) = delete;
   DstSolver& operator=(const DstSolver&) = delete;
 
-  const Grid& grid() const { return grid_; }
-  double c() const { return c_; }
-
-  /// Overwrites r (size n_unknowns, from the FFTW allocator) with A⁻¹ r.
-  void solve_in_place(GridVector& r) const;
-  /// y = A x, by the same transforms (used by tests and residual checks).
-  void apply(const GridVector& x, GridVector& y) const;
+  const Grid& grid() const override { return grid_; }
+  double c() const override { return c_; }
+  void solve_in_place(GridVector& r) const override;
+  void apply(const GridVector& x, GridVector& y) const override;
+  /// One in-place 2-D DST-I (RODFT00) of a grid vector: the unit of cost benchmarks compare to.
+  void transform(GridVector& v) const;
 
  private:
   void scale_by(GridVector& v, bool inverse) const;
   Grid grid_;
   double c_;
   int threads_;
-  SineSpectrum1d sx_, sy_;
+  Spectrum1d sx_, sy_;
   std::unique_ptr<detail::R2rPlan2d> plan_;
 };
 

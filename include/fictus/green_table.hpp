@@ -1,10 +1,14 @@
 #pragma once
-// Discrete Green's function of A = K + c·M on the Dirichlet box (docs/math.md, DESIGN §3):
-//   G[(i,j),(k,l)] = (A⁻¹)_{(i,j),(k,l)}
-//                  = T(i−k, j−l) − T(i+k, j−l) − T(i−k, j+l) + T(i+k, j+l),
-//   T(s,t) = 1/(nx·ny) Σ_{p<nx, q<ny, p,q ≥ 1} cos(pπs/nx) cos(qπt/ny) / λ_pq,
-// T is even and 2n-periodic in each argument; the table holds T on [0,nx]×[0,ny] and is made by
-// ONE 2-D DCT-I (FFTW REDFT00) of size (nx+1)(ny+1). Built once per grid and c.
+// Discrete Green's function of A = K + c·M (docs/math.md, DESIGN §3).
+// Dirichlet box:
+//   G[(i,j),(k,l)] = T(i−k, j−l) − T(i+k, j−l) − T(i−k, j+l) + T(i+k, j+l),
+//   T(s,t) = 1/(nx·ny) Σ_{p=1}^{nx−1} Σ_{q=1}^{ny−1} cos(pπs/nx) cos(qπt/ny) / λ_pq,
+//   even and 2n-periodic; the table holds [0,nx]×[0,ny], ONE 2-D DCT-I (REDFT00) of size (nx+1)(ny+1).
+// Periodic box (nx, ny even):
+//   G[(i,j),(k,l)] = T(i−k, j−l),  T(s,t) = 1/(nx·ny) Σ_{p<nx} Σ_{q<ny} cos(2πps/nx) cos(2πqt/ny) / λ_pq,
+//   even and n-periodic; the table holds [0,nx/2]×[0,ny/2], one REDFT00 of size (nx/2+1)(ny/2+1).
+//   With c = 0 the zero mode is dropped: G is the pseudo-inverse A⁺.
+// Built once per grid, boundary and c; lookups are const and thread-safe.
 #include <cstddef>
 
 #include "fictus/grid.hpp"
@@ -16,23 +20,28 @@ class GreenTable {
   GreenTable(const Grid& grid, double c, int threads = 1);
 
   const Grid& grid() const { return grid_; }
+  double c() const { return c_; }
   /// T(s, t) for any integers s, t (folded into the table).
-  double T(int s, int t) const {
-    return table_[std::size_t(fold(t, grid_.ny())) * std::size_t(grid_.nx() + 1) + fold(s, grid_.nx())];
-  }
-  /// (A⁻¹) between interior nodes (i, j) and (k, l).
+  double T(int s, int t) const { return table_[std::size_t(fold(t, ny_)) * width_ + std::size_t(fold(s, nx_))]; }
+  /// (A⁻¹)_{(i,j),(k,l)} between nodes carrying unknowns (A⁺ for a singular periodic A).
   double G(int i, int j, int k, int l) const {
+    if (periodic_) return T(i - k, j - l);
     return T(i - k, j - l) - T(i + k, j - l) - T(i - k, j + l) + T(i + k, j + l);
   }
   std::size_t memory_bytes() const { return table_.size() * sizeof(double); }
 
  private:
-  static int fold(int s, int n) {
-    s = s < 0 ? -s : s;
-    s %= 2 * n;
-    return s > n ? 2 * n - s : s;
+  /// Dirichlet: period 2n, table [0, n]; periodic: period n, table [0, n/2]. `n` is the period.
+  static int fold(int s, int period) {
+    s %= period;
+    s = s < 0 ? s + period : s;
+    return s > period / 2 ? period - s : s;
   }
   Grid grid_;
+  double c_;
+  bool periodic_;
+  int nx_, ny_;  // periods in s and t
+  std::size_t width_;
   AlignedVector<double> table_;
 };
 
