@@ -8,7 +8,8 @@
 #include <string>
 
 #include "fictus/curve_grid_intersection.hpp"
-#include "fictus/dst_solver.hpp"
+#include "fictus/fast_solver.hpp"
+#include "fictus/schur_complement.hpp"
 #include "fictus/green_table.hpp"
 #include "fictus/load_vector.hpp"
 #include "fictus/trace_operators.hpp"
@@ -89,107 +90,199 @@ Eigen::VectorXd to_eigen(const std::vector<double>& v) {
 
 }  // namespace
 
-Solution solve(const Problem& problem, SolverOptions options) {
-  options.validate();
-  if (!problem.gamma) throw std::invalid_argument("geometry: no curve given");
-  if (!problem.f) throw std::invalid_argument("data.f: not given");
-  if (!problem.g) throw std::invalid_argument("data.g: not given");
+namespace {
+
+Eigen::VectorXd row_sums(const SparseRows& rows, const Grid& grid) {
+  GridVector ones(grid.n_unknowns(), 1.0);
+  std::vector<double> out;
+  rows.multiply(ones, out);
+  return to_eigen(out);
+}
+
+}  // namespace
+
+/// Everything that depends on the curve and the options that shape the trace rows.
+struct CurveSetup {
+  std::shared_ptr<const Curve> gamma, Gamma;
+  SolverOptions options;  // the options it was built with
+  Collocation collocation;
+  double delta = 0;
+  std::unique_ptr<CurveGridIntersection> gamma_geometry, offset_geometry;
+  SparseRows B_gamma, C_gamma, B_Gamma;
+  std::unique_ptr<SchurComplement> schur;
+  Eigen::VectorXd b0, c0;
+  std::optional<ConstantMode> mode;
+
+  const CurveGridIntersection& Gamma_geometry() const { return offset_geometry ? *offset_geometry : *gamma_geometry; }
+  bool matches(const Problem& problem, const SolverOptions& o) const {
+    const SolverOptions& s = options;
+    return problem.gamma == gamma && o.variant == s.variant && o.multipliers == s.multipliers &&
+           o.offset == s.offset && o.normal_shift == s.normal_shift && o.inner == s.inner &&
+           o.krylov_tolerance == s.krylov_tolerance && o.krylov_max_iterations == s.krylov_max_iterations;
+  }
+};
+
+struct FictitiousDomainSolver::State {
+  Problem problem;  // grid-level data only: box, N, boundary, c, f
+  Grid grid;
+  int threads;
+  int load_quadrature;
+  std::unique_ptr<FastSolver> fast;
+  std::unique_ptr<GreenTable> green;
+  GridVector u0;
+  bool have_u0 = false;
+  double load_total = 0;
+  std::unique_ptr<CurveSetup> setup;
+};
+
+FictitiousDomainSolver::FictitiousDomainSolver(const Problem& problem, int threads, int load_quadrature) {
   if (problem.N < 8) throw std::invalid_argument("domain.N: need N >= 8, got " + std::to_string(problem.N));
   if (!(problem.c >= 0) || !std::isfinite(problem.c)) throw std::invalid_argument("data.c: must be finite and >= 0");
+  if (!problem.f) throw std::invalid_argument("data.f: not given");
+  if (threads < 1) throw std::invalid_argument("solver.threads: must be >= 1");
+  Grid grid(problem.box, problem.N, problem.boundary);
+  state_ = std::make_unique<State>(State{problem, grid, threads, load_quadrature, make_fast_solver(grid, problem.c, threads),
+                                         nullptr, {}, false, 0.0, nullptr});
+}
 
-  Solution sol(Grid(problem.box, problem.N));
-  const Grid& grid = sol.grid;
+FictitiousDomainSolver::~FictitiousDomainSolver() = default;
+
+const Grid& FictitiousDomainSolver::grid() const { return state_->grid; }
+
+Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions options, bool compute_field) {
+  options.validate();
+  if (!problem.gamma) throw std::invalid_argument("geometry: no curve given");
+  if (!problem.g) throw std::invalid_argument("data.g: not given");
+  State& st = *state_;
+  const Grid& grid = st.grid;
   const double h = grid.h();
+  Solution sol(grid);
   PhaseClock clock(sol.timings);
+  std::size_t fast_solves = 0;
 
-  // Curves, collocation points, trace rows.
-  const Curve& gamma = *problem.gamma;
-  const CurveGridIntersection gamma_geometry(gamma, grid, "geometry");
-  const ArcLengthTable arc_length(gamma);
-  const double L = arc_length.length();
-  if (options.multipliers == 0) options.multipliers = default_multipliers(L, grid.box().x1 - grid.box().x0, h);
-  const int m = options.multipliers;
-  const double spacing = L / m;
-  if (spacing < 2 * h)
-    throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) + " is too large for the grid (spacing L/m = " +
-                                std::to_string(spacing) + " < 2h; use m <= " + std::to_string(int(L / (2 * h))) + ")");
-  sol.collocation = make_collocation(gamma, arc_length, m);
-  const Collocation& points = sol.collocation;
-
-  if (options.variant == Variant::smooth) {
-    sol.delta = options.offset * spacing;
-    sol.Gamma = std::make_shared<OffsetCurve>(problem.gamma, sol.delta);
-  } else {
-    sol.delta = 0.0;
-    sol.Gamma = problem.gamma;
+  // Load and u₀ = A⁻¹f (A⁺f for a singular A), once per solver.
+  if (!st.have_u0) {
+    st.u0 = assemble_load(grid, st.problem.f, st.load_quadrature, st.threads);
+    st.load_total = 0;
+    for (double v : st.u0) {
+      if (!std::isfinite(v)) throw std::invalid_argument("data.f: not finite somewhere in the box");
+      st.load_total += v;
+    }
+    clock.mark("load");
+    st.fast->solve_in_place(st.u0);
+    ++fast_solves;
+    st.have_u0 = true;
+    clock.mark("u0");
   }
-  std::optional<CurveGridIntersection> offset_geometry;
-  if (options.variant == Variant::smooth) offset_geometry.emplace(*sol.Gamma, grid, "formulation.offset");
-  const CurveGridIntersection& Gamma_geometry = offset_geometry ? *offset_geometry : gamma_geometry;
 
-  const SparseRows B_gamma = point_value_rows(grid, points.point);
-  const SparseRows C_gamma = normal_derivative_rows(grid, points.point, points.normal, options.normal_shift * h);
-  const SparseRows B_Gamma = arc_integral_rows(Gamma_geometry, points.arc_begin, points.arc_end);
+  // Curve, collocation, trace rows, Schur complement: reused while the curve and its options stay.
+  if (st.setup && st.setup->matches(problem, options)) {
+    options.multipliers = st.setup->options.multipliers;
+    sol.reused_curve = true;
+  } else {
+    st.setup.reset();
+    auto setup = std::make_unique<CurveSetup>();
+    setup->gamma = problem.gamma;
+    const Curve& gamma = *problem.gamma;
+    setup->gamma_geometry = std::make_unique<CurveGridIntersection>(gamma, grid, "geometry");
+    const ArcLengthTable arc_length(gamma);
+    const double L = arc_length.length();
+    const SolverOptions requested = options;
+    if (options.multipliers == 0) options.multipliers = default_multipliers(L, grid.box().x1 - grid.box().x0, h);
+    const int m = options.multipliers;
+    const double spacing = L / m;
+    if (spacing < 2 * h)
+      throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) +
+                                  " is too large for the grid (spacing L/m = " + std::to_string(spacing) +
+                                  " < 2h; use m <= " + std::to_string(int(L / (2 * h))) + ")");
+    setup->collocation = make_collocation(gamma, arc_length, m);
+    if (options.variant == Variant::smooth) {
+      setup->delta = options.offset * spacing;
+      setup->Gamma = std::make_shared<OffsetCurve>(problem.gamma, setup->delta);
+      setup->offset_geometry = std::make_unique<CurveGridIntersection>(*setup->Gamma, grid, "formulation.offset");
+    } else {
+      setup->Gamma = problem.gamma;
+    }
+    const Collocation& points = setup->collocation;
+    setup->B_gamma = point_value_rows(grid, points.point);
+    setup->C_gamma = normal_derivative_rows(grid, points.point, points.normal, options.normal_shift * h);
+    setup->B_Gamma = arc_integral_rows(setup->Gamma_geometry(), points.arc_begin, points.arc_end);
+    std::vector<double> b0, c0;
+    setup->B_gamma.multiply(st.u0, b0);
+    setup->C_gamma.multiply(st.u0, c0);
+    setup->b0 = to_eigen(b0);
+    setup->c0 = to_eigen(c0);
+    if (st.fast->singular())
+      setup->mode = ConstantMode{row_sums(setup->B_gamma, grid), row_sums(setup->C_gamma, grid),
+                                 row_sums(setup->B_Gamma, grid), st.load_total};
+    clock.mark("geometry");
+
+    if (options.inner == InnerSolver::green) {
+      if (!st.green) {
+        st.green = std::make_unique<GreenTable>(grid, st.problem.c, st.threads);
+        clock.mark("green_table");
+      }
+      setup->schur = std::make_unique<ExplicitSchur>(*st.green, setup->B_gamma, setup->C_gamma, setup->B_Gamma, st.threads);
+      clock.mark("schur");
+    } else {
+      GmresOptions gmres_options;
+      gmres_options.relative_tolerance = options.krylov_tolerance;
+      gmres_options.max_iterations = options.krylov_max_iterations;
+      gmres_options.restart = m + 1;
+      setup->schur = std::make_unique<ImplicitSchur>(*st.fast, setup->B_gamma, setup->C_gamma, setup->B_Gamma, gmres_options);
+    }
+    setup->options = requested;
+    setup->options.multipliers = m;
+    st.setup = std::move(setup);
+  }
+  const CurveSetup& setup = *st.setup;
+  const int m = setup.collocation.m;
+  sol.collocation = setup.collocation;
+  sol.Gamma = setup.Gamma;
+  sol.delta = setup.delta;
+
+  // Obstacle at the collocation points, then semismooth Newton.
   sol.g.resize(m);
   for (int i = 0; i < m; ++i) {
-    sol.g[i] = problem.g(points.point[i].x, points.point[i].y);
+    const Point p = setup.collocation.point[i];
+    sol.g[i] = problem.g(p.x, p.y);
     if (!std::isfinite(sol.g[i]))
-      throw std::invalid_argument("data.g: not finite at the collocation point (" + std::to_string(points.point[i].x) +
-                                  ", " + std::to_string(points.point[i].y) + ")");
+      throw std::invalid_argument("data.g: not finite at the collocation point (" + std::to_string(p.x) + ", " +
+                                  std::to_string(p.y) + ")");
   }
-  clock.mark("geometry");
-
-  // Load and u₀ = A⁻¹ f.
-  GridVector load = assemble_load(grid, problem.f, options.load_quadrature, options.threads);
-  for (double v : load)
-    if (!std::isfinite(v)) throw std::invalid_argument("data.f: not finite somewhere in the box");
-  clock.mark("load");
-  const DstSolver fast_solver(grid, problem.c, options.threads);
-  GridVector u0 = load;
-  fast_solver.solve_in_place(u0);
-  std::vector<double> b0, c0;
-  B_gamma.multiply(u0, b0);
-  C_gamma.multiply(u0, c0);
-  u0 = GridVector();  // only its traces are needed from here on
-  clock.mark("u0");
-
-  // Schur complement.
-  std::unique_ptr<SchurComplement> schur;
-  if (options.inner == InnerSolver::green) {
-    const GreenTable green(grid, problem.c, options.threads);
-    clock.mark("green_table");
-    schur = std::make_unique<ExplicitSchur>(green, B_gamma, C_gamma, B_Gamma, options.threads);
-    clock.mark("schur");
-  } else {
-    GmresOptions gmres_options;
-    gmres_options.relative_tolerance = options.krylov_tolerance;
-    gmres_options.max_iterations = options.krylov_max_iterations;
-    gmres_options.restart = m;
-    schur = std::make_unique<ImplicitSchur>(fast_solver, B_gamma, C_gamma, B_Gamma, gmres_options);
-  }
-
-  // Semismooth Newton.
   NewtonOptions newton_options;
   newton_options.rho = options.rho;
   newton_options.max_iterations = options.max_newton;
   newton_options.start_all_active = options.start_all_active;
   newton_options.tolerance = options.newton_tolerance;
-  sol.newton = solve_semismooth_newton(*schur, to_eigen(b0), to_eigen(c0), to_eigen(sol.g), newton_options);
+  const std::size_t schur_solves_before = setup.schur->fast_solves();
+  sol.newton = solve_semismooth_newton(*setup.schur, setup.b0, setup.c0, to_eigen(sol.g), newton_options,
+                                       setup.mode ? &*setup.mode : nullptr);
+  fast_solves += setup.schur->fast_solves() - schur_solves_before;
   for (const NewtonStep& step : sol.newton.history) sol.inner_iterations += step.inner_iterations;
-  if (options.condition_number) sol.condition_number = schur->condition_number(sol.newton.active);
+  if (options.condition_number) sol.condition_number = setup.schur->condition_number(sol.newton.active);
+  sol.lambda.assign(sol.newton.lambda.data(), sol.newton.lambda.data() + m);
+  sol.alpha = sol.newton.alpha;
   clock.mark("newton");
 
-  // û = A⁻¹ (f + B_Γᵀ λ).
-  sol.lambda.assign(sol.newton.lambda.data(), sol.newton.lambda.data() + m);
-  B_Gamma.add_transposed(sol.lambda, load);
-  fast_solver.solve_in_place(load);
-  sol.u = std::move(load);
-  sol.fast_solves = 2 + schur->fast_solves();
-  clock.mark("final_solve");
+  if (compute_field) {
+    // û = u₀ + A⁻¹B_Γᵀλ (+ α for a singular A).
+    GridVector u(grid.n_unknowns(), 0.0);
+    setup.B_Gamma.add_transposed(sol.lambda, u);
+    st.fast->solve_in_place(u);
+    ++fast_solves;
+    for (std::size_t k = 0; k < u.size(); ++k) u[k] += st.u0[k] + sol.alpha;
+    sol.u = std::move(u);
+    setup.B_gamma.multiply(sol.u, sol.trace);
+    setup.C_gamma.multiply(sol.u, sol.normal_derivative);
+    clock.mark("final_solve");
+  } else {
+    sol.trace.assign(sol.newton.trace.data(), sol.newton.trace.data() + m);
+    sol.normal_derivative.assign(sol.newton.normal_derivative.data(), sol.newton.normal_derivative.data() + m);
+  }
+  sol.fast_solves = fast_solves;
 
   // Signorini conditions at the collocation points.
-  B_gamma.multiply(sol.u, sol.trace);
-  C_gamma.multiply(sol.u, sol.normal_derivative);
   sol.signorini.min_gap = 1e300;
   sol.signorini.min_normal_derivative = 1e300;
   for (int i = 0; i < m; ++i) {
@@ -199,15 +292,21 @@ Solution solve(const Problem& problem, SolverOptions options) {
     sol.signorini.max_complementarity = std::max(sol.signorini.max_complementarity, std::abs(gap * dn));
   }
 
-  if (problem.exact) {
+  if (problem.exact && compute_field) {
     const GradientField gradient = problem.exact_gradient ? problem.exact_gradient
                                                           : numerical_gradient(problem.exact, grid.box().x1 - grid.box().x0);
-    sol.errors = compute_errors(sol.u, gamma_geometry, problem.exact, gradient, options.error_quadrature, options.threads);
+    sol.errors = compute_errors(sol.u, *setup.gamma_geometry, problem.exact, gradient, options.error_quadrature, st.threads);
     clock.mark("errors");
   }
   sol.options = options;
   sol.peak_memory_bytes = peak_memory_bytes();
   return sol;
+}
+
+Solution solve(const Problem& problem, SolverOptions options) {
+  options.validate();
+  FictitiousDomainSolver solver(problem, options.threads, options.load_quadrature);
+  return solver.solve(problem, options);
 }
 
 }  // namespace fictus

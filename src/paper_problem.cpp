@@ -14,20 +14,21 @@ double u_exact(double x, double y) {
 }
 }  // namespace
 
-Problem paper_problem(int N) {
+Problem paper_problem(int N, double c, Boundary boundary) {
   Problem p;
-  p.name = "paper_ellipse";
+  p.name = boundary == Boundary::periodic ? "paper_ellipse_periodic" : "paper_ellipse";
   p.box = Box{0.0, 1.0, 0.0, 1.0};
   p.N = N;
+  p.boundary = boundary;
   p.gamma = std::make_shared<Ellipse>(Point{0.5, 0.5}, 0.4, 0.2, 0.0);
-  p.c = 1.0;
+  p.c = c;
   p.exact = u_exact;
   p.exact_gradient = [](double x, double y) {
     const double a = pos(x - 0.5), b = pos(y - 0.5);
     return Point{3 * a * a, 1.5 * b * b};
   };
   // −Δu_ex = −6(x−½)⁺ − 3(y−½)⁺
-  p.f = [](double x, double y) { return -6.0 * pos(x - 0.5) - 3.0 * pos(y - 0.5) + u_exact(x, y); };
+  p.f = [c](double x, double y) { return -6.0 * pos(x - 0.5) - 3.0 * pos(y - 0.5) + c * u_exact(x, y); };
   p.g = [](double x, double y) {
     if (x < 0.5 && y < 0.5) return std::sin(-2.0 * std::atan2(y - 0.5, x - 0.5));
     return u_exact(x, y);

@@ -4,7 +4,7 @@
 
 namespace fictus {
 
-ImplicitSchur::ImplicitSchur(const DstSolver& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
+ImplicitSchur::ImplicitSchur(const FastSolver& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
                              const SparseRows& B_Gamma, const GmresOptions& options)
     : solver_(solver), B_gamma_(B_gamma), C_gamma_(C_gamma), B_Gamma_(B_Gamma), options_(options),
       work_(solver.grid().n_unknowns()) {}
@@ -21,14 +21,27 @@ void ImplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Ei
   sc = Eigen::Map<const Eigen::VectorXd>(rows_.data(), Eigen::Index(rows_.size()));
 }
 
-LinearSolveReport ImplicitSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, Eigen::VectorXd& lambda) const {
-  Eigen::VectorXd sb, sc;
+LinearSolveReport ImplicitSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
+                                       Eigen::VectorXd& lambda, double& alpha) const {
+  const Eigen::Index m = lambda.size();
+  Eigen::VectorXd sb, sc, lam;
   const LinearOperator op = [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-    apply(x, sb, sc);
+    lam = x.head(m);
+    apply(lam, sb, sc);
     y.resize(x.size());
-    for (Eigen::Index i = 0; i < x.size(); ++i) y(i) = active[i] ? sb(i) : sc(i);
+    for (Eigen::Index i = 0; i < m; ++i) y(i) = active[i] ? sb(i) : sc(i);
+    if (mode) {
+      for (Eigen::Index i = 0; i < m; ++i) y(i) += x(m) * (active[i] ? mode->trace_B(i) : mode->trace_C(i));
+      y(m) = mode->arc_weights.dot(lam);
+    }
   };
-  const GmresReport g = gmres(op, d, lambda, options_);
+  Eigen::VectorXd x(m + (mode ? 1 : 0)), rhs(x.size());
+  x.head(m) = lambda;
+  rhs.head(m) = d;
+  if (mode) x(m) = alpha, rhs(m) = -mode->load_total;
+  const GmresReport g = gmres(op, rhs, x, options_);
+  lambda = x.head(m);
+  if (mode) alpha = x(m);
   return {g.iterations, g.relative_residual, g.converged};
 }
 
@@ -62,18 +75,31 @@ void ExplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Ei
   sc = S_C_ * lambda;
 }
 
-Eigen::MatrixXd ExplicitSchur::newton_matrix(const ActiveSet& active) const {
-  Eigen::MatrixXd S(S_B_.rows(), S_B_.cols());
-  for (Eigen::Index i = 0; i < S.rows(); ++i) S.row(i) = active[i] ? S_B_.row(i) : S_C_.row(i);
+Eigen::MatrixXd ExplicitSchur::newton_matrix(const ActiveSet& active, const ConstantMode* mode) const {
+  const Eigen::Index m = S_B_.rows(), n = m + (mode ? 1 : 0);
+  Eigen::MatrixXd S(n, n);
+  for (Eigen::Index i = 0; i < m; ++i) S.row(i).head(m) = active[i] ? S_B_.row(i) : S_C_.row(i);
+  if (mode) {
+    for (Eigen::Index i = 0; i < m; ++i) S(i, m) = active[i] ? mode->trace_B(i) : mode->trace_C(i);
+    S.row(m).head(m) = mode->arc_weights.transpose();
+    S(m, m) = 0.0;
+  }
   return S;
 }
 
-LinearSolveReport ExplicitSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, Eigen::VectorXd& lambda) const {
-  const Eigen::MatrixXd S = newton_matrix(active);
-  lambda = S.partialPivLu().solve(d);
+LinearSolveReport ExplicitSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
+                                       Eigen::VectorXd& lambda, double& alpha) const {
+  const Eigen::MatrixXd S = newton_matrix(active, mode);
+  const Eigen::Index m = lambda.size();
+  Eigen::VectorXd rhs(S.rows());
+  rhs.head(m) = d;
+  if (mode) rhs(m) = -mode->load_total;
+  const Eigen::VectorXd x = S.partialPivLu().solve(rhs);
+  lambda = x.head(m);
+  if (mode) alpha = x(m);
   LinearSolveReport report;
-  const double dn = d.norm();
-  report.relative_residual = dn > 0 ? (S * lambda - d).norm() / dn : 0.0;
+  const double rn = rhs.norm();
+  report.relative_residual = rn > 0 ? (S * x - rhs).norm() / rn : 0.0;
   return report;
 }
 

@@ -7,7 +7,7 @@ namespace fictus {
 
 NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::VectorXd& b0,
                                      const Eigen::VectorXd& c0, const Eigen::VectorXd& g,
-                                     const NewtonOptions& options) {
+                                     const NewtonOptions& options, const ConstantMode* mode) {
   if (!(options.rho > 0)) throw std::invalid_argument("formulation.rho: must be > 0");
   if (options.max_iterations < 1) throw std::invalid_argument("solver.max_newton: must be >= 1");
   const int m = schur.size();
@@ -25,12 +25,18 @@ NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::
   for (int k = 0; k < options.max_iterations; ++k) {
     // 1. Linear solve for the current active set.
     for (int i = 0; i < m; ++i) d(i) = active[i] ? g(i) - b0(i) : -c0(i);
-    const LinearSolveReport linear = schur.solve(active, d, result.lambda);
+    const LinearSolveReport linear = schur.solve(active, d, mode, result.lambda, result.alpha);
     ++result.iterations;
 
     // 2. Residual at the new λ.
     schur.apply(result.lambda, sb, sc);
-    const Eigen::VectorXd b = b0 + sb, c = c0 + sc;
+    Eigen::VectorXd b = b0 + sb, c = c0 + sc;
+    if (mode) {
+      b += result.alpha * mode->trace_B;
+      c += result.alpha * mode->trace_C;
+    }
+    result.trace = b;
+    result.normal_derivative = c;
     const Eigen::VectorXd shifted = c - rho * (b - g);
     const Eigen::VectorXd F = c - shifted.cwiseMax(0.0);
     result.residual = F.lpNorm<Eigen::Infinity>();

@@ -1,7 +1,13 @@
 #pragma once
-// The whole method on one problem: curves and collocation → trace rows → load → u₀ = A⁻¹f →
-// Schur complement (implicit or from the Green's table) → semismooth Newton on λ →
-// û = A⁻¹(f + B_Γᵀλ) → Signorini checks and errors.
+// The whole method: curves and collocation → trace rows → load → u₀ = A⁻¹f → Schur complement
+// (implicit, or explicit from the Green's table) → semismooth Newton on λ → û = u₀ + A⁻¹B_Γᵀλ →
+// Signorini checks and errors.
+//
+// FictitiousDomainSolver keeps what does not depend on the curve or the obstacle: the fast solver,
+// the Green's table T (grid, boundary and c only) and u₀ (the load f). A new obstacle g or ρ costs
+// only the m×m Newton; a new curve its trace rows, Schur blocks and Newton; the grid field û one
+// more fast solve (skip it with compute_field = false: boundary values then come from the Schur
+// blocks).
 #include <cstddef>
 #include <memory>
 #include <optional>
@@ -33,15 +39,17 @@ struct Timings {
 struct Solution {
   explicit Solution(const Grid& g) : grid(g) {}
   Grid grid;
-  SolverOptions options;                // in effect (m and δ resolved)
-  GridVector u;                         // û at the interior nodes
+  SolverOptions options;                // in effect (m resolved)
+  GridVector u;                         // û at the unknowns (empty when the field was not asked for)
   Collocation collocation;              // points on γ
   std::shared_ptr<const Curve> Gamma;   // the curve carrying λ (γ itself in the non-smooth variant)
   double delta = 0;                     // distance of Γ from γ
   std::vector<double> lambda, g, trace, normal_derivative;  // per point: λ, g, B_γû, C_γû
+  double alpha = 0;                     // constant added to û (singular A: periodic box, c = 0)
   NewtonResult newton;
-  std::size_t fast_solves = 0;          // applications of A⁻¹ (the paper's it₁)
+  std::size_t fast_solves = 0;          // applications of A⁻¹ in this solve (the paper's it₁)
   int inner_iterations = 0;             // Krylov iterations over all Newton steps
+  bool reused_curve = false;            // trace rows and Schur blocks came from the previous solve
   std::optional<double> condition_number;
   SignoriniCheck signorini;
   std::optional<ErrorNorms> errors;
@@ -49,7 +57,28 @@ struct Solution {
   std::size_t peak_memory_bytes = 0;    // of the process so far (VmHWM)
 };
 
-/// Throws std::invalid_argument with a message naming the offending field on bad input.
+class FictitiousDomainSolver {
+ public:
+  /// Takes the grid-level data of `problem` (box, N, boundary, c, f); throws std::invalid_argument
+  /// naming the field on bad input. u₀ and T are computed on the first solve that needs them.
+  explicit FictitiousDomainSolver(const Problem& problem, int threads = 1, int load_quadrature = 2);
+  ~FictitiousDomainSolver();
+  FictitiousDomainSolver(const FictitiousDomainSolver&) = delete;
+  FictitiousDomainSolver& operator=(const FictitiousDomainSolver&) = delete;
+
+  const Grid& grid() const;
+
+  /// Solves with the curve, obstacle and exact solution of `problem` (its box, N, boundary, c and f
+  /// must be those given to the constructor). Reuses the previous curve's trace rows and Schur
+  /// blocks when problem.gamma is the same object and the options that shape them are unchanged.
+  Solution solve(const Problem& problem, SolverOptions options, bool compute_field = true);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+/// One problem, one call (a thin wrapper over FictitiousDomainSolver).
 Solution solve(const Problem& problem, SolverOptions options);
 
 /// Peak resident memory of this process in bytes (0 where unknown).

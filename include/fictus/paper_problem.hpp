@@ -11,7 +11,9 @@
 
 namespace fictus {
 
-Problem paper_problem(int N);
+/// The paper's problem; c and the box conditions may be changed (f = −Δu_ex + c·u_ex follows c),
+/// e.g. c = 0 on a periodic box: the singular setting of the paper's reference [1].
+Problem paper_problem(int N, double c = 1.0, Boundary boundary = Boundary::dirichlet);
 
 struct PaperRow {
   int N, m, it0, it1;

@@ -13,6 +13,7 @@ namespace fictus {
 struct Problem {
   std::string name = "problem";
   Box box;                              // Ω
+  Boundary boundary = Boundary::dirichlet;  // conditions on ∂Ω (periodic: c = 0 is allowed)
   int N = 128;                          // cells along x (h = (x1 − x0)/N)
   std::shared_ptr<const Curve> gamma;   // γ, counter-clockwise, strictly inside Ω
   double c = 1.0;                       // c ≥ 0

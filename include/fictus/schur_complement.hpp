@@ -11,7 +11,7 @@
 
 #include <Eigen/Dense>
 
-#include "fictus/dst_solver.hpp"
+#include "fictus/fast_solver.hpp"
 #include "fictus/gmres.hpp"
 #include "fictus/green_table.hpp"
 #include "fictus/trace_operators.hpp"
@@ -19,6 +19,16 @@
 namespace fictus {
 
 using ActiveSet = std::vector<char>;  // 1: contact row (B_γ u = g), 0: free row (C_γ u = 0)
+
+/// Bordering for a singular A (periodic box, c = 0: constants in the null space), as in the
+/// projected Schur complement method: unknowns (λ, α) with u = u₀ + A⁺B_Γᵀλ + α·1; Newton row i
+/// gains α·(B_γ1)_i (contact) or α·(C_γ1)_i (free), and the solvability row ℓᵀλ = −F with
+/// ℓ = B_Γ1, F = 1ᵀf (that is 1ᵀ(f + B_Γᵀλ) = 0) closes the system.
+struct ConstantMode {
+  Eigen::VectorXd trace_B, trace_C;  // B_γ·1, C_γ·1
+  Eigen::VectorXd arc_weights;       // ℓ = B_Γ·1
+  double load_total = 0.0;           // F = 1ᵀf
+};
 
 struct LinearSolveReport {
   int inner_iterations = 0;  // Krylov operator applications (0 for a direct solve)
@@ -32,8 +42,10 @@ class SchurComplement {
   virtual int size() const = 0;
   /// sb = S_B λ, sc = S_C λ.
   virtual void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const = 0;
-  /// Solves S_𝒜 λ = d; λ holds the starting guess on entry.
-  virtual LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, Eigen::VectorXd& lambda) const = 0;
+  /// Solves S_𝒜 λ = d (bordered by `mode` when given, then α is the second unknown); λ and α hold
+  /// the starting guess on entry.
+  virtual LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
+                                  Eigen::VectorXd& lambda, double& alpha) const = 0;
   /// Applications of A⁻¹ so far (the paper's it₁).
   virtual std::size_t fast_solves() const = 0;
   /// 2-norm condition number of S_𝒜, where it is available without extra fast solves.
@@ -42,16 +54,17 @@ class SchurComplement {
 
 class ImplicitSchur final : public SchurComplement {
  public:
-  ImplicitSchur(const DstSolver& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
+  ImplicitSchur(const FastSolver& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
                 const SparseRows& B_Gamma, const GmresOptions& options);
   int size() const override { return B_Gamma_.n_rows(); }
   void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override;
-  LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, Eigen::VectorXd& lambda) const override;
+  LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
+                          Eigen::VectorXd& lambda, double& alpha) const override;
   std::size_t fast_solves() const override { return fast_solves_; }
   std::optional<double> condition_number(const ActiveSet&) const override { return std::nullopt; }
 
  private:
-  const DstSolver& solver_;
+  const FastSolver& solver_;
   const SparseRows &B_gamma_, &C_gamma_, &B_Gamma_;
   GmresOptions options_;
   mutable GridVector work_;
@@ -68,14 +81,15 @@ class ExplicitSchur final : public SchurComplement {
   ExplicitSchur(Eigen::MatrixXd S_B, Eigen::MatrixXd S_C) : S_B_(std::move(S_B)), S_C_(std::move(S_C)) {}
   int size() const override { return int(S_B_.rows()); }
   void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override;
-  LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, Eigen::VectorXd& lambda) const override;
+  LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
+                          Eigen::VectorXd& lambda, double& alpha) const override;
   std::size_t fast_solves() const override { return 0; }
   std::optional<double> condition_number(const ActiveSet& active) const override;
   const Eigen::MatrixXd& S_B() const { return S_B_; }
   const Eigen::MatrixXd& S_C() const { return S_C_; }
 
  private:
-  Eigen::MatrixXd newton_matrix(const ActiveSet& active) const;
+  Eigen::MatrixXd newton_matrix(const ActiveSet& active, const ConstantMode* mode = nullptr) const;
   Eigen::MatrixXd S_B_, S_C_;
 };
 

@@ -36,6 +36,8 @@ struct NewtonStep {
 
 struct NewtonResult {
   Eigen::VectorXd lambda;
+  double alpha = 0.0;         // the constant added to u (singular A only)
+  Eigen::VectorXd trace, normal_derivative;  // B_γu and C_γu at the final λ (from the Schur blocks)
   ActiveSet active;
   int iterations = 0;         // linear solves (the paper's it₀)
   bool converged = false;
@@ -44,8 +46,9 @@ struct NewtonResult {
   std::vector<NewtonStep> history;
 };
 
+/// `mode`: bordering for a singular A (see ConstantMode); nullptr otherwise.
 NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::VectorXd& b0,
                                      const Eigen::VectorXd& c0, const Eigen::VectorXd& g,
-                                     const NewtonOptions& options);
+                                     const NewtonOptions& options, const ConstantMode* mode = nullptr);
 
 }  // namespace fictus
