@@ -14,6 +14,7 @@
 #include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/paper_problem.hpp"
 #include "results_io.hpp"
+#include "sweep.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -180,6 +181,20 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   reproduce_cmd->add_option("--normal-shift", reproduce_options.normal_shift, "C_γ shift in cells")->capture_default_str();
 
+  fictus::SolverOptions sweep_options;
+  SolveArguments sweep_solver_args;
+  fictus::cli::SweepArguments sweep_args;
+  CLI::App* sweep_cmd = app.add_subcommand(
+      "sweep", "solve a family of problems on one grid (paper's problem; g scaled, or the curve rotated or moved)");
+  sweep_cmd->add_option("--N", sweep_args.N, "cells per side")->capture_default_str();
+  sweep_cmd->add_option("--g-scale", sweep_args.g_scale, "obstacle factors: a,b,c or start:stop:count");
+  sweep_cmd->add_option("--rotate", sweep_args.rotate, "rotations of γ about its center [rad]: a,b,c or start:stop:count");
+  sweep_cmd->add_option("--move", sweep_args.move, "shifts of γ along x: a,b,c or start:stop:count");
+  sweep_cmd->add_flag("--field", sweep_args.field, "also compute the grid field û for every problem");
+  sweep_cmd->add_option("--out", sweep_args.out, "write sweep.csv here (\"\": none)")->capture_default_str();
+  add_solver_options(*sweep_cmd, sweep_options, sweep_solver_args);
+  sweep_options.condition_number = false;
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -188,6 +203,10 @@ int main(int argc, char** argv) {
   try {
     if (*solve_cmd) return run_solve(solve_options, solve_args);
     if (*reproduce_cmd) return run_reproduce(reproduce_options, reproduce_args, table, levels);
+    if (*sweep_cmd) {
+      resolve(sweep_options, sweep_solver_args);
+      return fictus::cli::run_sweep(sweep_args, sweep_options);
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fictus: error: %s\n", e.what());
     return 1;

@@ -57,6 +57,14 @@ Point OffsetCurve::second_derivative(double t) const {
   return (1.0 / (2 * e)) * (derivative(t + e) - derivative(t - e));
 }
 
+TransformedCurve::TransformedCurve(std::shared_ptr<const Curve> base, double angle, Point shift)
+    : base_(std::move(base)), cos_(std::cos(angle)), sin_(std::sin(angle)), shift_(shift) {}
+
+Point TransformedCurve::position(double t) const {
+  const Point c = base_->center();
+  return c + rotate(base_->position(t) - c) + shift_;
+}
+
 ArcLengthTable::ArcLengthTable(const Curve& curve, int panels)
     : curve_(curve), dt_(two_pi / panels), cumulative_(panels + 1, 0.0) {
   if (panels < 1) throw std::invalid_argument("ArcLengthTable: panels must be positive");

@@ -177,7 +177,7 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
 
   // Curve, collocation, trace rows, Schur complement: reused while the curve and its options stay.
   if (st.setup && st.setup->matches(problem, options)) {
-    options.multipliers = st.setup->options.multipliers;
+    options.multipliers = st.setup->collocation.m;
     sol.reused_curve = true;
   } else {
     st.setup.reset();
@@ -231,8 +231,7 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
       gmres_options.restart = m + 1;
       setup->schur = std::make_unique<ImplicitSchur>(*st.fast, setup->B_gamma, setup->C_gamma, setup->B_Gamma, gmres_options);
     }
-    setup->options = requested;
-    setup->options.multipliers = m;
+    setup->options = requested;  // as asked (m = 0 stays 0), so the next request compares equal
     st.setup = std::move(setup);
   }
   const CurveSetup& setup = *st.setup;

@@ -59,6 +59,22 @@ class OffsetCurve final : public Curve {
   double delta_;
 };
 
+/// γ rotated by `angle` about its center, then moved by `shift`: p(t) = c + R(p₀(t) − c) + shift.
+class TransformedCurve final : public Curve {
+ public:
+  TransformedCurve(std::shared_ptr<const Curve> base, double angle, Point shift);
+  Point position(double t) const override;
+  Point derivative(double t) const override { return rotate(base_->derivative(t)); }
+  Point second_derivative(double t) const override { return rotate(base_->second_derivative(t)); }
+  Point center() const override { return base_->center() + shift_; }
+
+ private:
+  Point rotate(Point v) const { return {cos_ * v.x - sin_ * v.y, sin_ * v.x + cos_ * v.y}; }
+  std::shared_ptr<const Curve> base_;
+  double cos_, sin_;
+  Point shift_;
+};
+
 /// Cumulative arc length s(t) on [0, 2π] by composite Gauss–Legendre, and its inverse.
 class ArcLengthTable {
  public:

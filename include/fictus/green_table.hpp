@@ -23,10 +23,13 @@ class GreenTable {
   double c() const { return c_; }
   /// T(s, t) for any integers s, t (folded into the table).
   double T(int s, int t) const { return table_[std::size_t(fold(t, ny_)) * width_ + std::size_t(fold(s, nx_))]; }
-  /// (A⁻¹)_{(i,j),(k,l)} between nodes carrying unknowns (A⁺ for a singular periodic A).
+  /// (A⁻¹)_{(i,j),(k,l)} between nodes carrying unknowns (A⁺ for a singular periodic A);
+  /// 0 ≤ i, k ≤ nx and 0 ≤ j, l ≤ ny (so the arguments of T need one reflection, no division).
   double G(int i, int j, int k, int l) const {
-    if (periodic_) return T(i - k, j - l);
-    return T(i - k, j - l) - T(i + k, j - l) - T(i - k, j + l) + T(i + k, j + l);
+    if (periodic_) return at(near_fold(i - k, nx_), near_fold(j - l, ny_));
+    const int sm = near_fold(i - k, nx_), sp = near_fold(i + k, nx_);
+    const int tm = near_fold(j - l, ny_), tp = near_fold(j + l, ny_);
+    return at(sm, tm) - at(sp, tm) - at(sm, tp) + at(sp, tp);
   }
   std::size_t memory_bytes() const { return table_.size() * sizeof(double); }
 
@@ -37,6 +40,13 @@ class GreenTable {
     s = s < 0 ? s + period : s;
     return s > period / 2 ? period - s : s;
   }
+  /// fold() for |s| ≤ period: one reflection instead of a remainder.
+  static int near_fold(int s, int period) {
+    s = s < 0 ? -s : s;
+    s = s == period ? 0 : s;
+    return s > period / 2 ? period - s : s;
+  }
+  double at(int s, int t) const { return table_[std::size_t(t) * width_ + std::size_t(s)]; }
   Grid grid_;
   double c_;
   bool periodic_;
