@@ -31,7 +31,7 @@ test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -LE slow
 
 bench: build
-	$(BUILD_DIR)/bench/fictus_bench --out bench/results
+	$(BUILD_DIR)/bench/fictus_bench --out bench/results $(BENCH_ARGS)
 
 clean:
 	rm -rf $(BUILD_DIR)

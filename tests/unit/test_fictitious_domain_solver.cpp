@@ -98,6 +98,17 @@ TEST(Reuse, NewObstacleReusesTheCurveAndMatchesAFreshSolve) {
   EXPECT_LE(max_abs_diff(second.normal_derivative, fresh.normal_derivative), 1e-10);
 }
 
+TEST(Reuse, DefaultMultiplierRuleAlsoReuses) {
+  fictus::Problem problem = fictus::paper_problem(256);
+  fictus::FictitiousDomainSolver solver(problem);
+  fictus::SolverOptions o;  // m = 0: the default rule
+  const fictus::Solution first = solver.solve(problem, o, false);
+  const fictus::Solution second = solver.solve(problem, o, false);
+  EXPECT_TRUE(second.reused_curve);
+  EXPECT_EQ(second.collocation.m, first.collocation.m);
+  EXPECT_EQ(second.options.multipliers, first.collocation.m);
+}
+
 TEST(Reuse, NewCurveMatchesAFreshSolve) {
   fictus::Problem problem = fictus::paper_problem(256);
   fictus::FictitiousDomainSolver solver(problem);
