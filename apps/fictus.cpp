@@ -3,6 +3,8 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <cstdlib>
+#include <functional>
 #include <filesystem>
 #include <iostream>
 #include <regex>
@@ -13,7 +15,9 @@
 #include "fictus/convergence_table.hpp"
 #include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/paper_problem.hpp"
+#include "fictus/problem_file.hpp"
 #include "results_io.hpp"
+#include "vtk_io.hpp"
 #include "sweep.hpp"
 
 namespace fs = std::filesystem;
@@ -22,37 +26,53 @@ using nlohmann::json;
 namespace {
 
 struct SolveArguments {
+  std::string problem_path;
   int N = 256;
+  double c = 1.0;
+  std::string boundary = "dirichlet";
   std::string variant = "smooth";
   std::string schur = "green";
   std::string start = "all";
   std::string out;
 };
 
-void add_solver_options(CLI::App& cmd, fictus::SolverOptions& o, SolveArguments& a) {
-  cmd.add_option("--variant", a.variant, "smooth (controls on Γ outside ω) or nonsmooth (Γ = γ)")
-      ->capture_default_str();
-  cmd.add_option("--m,--multipliers", o.multipliers, "number of multipliers m (0: default rule)")->capture_default_str();
-  cmd.add_option("--offset", o.offset, "smooth variant: distance of Γ from γ in units of the spacing L/m")
-      ->capture_default_str();
-  cmd.add_option("--rho", o.rho, "ρ > 0 of the projection")->capture_default_str();
-  cmd.add_option("--normal-shift", o.normal_shift, "C_γ is taken this many cells h inside ω")->capture_default_str();
-  cmd.add_option("--start", a.start, "Newton start: all (every point active) or zero (λ = 0)")->capture_default_str();
-  cmd.add_option("--schur", a.schur, "inner solver: green (explicit Schur complement) or krylov (GMRES, paper)")
-      ->capture_default_str();
-  cmd.add_option("--krylov-tol", o.krylov_tolerance, "relative GMRES tolerance")->capture_default_str();
-  cmd.add_option("--newton-tol", o.newton_tolerance, "relative Newton residual tolerance")->capture_default_str();
-  cmd.add_option("--max-newton", o.max_newton, "maximum Newton steps")->capture_default_str();
-  cmd.add_option("--threads", o.threads, "threads for transforms and loops")->capture_default_str();
-  cmd.add_flag("!--no-condition", o.condition_number, "skip the condition number of the Newton matrix");
-}
+/// Flags that override a problem file: applied only when given on the command line.
+struct Overrides {
+  std::vector<std::pair<CLI::Option*, std::function<void(fictus::ProblemSpec&)>>> items;
+  void apply(fictus::ProblemSpec& spec) const {
+    for (const auto& [option, set] : items)
+      if (option->count() > 0) set(spec);
+  }
+};
 
-void resolve(fictus::SolverOptions& o, const SolveArguments& a) {
-  o.variant = fictus::parse_variant(a.variant);
-  o.inner = fictus::parse_inner_solver(a.schur);
-  if (a.start != "all" && a.start != "zero")
-    throw std::invalid_argument("solver.start: expected \"all\" or \"zero\", got \"" + a.start + "\"");
-  o.start_all_active = a.start == "all";
+void add_solver_options(CLI::App& cmd, fictus::SolverOptions& o, SolveArguments& a, Overrides* overrides = nullptr) {
+  auto add = [&](CLI::Option* option, std::function<void(fictus::ProblemSpec&)> set) {
+    option->capture_default_str();
+    if (overrides) overrides->items.emplace_back(option, std::move(set));
+  };
+  add(cmd.add_option("--variant", a.variant, "smooth (controls on Γ outside ω) or nonsmooth (Γ = γ)"),
+      [&](fictus::ProblemSpec& s) { s.options.variant = fictus::parse_variant(a.variant); });
+  add(cmd.add_option("--m,--multipliers", o.multipliers, "number of multipliers m (0: default rule)"),
+      [&](fictus::ProblemSpec& s) { s.options.multipliers = o.multipliers; });
+  add(cmd.add_option("--offset", o.offset, "smooth variant: distance of Γ from γ in units of the spacing L/m"),
+      [&](fictus::ProblemSpec& s) { s.options.offset = o.offset; });
+  add(cmd.add_option("--rho", o.rho, "ρ > 0 of the projection"), [&](fictus::ProblemSpec& s) { s.options.rho = o.rho; });
+  add(cmd.add_option("--normal-shift", o.normal_shift, "C_γ is taken this many cells h inside ω"),
+      [&](fictus::ProblemSpec& s) { s.options.normal_shift = o.normal_shift; });
+  add(cmd.add_option("--start", a.start, "Newton start: all (every point active) or zero (λ = 0)"),
+      [&](fictus::ProblemSpec& s) { s.options.start_all_active = a.start == "all"; });
+  add(cmd.add_option("--schur", a.schur, "inner solver: green (explicit Schur complement) or krylov (GMRES, paper)"),
+      [&](fictus::ProblemSpec& s) { s.options.inner = fictus::parse_inner_solver(a.schur); });
+  add(cmd.add_option("--krylov-tol", o.krylov_tolerance, "relative GMRES tolerance"),
+      [&](fictus::ProblemSpec& s) { s.options.krylov_tolerance = o.krylov_tolerance; });
+  add(cmd.add_option("--newton-tol", o.newton_tolerance, "relative Newton residual tolerance"),
+      [&](fictus::ProblemSpec& s) { s.options.newton_tolerance = o.newton_tolerance; });
+  add(cmd.add_option("--max-newton", o.max_newton, "maximum Newton steps"),
+      [&](fictus::ProblemSpec& s) { s.options.max_newton = o.max_newton; });
+  add(cmd.add_option("--threads", o.threads, "threads for transforms and loops"),
+      [&](fictus::ProblemSpec& s) { s.options.threads = o.threads; });
+  CLI::Option* no_condition = cmd.add_flag("!--no-condition", o.condition_number, "skip the condition number of the Newton matrix");
+  if (overrides) overrides->items.emplace_back(no_condition, [&](fictus::ProblemSpec& s) { s.options.condition_number = false; });
 }
 
 void print_summary(const fictus::Solution& s) {
@@ -74,6 +94,14 @@ void print_summary(const fictus::Solution& s) {
   std::printf("), peak memory %.1f MiB\n", s.peak_memory_bytes / 1048576.0);
 }
 
+void resolve(fictus::SolverOptions& o, const SolveArguments& a) {
+  o.variant = fictus::parse_variant(a.variant);
+  o.inner = fictus::parse_inner_solver(a.schur);
+  if (a.start != "all" && a.start != "zero")
+    throw std::invalid_argument("solver.start: expected \"all\" or \"zero\", got \"" + a.start + "\"");
+  o.start_all_active = a.start == "all";
+}
+
 std::pair<int, int> parse_levels(const std::string& text) {
   static const std::regex pattern(R"((\d+)(?:-(\d+))?)");
   std::smatch match;
@@ -83,23 +111,61 @@ std::pair<int, int> parse_levels(const std::string& text) {
   return {a, b};
 }
 
-int run_solve(fictus::SolverOptions options, const SolveArguments& args) {
-  resolve(options, args);
-  const fictus::Problem problem = fictus::paper_problem(args.N);
-  const fictus::Solution solution = fictus::solve(problem, options);
-  print_summary(solution);
-  if (!args.out.empty()) {
-    fs::create_directories(args.out);
-    fictus::cli::write_atomically(fs::path(args.out) / "results.json",
-                                  fictus::cli::solution_to_json(problem, solution).dump(2) + "\n");
-    fictus::cli::write_atomically(fs::path(args.out) / "points.csv", fictus::cli::points_csv(solution));
-    std::printf("wrote %s/results.json and points.csv\n", args.out.c_str());
+std::string newton_failure_line(const fictus::Solution& s) {
+  std::string line = "solver.max_newton: Newton did not converge: " + s.newton.failure + "; history (active points, residual):";
+  for (const fictus::NewtonStep& step : s.newton.history) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, " (%d, %.2e)", step.n_active, step.residual);
+    line += buffer;
   }
-  if (!solution.newton.converged) {
-    std::fprintf(stderr, "fictus: error: Newton did not converge: %s\n", solution.newton.failure.c_str());
-    return 2;
+  return line;
+}
+
+int run_solve(const fictus::SolverOptions& cli_options, const SolveArguments& args, const Overrides& overrides,
+              CLI::Option* out_option) {
+  fictus::ProblemSpec spec;
+  if (!args.problem_path.empty()) {
+    spec = fictus::read_problem_file(args.problem_path);
+  } else {
+    if (args.boundary != "dirichlet" && args.boundary != "periodic")
+      throw std::invalid_argument("domain.boundary: expected \"dirichlet\" or \"periodic\", got \"" + args.boundary + "\"");
+    spec.problem = fictus::paper_problem(
+        args.N, args.c, args.boundary == "periodic" ? fictus::Boundary::periodic : fictus::Boundary::dirichlet);
+    spec.options = cli_options;
+    resolve(spec.options, args);
+  }
+  overrides.apply(spec);
+  if (out_option->count() > 0) spec.output.dir = args.out;
+  spec.options.validate();
+  for (const std::string& w : spec.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
+
+  const fictus::Problem& problem = spec.problem;
+  const fictus::Solution solution = fictus::solve(problem, spec.options);
+  if (!solution.newton.converged) throw std::runtime_error(newton_failure_line(solution));
+  print_summary(solution);
+  if (!spec.output.dir.empty()) {
+    const fs::path dir = spec.output.dir;
+    fs::create_directories(dir);
+    for (const std::string& name : spec.output.files) {
+      if (name == "results.json")
+        fictus::cli::write_atomically(dir / name, fictus::cli::solution_to_json(problem, solution).dump(2) + "\n");
+      else if (name == "points.csv")
+        fictus::cli::write_atomically(dir / name, fictus::cli::points_csv(solution));
+      else if (name == "solution.vti")
+        fictus::cli::write_atomically(dir / name, [&](std::ostream& out) { fictus::cli::write_vti(out, problem, solution); });
+      else if (name == "curves.vtp")
+        fictus::cli::write_atomically(dir / name, [&](std::ostream& out) { fictus::cli::write_vtp(out, solution); });
+    }
+    std::printf("wrote %zu files to %s/\n", spec.output.files.size(), spec.output.dir.c_str());
   }
   return 0;
+}
+
+int run_plot(const std::string& folder) {
+  if (!fs::is_directory(folder)) throw std::invalid_argument("plot: " + folder + " is not a folder");
+  const std::string command = std::string("'") + FICTUS_PYTHON + "' '" + FICTUS_PLOT_SCRIPT + "' '" + folder + "'";
+  const int status = std::system(command.c_str());
+  return status == 0 ? 0 : 1;
 }
 
 int run_reproduce(fictus::SolverOptions base, const SolveArguments& args, const std::string& table,
@@ -161,12 +227,35 @@ int main(int argc, char** argv) {
 
   fictus::SolverOptions solve_options;
   SolveArguments solve_args;
-  CLI::App* solve_cmd = app.add_subcommand("solve", "solve the paper's problem on one grid");
-  solve_cmd->add_option("--N", solve_args.N, "cells per side (h = 1/N)")->capture_default_str();
+  Overrides overrides;
+  CLI::App* solve_cmd = app.add_subcommand("solve", "solve a problem file, or the paper's problem without one");
+  solve_cmd->add_option("problem", solve_args.problem_path, "problem file (TOML, see docs/problem_files.md)")
+      ->check(CLI::ExistingFile);
   solve_args.out = "results/solve";
-  solve_cmd->add_option("--out", solve_args.out, "write results.json and points.csv into this folder (\"\": none)")
-      ->capture_default_str();
-  add_solver_options(*solve_cmd, solve_options, solve_args);
+  CLI::Option* out_option =
+      solve_cmd->add_option("--out", solve_args.out, "folder for the output files (\"\": none; default: output.dir)")
+          ->capture_default_str();
+  overrides.items.emplace_back(
+      solve_cmd->add_option("--N", solve_args.N, "cells along x (h = (x1 - x0)/N)")->capture_default_str(),
+      [&](fictus::ProblemSpec& s) { s.problem.N = solve_args.N; });
+  overrides.items.emplace_back(
+      solve_cmd->add_option("--c", solve_args.c, "reaction coefficient c >= 0 (paper's problem: f = -Δu_ex + c·u_ex follows)")
+          ->capture_default_str(),
+      [&](fictus::ProblemSpec& s) { s.problem.c = solve_args.c; });
+  overrides.items.emplace_back(
+      solve_cmd->add_option("--boundary", solve_args.boundary,
+                            "box conditions: dirichlet, or periodic (c = 0 allowed: singular A, bordered Newton)")
+          ->capture_default_str(),
+      [&](fictus::ProblemSpec& s) {
+        if (solve_args.boundary != "dirichlet" && solve_args.boundary != "periodic")
+          throw std::invalid_argument("domain.boundary: expected \"dirichlet\" or \"periodic\"");
+        s.problem.boundary = solve_args.boundary == "periodic" ? fictus::Boundary::periodic : fictus::Boundary::dirichlet;
+      });
+  add_solver_options(*solve_cmd, solve_options, solve_args, &overrides);
+
+  std::string plot_dir;
+  CLI::App* plot_cmd = app.add_subcommand("plot", "PNG plots of the results in a folder (matplotlib)");
+  plot_cmd->add_option("dir", plot_dir, "folder written by solve or reproduce")->required();
 
   fictus::SolverOptions reproduce_options;
   SolveArguments reproduce_args;
@@ -201,15 +290,19 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
   try {
-    if (*solve_cmd) return run_solve(solve_options, solve_args);
+    if (*solve_cmd) return run_solve(solve_options, solve_args, overrides, out_option);
+    if (*plot_cmd) return run_plot(plot_dir);
     if (*reproduce_cmd) return run_reproduce(reproduce_options, reproduce_args, table, levels);
     if (*sweep_cmd) {
       resolve(sweep_options, sweep_solver_args);
       return fictus::cli::run_sweep(sweep_args, sweep_options);
     }
-  } catch (const std::exception& e) {
+  } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "fictus: error: %s\n", e.what());
     return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fictus: error: %s\n", e.what());
+    return 2;
   }
   return 0;
 }

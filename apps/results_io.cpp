@@ -36,6 +36,8 @@ json solution_to_json(const Problem& problem, const Solution& s) {
   j["options"]["N"] = problem.N;
   j["options"]["c"] = problem.c;
   j["options"]["box"] = {problem.box.x0, problem.box.x1, problem.box.y0, problem.box.y1};
+  j["options"]["boundary"] = problem.boundary == Boundary::periodic ? "periodic" : "dirichlet";
+  j["alpha"] = s.alpha;
   j["grid"] = {{"N", s.grid.nx()}, {"Ny", s.grid.ny()}, {"h", s.grid.h()}, {"n_nodes", s.grid.n_nodes()},
                {"n_unknowns", s.grid.n_unknowns()}};
   j["multipliers"] = s.collocation.m;
@@ -88,11 +90,15 @@ LevelResult level_result(const Solution& s) {
 }
 
 void write_atomically(const std::filesystem::path& path, const std::string& text) {
+  write_atomically(path, [&](std::ostream& out) { out << text; });
+}
+
+void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& writer) {
   const std::filesystem::path tmp = path.string() + ".tmp." + std::to_string(::getpid());
   {
     std::ofstream out(tmp, std::ios::binary);
     if (!out) throw std::runtime_error("output: cannot write " + tmp.string());
-    out << text;
+    writer(out);
     out.flush();
     if (!out) {
       std::filesystem::remove(tmp);
@@ -105,11 +111,14 @@ void write_atomically(const std::filesystem::path& path, const std::string& text
 std::string points_csv(const Solution& s) {
   std::ostringstream out;
   out.precision(17);
-  out << "i,x,y,nx,ny,g,u,dudn,lambda,contact\n";
-  for (int i = 0; i < s.collocation.m; ++i)
-    out << i << ',' << s.collocation.point[i].x << ',' << s.collocation.point[i].y << ',' << s.collocation.normal[i].x
-        << ',' << s.collocation.normal[i].y << ',' << s.g[i] << ',' << s.trace[i] << ',' << s.normal_derivative[i]
-        << ',' << s.lambda[i] << ',' << int(s.newton.active[i]) << '\n';
+  out << "i,s,x,y,nx,ny,g,u,dudn,lambda,contact,Gamma_x,Gamma_y\n";
+  for (int i = 0; i < s.collocation.m; ++i) {
+    const Point G = s.Gamma->position(s.collocation.t[i]);
+    out << i << ',' << s.collocation.s[i] << ',' << s.collocation.point[i].x << ',' << s.collocation.point[i].y << ','
+        << s.collocation.normal[i].x << ',' << s.collocation.normal[i].y << ',' << s.g[i] << ',' << s.trace[i] << ','
+        << s.normal_derivative[i] << ',' << s.lambda[i] << ',' << int(s.newton.active[i]) << ',' << G.x << ',' << G.y
+        << '\n';
+  }
   return out.str();
 }
 

@@ -1,6 +1,8 @@
 #pragma once
 // Output formats of the CLI: results.json (keys of docs/results.md), CSV tables, atomic writes.
 #include <filesystem>
+#include <functional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -18,6 +20,7 @@ LevelResult level_result(const Solution& solution);
 /// Writes `text` to `path` through a temporary file in the same folder and a rename, so a reader
 /// never sees a half-written file and an old file survives a failed write.
 void write_atomically(const std::filesystem::path& path, const std::string& text);
+void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& writer);
 
 std::string points_csv(const Solution& solution);
 std::string levels_csv(const std::vector<LevelResult>& rows);

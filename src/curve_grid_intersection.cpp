@@ -66,7 +66,9 @@ CurveGridIntersection::CurveGridIntersection(const Curve& curve, const Grid& gri
   check_inside_box(pa);
   for (int k = 0; k < steps; ++k) {
     const double ta = k * dt, tb = k + 1 == steps ? two_pi : (k + 1) * dt;
-    const Point pb = curve.position(tb);
+    // The last step ends at the start point exactly: a curve that starts on a grid line must cross
+    // it again when it closes (position(2π) may differ from position(0) by rounding).
+    const Point pb = k + 1 == steps ? curve.position(0.0) : curve.position(tb);
     check_inside_box(pb);
     for (int axis = 0; axis < 2; ++axis) {
       const double origin = axis == 0 ? box.x0 : box.y0;

@@ -10,6 +10,7 @@
 #include "fictus/curve_grid_intersection.hpp"
 #include "fictus/fast_solver.hpp"
 #include "fictus/schur_complement.hpp"
+#include "fictus/shapes.hpp"
 #include "fictus/green_table.hpp"
 #include "fictus/load_vector.hpp"
 #include "fictus/trace_operators.hpp"
@@ -152,7 +153,7 @@ const Grid& FictitiousDomainSolver::grid() const { return state_->grid; }
 Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions options, bool compute_field) {
   options.validate();
   if (!problem.gamma) throw std::invalid_argument("geometry: no curve given");
-  if (!problem.g) throw std::invalid_argument("data.g: not given");
+  if (!problem.g && !problem.g_along_curve) throw std::invalid_argument("data.g: not given");
   State& st = *state_;
   const Grid& grid = st.grid;
   const double h = grid.h();
@@ -184,6 +185,11 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
     auto setup = std::make_unique<CurveSetup>();
     setup->gamma = problem.gamma;
     const Curve& gamma = *problem.gamma;
+    // A curve must be simple, counter-clockwise and a few cells inside the box.
+    if (signed_area(gamma) <= 0)
+      throw std::invalid_argument("geometry: the curve must be counter-clockwise (ω on its left)");
+    check_simple(gamma, "geometry");
+    check_inside_box(gamma, grid.box(), 2 * h, "geometry");
     setup->gamma_geometry = std::make_unique<CurveGridIntersection>(gamma, grid, "geometry");
     const ArcLengthTable arc_length(gamma);
     const double L = arc_length.length();
@@ -195,10 +201,16 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
       throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) +
                                   " is too large for the grid (spacing L/m = " + std::to_string(spacing) +
                                   " < 2h; use m <= " + std::to_string(int(L / (2 * h))) + ")");
-    setup->collocation = make_collocation(gamma, arc_length, m);
+    if (m < 8) throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) + " is too small (need m >= 8)");
+    setup->collocation = make_collocation(gamma, arc_length, m, phase_off_corners(gamma, arc_length, m));
     if (options.variant == Variant::smooth) {
+      if (!gamma.smooth())
+        throw std::invalid_argument("formulation.variant: the smooth variant needs a curve with a continuous normal "
+                                    "(use \"nonsmooth\" for polygons)");
       setup->delta = options.offset * spacing;
       setup->Gamma = std::make_shared<OffsetCurve>(problem.gamma, setup->delta);
+      check_simple(*setup->Gamma, "formulation.offset");
+      check_inside_box(*setup->Gamma, grid.box(), 2 * h, "formulation.offset");
       setup->offset_geometry = std::make_unique<CurveGridIntersection>(*setup->Gamma, grid, "formulation.offset");
     } else {
       setup->Gamma = problem.gamma;
@@ -244,7 +256,7 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
   sol.g.resize(m);
   for (int i = 0; i < m; ++i) {
     const Point p = setup.collocation.point[i];
-    sol.g[i] = problem.g(p.x, p.y);
+    sol.g[i] = problem.g_along_curve ? problem.g_along_curve(p.x, p.y, setup.collocation.s[i]) : problem.g(p.x, p.y);
     if (!std::isfinite(sol.g[i]))
       throw std::invalid_argument("data.g: not finite at the collocation point (" + std::to_string(p.x) + ", " +
                                   std::to_string(p.y) + ")");
@@ -292,6 +304,9 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
   }
 
   if (problem.exact && compute_field) {
+    for (const Point& p : setup.collocation.point)
+      if (!std::isfinite(problem.exact(p.x, p.y)))
+        throw std::invalid_argument("data.exact: not finite at (" + std::to_string(p.x) + ", " + std::to_string(p.y) + ")");
     const GradientField gradient = problem.exact_gradient ? problem.exact_gradient
                                                           : numerical_gradient(problem.exact, grid.box().x1 - grid.box().x0);
     sol.errors = compute_errors(sol.u, *setup.gamma_geometry, problem.exact, gradient, options.error_quadrature, st.threads);

@@ -1,6 +1,7 @@
 #include "fictus/gmres.hpp"
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace fictus {
@@ -19,6 +20,7 @@ GmresReport gmres(const LinearOperator& apply, const Eigen::VectorXd& b, Eigen::
   Eigen::VectorXd r(n), w(n);
   Eigen::MatrixXd V(n, restart + 1), H = Eigen::MatrixXd::Zero(restart + 1, restart);
   Eigen::VectorXd cs(restart), sn(restart), e(restart + 1);
+  double previous_cycle = std::numeric_limits<double>::infinity();
   while (report.iterations < options.max_iterations) {
     apply(x, w);
     ++report.iterations;
@@ -29,6 +31,9 @@ GmresReport gmres(const LinearOperator& apply, const Eigen::VectorXd& b, Eigen::
       report.converged = true;
       return report;
     }
+    // Stagnation at round-off (tolerance below cond·ε): a whole cycle gained less than a factor 2.
+    if (report.relative_residual > 0.5 * previous_cycle) return report;
+    previous_cycle = report.relative_residual;
     V.col(0) = r / beta;
     e.setZero();
     e(0) = beta;

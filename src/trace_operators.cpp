@@ -1,6 +1,7 @@
 #include "fictus/trace_operators.hpp"
 
 #include <algorithm>
+#include <numbers>
 #include <stdexcept>
 
 #include "fictus/quadrature.hpp"
@@ -89,16 +90,24 @@ SparseRows arc_integral_rows(const CurveGridIntersection& geometry, const std::v
   const GaussRule& rule = gauss_legendre(q);
   SparseRows rows;
   RowBuilder builder(grid, rows);
-  for (std::size_t r = 0; r < arc_begin.size(); ++r) {
-    const auto [first, last] = geometry.pieces_in(arc_begin[r], arc_end[r]);
+  auto add_interval = [&](double ta, double tb) {
+    const auto [first, last] = geometry.pieces_in(ta, tb);
     for (std::size_t k = first; k < last; ++k) {
       const CurvePiece& piece = geometry.pieces()[k];
-      const double t0 = std::max(piece.t0, arc_begin[r]), t1 = std::min(piece.t1, arc_end[r]);
+      const double t0 = std::max(piece.t0, ta), t1 = std::min(piece.t1, tb);
       if (!(t1 > t0)) continue;
       for (int g = 0; g < q; ++g) {
         const double t = t0 + rule.nodes[g] * (t1 - t0);
         builder.add_bilinear(piece.ix, piece.iy, curve.position(t), rule.weights[g] * (t1 - t0) * curve.speed(t));
       }
+    }
+  };
+  for (std::size_t r = 0; r < arc_begin.size(); ++r) {
+    if (arc_begin[r] <= arc_end[r]) {
+      add_interval(arc_begin[r], arc_end[r]);
+    } else {  // the arc wraps past t = 0
+      add_interval(arc_begin[r], 2.0 * std::numbers::pi);
+      add_interval(0.0, arc_end[r]);
     }
     builder.end_row();
   }

@@ -1,6 +1,7 @@
 #pragma once
-// m collocation points on γ equally spaced in arc length: point i sits at s_i = (i + ½)·L/m and
-// owns the arc [i·L/m, (i+1)·L/m] between the midpoints to its neighbours.
+// m collocation points on γ equally spaced in arc length: point i sits at s_i = (i + phase)·L/m
+// (phase ½ by default) and owns the arc [s_i − L/2m, s_i + L/2m] between the midpoints to its
+// neighbours. An arc may wrap past t = 0: then arc_begin > arc_end.
 #include <vector>
 
 #include "fictus/curve.hpp"
@@ -11,6 +12,8 @@ struct Collocation {
   int m = 0;
   double length = 0.0;   // L = |γ|
   double spacing = 0.0;  // s = L/m
+  double phase = 0.5;
+  std::vector<double> s;                     // arc length of point i
   std::vector<double> t;                     // parameter of point i
   std::vector<double> arc_begin, arc_end;    // parameters bounding arc i, arc_begin[0] = 0
   std::vector<Point> point, normal;          // x_i and the outward unit normal n_i
@@ -18,7 +21,10 @@ struct Collocation {
   int n_points() const { return m; }
 };
 
-Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m);
+Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase = 0.5);
+
+/// The phase (among 32 candidates, ½ first) that keeps the points farthest from the curve's corners.
+double phase_off_corners(const Curve& curve, const ArcLengthTable& arc_length, int m);
 
 /// Default number of multipliers: the paper's m ≈ 34·(N/128)^0.85 on its ellipse (length
 /// L_ref = 1.93768… in the unit box), scaled with the curve length relative to the box width:

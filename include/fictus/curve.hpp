@@ -19,6 +19,11 @@ class Curve {
   /// A point inside ω used for the polar angle φ of user data (the ellipse's center).
   virtual Point center() const = 0;
 
+  /// Parameters of corners (where p′ jumps), sorted; none for a smooth curve.
+  virtual std::vector<double> corners() const { return {}; }
+  /// Has a continuous tangent (the smooth variant's offset curve needs one).
+  virtual bool smooth() const { return true; }
+
   double speed(double t) const { return norm(derivative(t)); }
   Point outward_normal(double t) const;
   double curvature(double t) const;

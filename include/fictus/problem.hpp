@@ -19,6 +19,8 @@ struct Problem {
   double c = 1.0;                       // c ≥ 0
   ScalarField f;                        // load, on all of Ω
   ScalarField g;                        // obstacle, sampled at the collocation points on γ
+  /// Optional obstacle that also depends on the arc length s along γ (used instead of g when set).
+  std::function<double(double x, double y, double s)> g_along_curve;
   ScalarField exact;                    // optional exact solution on ω (errors are computed if set)
   GradientField exact_gradient;         // optional ∇u (central differences of `exact` if unset)
 };

@@ -37,7 +37,7 @@ def main(folder):
         assert math.isfinite(value) and 0 < value < 1, f"errors.{key} = {value}"
     with open(f"{folder}/points.csv") as handle:
         rows = handle.read().strip().splitlines()
-    assert rows[0] == "i,x,y,nx,ny,g,u,dudn,lambda,contact"
+    assert rows[0] == "i,s,x,y,nx,ny,g,u,dudn,lambda,contact,Gamma_x,Gamma_y"
     assert len(rows) == results["multipliers"] + 1
     print("results.json and points.csv OK")
 

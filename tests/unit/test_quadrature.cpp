@@ -54,6 +54,17 @@ TEST(CurveGridIntersection, InsideTestMatchesEllipseEquation) {
   EXPECT_EQ(mismatches, 0);
 }
 
+TEST(CurveGridIntersection, CurveStartingOnAGridLineKeepsTheParityOfThatRow) {
+  // The paper's ellipse starts at (0.9, 0.5), on grid row y = ½ for every even N.
+  const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2);
+  const fictus::Grid grid(fictus::Box{}, 128);
+  const fictus::CurveGridIntersection geometry(e, grid);
+  for (int i = 0; i <= 128; ++i) {
+    const double x = grid.x(i);
+    EXPECT_EQ(geometry.node_inside(i, 64), x > 0.1 && x < 0.9) << "x = " << x;
+  }
+}
+
 TEST(CurveGridIntersection, RejectsCurveLeavingTheBox) {
   const fictus::Ellipse e({0.5, 0.5}, 0.6, 0.2);
   const fictus::Grid grid(fictus::Box{}, 32);

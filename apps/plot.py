@@ -1,0 +1,138 @@
+#!/usr/bin/env python3
+"""fictus plot DIR: PNG plots of a solve or a reproduction in DIR.
+
+- solution.png  û as a heat map (ω only), γ, Γ and the contact set (from solution.vti, points.csv)
+- profiles.png  u − g, ∂u/∂n and λ along γ against arc length (from points.csv)
+- convergence.png  relative errors against h with the paper's (from table1.csv / table2.csv)
+Needs numpy and matplotlib (Debian: python3-numpy, python3-matplotlib).
+"""
+import csv
+import os
+import re
+import sys
+
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def read_vti(path):
+    """Reads fictus's own solution.vti: ImageData with raw appended arrays (UInt64 headers)."""
+    with open(path, "rb") as handle:
+        data = handle.read()
+    head, _, tail = data.partition(b"<AppendedData encoding=\"raw\">")
+    text = head.decode()
+    extent = [int(v) for v in re.search(r'WholeExtent="([^"]+)"', text).group(1).split()]
+    origin = [float(v) for v in re.search(r'Origin="([^"]+)"', text).group(1).split()]
+    spacing = [float(v) for v in re.search(r'Spacing="([^"]+)"', text).group(1).split()]
+    raw = tail[tail.index(b"_") + 1:]
+    arrays = {}
+    for kind, name, offset in re.findall(r'type="(\w+)" Name="(\w+)" format="appended" offset="(\d+)"', text):
+        offset = int(offset)
+        size = int(np.frombuffer(raw[offset:offset + 8], dtype="<u8")[0])
+        dtype = {"Float64": "<f8", "UInt8": "u1"}[kind]
+        values = np.frombuffer(raw[offset + 8:offset + 8 + size], dtype=dtype)
+        arrays[name] = values.reshape(extent[3] + 1, extent[1] + 1)
+    nx, ny = extent[1], extent[3]
+    x = origin[0] + spacing[0] * np.arange(nx + 1)
+    y = origin[1] + spacing[1] * np.arange(ny + 1)
+    return x, y, arrays
+
+
+def read_csv(path):
+    with open(path) as handle:
+        rows = list(csv.DictReader(handle))
+    return {key: np.array([float(r[key]) for r in rows]) for key in rows[0]}
+
+
+def closed(v):
+    return np.append(v, v[0])
+
+
+def plot_solution(folder):
+    x, y, arrays = read_vti(os.path.join(folder, "solution.vti"))
+    p = read_csv(os.path.join(folder, "points.csv"))
+    u = np.where(arrays["inside"] > 0, arrays["u"], np.nan)
+    fig, ax = plt.subplots(figsize=(7, 6))
+    image = ax.pcolormesh(x, y, u, shading="auto", cmap="viridis")
+    fig.colorbar(image, ax=ax, label="û in ω")
+    ax.plot(closed(p["x"]), closed(p["y"]), "k-", lw=1, label="γ")
+    if np.any(np.hypot(p["Gamma_x"] - p["x"], p["Gamma_y"] - p["y"]) > 0):
+        ax.plot(closed(p["Gamma_x"]), closed(p["Gamma_y"]), "w--", lw=1, label="Γ")
+    contact = p["contact"] > 0
+    ax.plot(p["x"][contact], p["y"][contact], "r.", ms=4, label="contact")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.legend(loc="upper right", fontsize=8)
+    ax.set_title("fictus: û, γ, Γ and the contact set")
+    fig.savefig(os.path.join(folder, "solution.png"), dpi=120)
+    plt.close(fig)
+
+
+def plot_profiles(folder):
+    p = read_csv(os.path.join(folder, "points.csv"))
+    fig, axes = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
+    contact = p["contact"] > 0
+    for ax, values, label in zip(axes, (p["u"] - p["g"], p["dudn"], p["lambda"]), ("u − g", "∂u/∂n", "λ")):
+        ax.plot(p["s"], values, "k.-", ms=3)
+        ax.plot(p["s"][contact], values[contact], "r.", ms=4)
+        ax.axhline(0.0, color="gray", lw=0.5)
+        ax.set_ylabel(label)
+    axes[-1].set_xlabel("arc length s along γ (red: contact)")
+    fig.suptitle("Signorini conditions along γ")
+    fig.savefig(os.path.join(folder, "profiles.png"), dpi=120)
+    plt.close(fig)
+
+
+PAPER = {  # relative L2(ω), L2(γ) of the paper's Tables 1 and 2, h = 1/128 … 1/4096
+    1: ([4.10e-2, 2.00e-2, 9.78e-3, 4.84e-3, 2.27e-3, 1.13e-3], [1.70e-2, 8.52e-3, 4.25e-3, 2.08e-3, 1.09e-3, 7.21e-4]),
+    2: ([3.24e-4, 6.31e-5, 1.59e-5, 4.35e-6, 1.38e-6, 8.07e-7], [5.07e-4, 9.10e-5, 2.65e-5, 1.17e-5, 5.18e-6, 2.28e-6]),
+}
+
+
+def plot_convergence(folder):
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for table, colour in ((1, "C0"), (2, "C1")):
+        path = os.path.join(folder, f"table{table}.csv")
+        if not os.path.exists(path):
+            continue
+        t = read_csv(path)
+        ax.loglog(t["h"], t["rel_l2_omega"], "o-", color=colour, label=f"Table {table}: L²(ω)")
+        ax.loglog(t["h"], t["rel_h1_omega"], "s-", color=colour, label=f"Table {table}: H¹(ω)")
+        ax.loglog(t["h"], t["rel_l2_gamma"], "^-", color=colour, label=f"Table {table}: L²(γ)")
+        h_paper = [1 / 128 / 2 ** k for k in range(6)]
+        ax.loglog(h_paper, PAPER[table][0], "o:", color=colour, alpha=0.5, label=f"paper {table}: L²(ω)")
+    ax.set_xlabel("h")
+    ax.set_ylabel("relative error")
+    ax.grid(True, which="both", lw=0.3)
+    ax.legend(fontsize=7)
+    ax.set_title("fictus convergence (dotted: the paper)")
+    fig.savefig(os.path.join(folder, "convergence.png"), dpi=120)
+    plt.close(fig)
+
+
+def main(folder):
+    made = []
+    if os.path.exists(os.path.join(folder, "solution.vti")) and os.path.exists(os.path.join(folder, "points.csv")):
+        plot_solution(folder)
+        made.append("solution.png")
+    if os.path.exists(os.path.join(folder, "points.csv")):
+        plot_profiles(folder)
+        made.append("profiles.png")
+    if any(os.path.exists(os.path.join(folder, f"table{k}.csv")) for k in (1, 2)):
+        plot_convergence(folder)
+        made.append("convergence.png")
+    if not made:
+        print(f"fictus: error: plot: {folder} holds no solution.vti, points.csv or table<k>.csv", file=sys.stderr)
+        return 1
+    print("wrote " + ", ".join(os.path.join(folder, name) for name in made))
+    return 0
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2:
+        print("usage: plot.py DIR", file=sys.stderr)
+        sys.exit(1)
+    sys.exit(main(sys.argv[1]))

@@ -1,0 +1,31 @@
+#pragma once
+// User expressions (muParser syntax: + - * / ^, sin, cos, exp, sqrt, abs, min, max, a ? b : c, _pi …)
+// in named variables, e.g. "x^2 + sin(y)" in (x, y). Parsed and checked once at construction;
+// evaluation is thread-safe (one compiled parser per thread, made on first use).
+#include <cstdint>
+#include <initializer_list>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace fictus {
+
+class Expression {
+ public:
+  /// Throws std::invalid_argument("<key>: cannot parse \"<text>\": <reason>") on a syntax error or
+  /// an unknown variable.
+  Expression(std::string text, std::vector<std::string> variables, std::string key);
+
+  /// Value for the variables in the order given at construction.
+  double operator()(std::initializer_list<double> values) const;
+  double operator()(const double* values) const;
+
+  const std::string& text() const;
+  const std::string& key() const;
+
+ private:
+  struct Shared;
+  std::shared_ptr<const Shared> shared_;
+};
+
+}  // namespace fictus

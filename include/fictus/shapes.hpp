@@ -1,0 +1,92 @@
+#pragma once
+// Curves a user can describe (besides Ellipse in curve.hpp), and the checks every user curve gets.
+//   PolygonCurve      vertices, parametrized proportionally to arc length, corners reported;
+//   ParametricCurve   x(t), y(t) expressions, t ∈ [0, 2π);
+//   StarCurve         center + r(t)·(cos t, sin t), r(t) an expression;
+//   ReversedCurve     a clockwise curve made counter-clockwise (t ↦ 2π − t).
+// Expression curves take derivatives by central differences (errors ~1e-10 in p′, ~1e-8 in p″).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fictus/curve.hpp"
+#include "fictus/expression.hpp"
+
+namespace fictus {
+
+class PolygonCurve final : public Curve {
+ public:
+  /// At least 3 vertices, no repeated consecutive vertices (the closing edge is implied).
+  explicit PolygonCurve(std::vector<Point> vertices);
+  Point position(double t) const override;
+  Point derivative(double t) const override;
+  Point second_derivative(double) const override { return {0.0, 0.0}; }
+  Point center() const override { return centroid_; }
+  std::vector<double> corners() const override;
+  bool smooth() const override { return false; }
+  const std::vector<Point>& vertices() const { return vertices_; }
+
+ private:
+  int edge_of(double t) const;
+  std::vector<Point> vertices_;
+  std::vector<double> cumulative_;  // arc length at each vertex, size n + 1
+  Point centroid_;
+};
+
+/// Base for curves given by expressions: derivatives by central differences of position().
+class ExpressionCurve : public Curve {
+ public:
+  Point derivative(double t) const override;
+  Point second_derivative(double t) const override;
+};
+
+class ParametricCurve final : public ExpressionCurve {
+ public:
+  ParametricCurve(Expression x, Expression y);
+  Point position(double t) const override;
+  Point center() const override { return center_; }
+
+ private:
+  Expression x_, y_;
+  Point center_;
+};
+
+class StarCurve final : public ExpressionCurve {
+ public:
+  StarCurve(Point center, Expression r);
+  Point position(double t) const override;
+  Point center() const override { return center_; }
+
+ private:
+  Point center_;
+  Expression r_;
+};
+
+class ReversedCurve final : public Curve {
+ public:
+  explicit ReversedCurve(std::shared_ptr<const Curve> base) : base_(std::move(base)) {}
+  Point position(double t) const override;
+  Point derivative(double t) const override;
+  Point second_derivative(double t) const override;
+  Point center() const override { return base_->center(); }
+  std::vector<double> corners() const override;
+  bool smooth() const override { return base_->smooth(); }
+
+ private:
+  std::shared_ptr<const Curve> base_;
+};
+
+/// Signed area enclosed by the curve (> 0: counter-clockwise), by Gauss on 512 panels.
+double signed_area(const Curve& curve);
+
+/// Area-weighted centroid of the region the curve encloses.
+Point centroid(const Curve& curve);
+
+/// Throws std::invalid_argument("<what>: the curve intersects itself near (x, y)") if the polyline
+/// through `samples` points of the curve (and all corners) crosses itself.
+void check_simple(const Curve& curve, const std::string& what, int samples = 4096);
+
+/// Throws std::invalid_argument("<what>: …") if the curve comes closer than `margin` to ∂box.
+void check_inside_box(const Curve& curve, const Box& box, double margin, const std::string& what, int samples = 4096);
+
+}  // namespace fictus

@@ -1,0 +1,281 @@
+#include "fictus/problem_file.hpp"
+
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "fictus/expression.hpp"
+#include "fictus/shapes.hpp"
+
+namespace fictus {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& key, const std::string& reason) { throw std::invalid_argument(key + ": " + reason); }
+
+/// Reads the keys of one table, remembering which were used so that unknown keys are reported.
+class TableReader {
+ public:
+  TableReader(const toml::table* table, std::string name) : table_(table), name_(std::move(name)) {}
+
+  bool has(const std::string& key) const { return table_ && table_->contains(key); }
+  std::string key(const std::string& k) const { return name_ + "." + k; }
+
+  double number(const std::string& k, double fallback) {
+    const toml::node* n = node(k);
+    if (!n) return fallback;
+    std::optional<double> v = n->is_integer() ? std::optional<double>(double(*n->value<int64_t>())) : n->value<double>();
+    if (!v || n->is_boolean()) fail(key(k), std::string("expected a number, got ") + type_name(*n));
+    if (!std::isfinite(*v)) fail(key(k), "must be finite (NaN or Inf given)");
+    return *v;
+  }
+  int integer(const std::string& k, int fallback) {
+    const toml::node* n = node(k);
+    if (!n) return fallback;
+    if (!n->is_integer()) fail(key(k), std::string("expected an integer, got ") + type_name(*n));
+    const int64_t v = *n->value<int64_t>();
+    if (v < -1000000000 || v > 1000000000) fail(key(k), "out of range");
+    return int(v);
+  }
+  bool boolean(const std::string& k, bool fallback) {
+    const toml::node* n = node(k);
+    if (!n) return fallback;
+    if (!n->is_boolean()) fail(key(k), std::string("expected true or false, got ") + type_name(*n));
+    return *n->value<bool>();
+  }
+  std::string string(const std::string& k, const std::string& fallback) {
+    const toml::node* n = node(k);
+    if (!n) return fallback;
+    if (!n->is_string()) fail(key(k), std::string("expected a string, got ") + type_name(*n));
+    return *n->value<std::string>();
+  }
+  std::string required_string(const std::string& k) {
+    if (!has(k)) fail(key(k), "missing");
+    return string(k, "");
+  }
+  std::vector<double> numbers(const std::string& k, std::size_t size, std::vector<double> fallback) {
+    const toml::node* n = node(k);
+    if (!n) return fallback;
+    const toml::array* a = n->as_array();
+    if (!a || a->size() != size) fail(key(k), "expected an array of " + std::to_string(size) + " numbers");
+    std::vector<double> out;
+    for (const toml::node& e : *a) {
+      std::optional<double> v = e.is_integer() ? std::optional<double>(double(*e.value<int64_t>())) : e.value<double>();
+      if (!v || e.is_boolean()) fail(key(k), "expected an array of " + std::to_string(size) + " numbers");
+      if (!std::isfinite(*v)) fail(key(k), "must be finite (NaN or Inf given)");
+      out.push_back(*v);
+    }
+    return out;
+  }
+  std::vector<double> required_numbers(const std::string& k, std::size_t size) {
+    if (!has(k)) fail(key(k), "missing");
+    return numbers(k, size, {});
+  }
+  const toml::array* array(const std::string& k) {
+    const toml::node* n = node(k);
+    if (!n) return nullptr;
+    if (!n->is_array()) fail(key(k), std::string("expected an array, got ") + type_name(*n));
+    return n->as_array();
+  }
+  /// Throws for the first key that was never read.
+  void finish() const {
+    if (!table_) return;
+    for (const auto& [k, v] : *table_)
+      if (!used_.count(std::string(k.str()))) fail(key(std::string(k.str())), "unknown key");
+  }
+
+ private:
+  const toml::node* node(const std::string& k) {
+    used_.insert(k);
+    return table_ ? table_->get(k) : nullptr;
+  }
+  static const char* type_name(const toml::node& n) {
+    switch (n.type()) {
+      case toml::node_type::string: return "a string";
+      case toml::node_type::integer: return "an integer";
+      case toml::node_type::floating_point: return "a number";
+      case toml::node_type::boolean: return "a boolean";
+      case toml::node_type::array: return "an array";
+      case toml::node_type::table: return "a table";
+      default: return "a date or time";
+    }
+  }
+  const toml::table* table_;
+  std::string name_;
+  std::set<std::string> used_;
+};
+
+const toml::table* subtable(const toml::table& root, const std::string& name) {
+  const toml::node* n = root.get(name);
+  if (!n) return nullptr;
+  if (!n->is_table()) fail(name, "expected a table [" + name + "]");
+  return n->as_table();
+}
+
+std::shared_ptr<const Curve> read_geometry(TableReader& g, std::vector<std::string>& warnings) {
+  const std::string shape = g.required_string("shape");
+  std::shared_ptr<const Curve> curve;
+  if (shape == "ellipse") {
+    const auto c = g.required_numbers("center", 2), ab = g.required_numbers("semi_axes", 2);
+    if (!(ab[0] > 0 && ab[1] > 0)) fail("geometry.semi_axes", "must be positive");
+    curve = std::make_shared<Ellipse>(Point{c[0], c[1]}, ab[0], ab[1], g.number("angle", 0.0));
+  } else if (shape == "circle") {
+    const auto c = g.required_numbers("center", 2);
+    if (!g.has("radius")) fail("geometry.radius", "missing");
+    const double r = g.number("radius", 0.0);
+    if (!(r > 0)) fail("geometry.radius", "must be positive");
+    curve = std::make_shared<Ellipse>(Point{c[0], c[1]}, r, r, 0.0);
+  } else if (shape == "polygon") {
+    const toml::array* list = g.array("vertices");
+    if (!list) fail("geometry.vertices", "missing");
+    std::vector<Point> vertices;
+    for (const toml::node& v : *list) {
+      const toml::array* xy = v.as_array();
+      if (!xy || xy->size() != 2 || !(*xy)[0].is_number() || !(*xy)[1].is_number())
+        fail("geometry.vertices", "expected an array of [x, y] number pairs");
+      const double x = (*xy)[0].value<double>().value(), y = (*xy)[1].value<double>().value();
+      if (!std::isfinite(x) || !std::isfinite(y)) fail("geometry.vertices", "must be finite (NaN or Inf given)");
+      vertices.push_back({x, y});
+    }
+    auto polygon = std::make_shared<PolygonCurve>(vertices);
+    check_simple(*polygon, "geometry.vertices");
+    if (signed_area(*polygon) < 0) {
+      std::reverse(vertices.begin(), vertices.end());
+      polygon = std::make_shared<PolygonCurve>(vertices);
+      warnings.push_back("geometry.vertices: the polygon is clockwise; reoriented counter-clockwise");
+    }
+    curve = polygon;
+  } else if (shape == "parametric") {
+    curve = std::make_shared<ParametricCurve>(Expression(g.required_string("x"), {"t"}, "geometry.x"),
+                                              Expression(g.required_string("y"), {"t"}, "geometry.y"));
+  } else if (shape == "star") {
+    const auto c = g.required_numbers("center", 2);
+    curve = std::make_shared<StarCurve>(Point{c[0], c[1]}, Expression(g.required_string("r"), {"t"}, "geometry.r"));
+  } else {
+    fail("geometry.shape", "unknown shape \"" + shape + "\" (ellipse, circle, polygon, parametric, star)");
+  }
+  if (shape != "polygon") {
+    check_simple(*curve, "geometry");
+    if (signed_area(*curve) < 0) {
+      curve = std::make_shared<ReversedCurve>(curve);
+      warnings.push_back("geometry: the curve is clockwise; reoriented counter-clockwise");
+    }
+  }
+  return curve;
+}
+
+}  // namespace
+
+const std::vector<std::string>& output_file_names() {
+  static const std::vector<std::string> names = {"results.json", "points.csv", "solution.vti", "curves.vtp"};
+  return names;
+}
+
+ProblemSpec parse_problem_text(const std::string& text, const std::string& source) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream msg;
+    msg << source << ":" << e.source().begin.line << ": TOML syntax error: " << e.description();
+    throw std::invalid_argument(msg.str());
+  }
+  for (const auto& [k, v] : root) {
+    const std::string name(k.str());
+    if (name != "domain" && name != "geometry" && name != "formulation" && name != "data" && name != "solver" && name != "output")
+      fail(name, "unknown section (domain, geometry, formulation, data, solver, output)");
+  }
+  ProblemSpec spec;
+  Problem& p = spec.problem;
+  SolverOptions& o = spec.options;
+
+  TableReader domain(subtable(root, "domain"), "domain");
+  const auto box = domain.numbers("box", 4, {0.0, 1.0, 0.0, 1.0});
+  p.box = Box{box[0], box[1], box[2], box[3]};
+  if (!(p.box.x1 > p.box.x0 && p.box.y1 > p.box.y0)) fail("domain.box", "need x0 < x1 and y0 < y1");
+  p.N = domain.integer("N", 256);
+  const std::string boundary = domain.string("boundary", "dirichlet");
+  if (boundary != "dirichlet" && boundary != "periodic") fail("domain.boundary", "expected \"dirichlet\" or \"periodic\"");
+  p.boundary = boundary == "periodic" ? Boundary::periodic : Boundary::dirichlet;
+  domain.finish();
+
+  const toml::table* geometry_table = subtable(root, "geometry");
+  if (!geometry_table) fail("geometry", "missing section [geometry]");
+  TableReader geometry(geometry_table, "geometry");
+  p.gamma = read_geometry(geometry, spec.warnings);
+  geometry.finish();
+
+  TableReader formulation(subtable(root, "formulation"), "formulation");
+  o.variant = parse_variant(formulation.string("variant", "smooth"));
+  o.multipliers = formulation.integer("multipliers", 0);
+  o.offset = formulation.number("offset", o.offset);
+  o.rho = formulation.number("rho", o.rho);
+  o.normal_shift = formulation.number("normal_shift", o.normal_shift);
+  formulation.finish();
+
+  TableReader data(subtable(root, "data"), "data");
+  p.c = data.number("c", 1.0);
+  if (p.c < 0) fail("data.c", "must be >= 0");
+  const Expression f(data.required_string("f"), {"x", "y"}, "data.f");
+  p.f = [f](double x, double y) { return f({x, y}); };
+  const Expression g(data.required_string("g"), {"x", "y", "phi", "s"}, "data.g");
+  const Point center = p.gamma->center();
+  p.g_along_curve = [g, center](double x, double y, double s) {
+    return g({x, y, std::atan2(y - center.y, x - center.x), s});
+  };
+  p.g = [g, center](double x, double y) { return g({x, y, std::atan2(y - center.y, x - center.x), 0.0}); };
+  if (data.has("exact")) {
+    const Expression exact(data.string("exact", ""), {"x", "y"}, "data.exact");
+    p.exact = [exact](double x, double y) { return exact({x, y}); };
+  }
+  data.finish();
+
+  TableReader solver(subtable(root, "solver"), "solver");
+  o.inner = parse_inner_solver(solver.string("schur", "green"));
+  o.krylov_tolerance = solver.number("krylov_tolerance", o.krylov_tolerance);
+  o.krylov_max_iterations = solver.integer("krylov_max_iterations", o.krylov_max_iterations);
+  o.newton_tolerance = solver.number("newton_tolerance", o.newton_tolerance);
+  o.max_newton = solver.integer("max_newton", o.max_newton);
+  const std::string start = solver.string("start", "all");
+  if (start != "all" && start != "zero") fail("solver.start", "expected \"all\" or \"zero\"");
+  o.start_all_active = start == "all";
+  o.threads = solver.integer("threads", o.threads);
+  o.load_quadrature = solver.integer("load_quadrature", o.load_quadrature);
+  o.error_quadrature = solver.integer("error_quadrature", o.error_quadrature);
+  o.condition_number = solver.boolean("condition_number", o.condition_number);
+  solver.finish();
+  o.validate();
+
+  TableReader output(subtable(root, "output"), "output");
+  spec.output.dir = output.string("dir", spec.output.dir);
+  if (const toml::array* files = output.array("files")) {
+    spec.output.files.clear();
+    for (const toml::node& f : *files) {
+      const auto name = f.value<std::string>();
+      if (!name || std::find(output_file_names().begin(), output_file_names().end(), *name) == output_file_names().end())
+        fail("output.files", "expected names from results.json, points.csv, solution.vti, curves.vtp");
+      spec.output.files.push_back(*name);
+    }
+  }
+  output.finish();
+  p.name = source;
+  return spec;
+}
+
+ProblemSpec read_problem_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument(path + ": cannot open the problem file");
+  std::stringstream text;
+  text << in.rdbuf();
+  ProblemSpec spec = parse_problem_text(text.str(), path);
+  std::string name = path.substr(path.find_last_of('/') + 1);
+  spec.problem.name = name.substr(0, name.rfind(".toml"));
+  return spec;
+}
+
+}  // namespace fictus
