@@ -59,7 +59,7 @@ def plot_solution(folder):
     fig.colorbar(image, ax=ax, label="û in ω")
     ax.plot(closed(p["x"]), closed(p["y"]), "k-", lw=1, label="γ")
     if np.any(np.hypot(p["Gamma_x"] - p["x"], p["Gamma_y"] - p["y"]) > 0):
-        ax.plot(closed(p["Gamma_x"]), closed(p["Gamma_y"]), "w--", lw=1, label="Γ")
+        ax.plot(closed(p["Gamma_x"]), closed(p["Gamma_y"]), "--", color="tab:orange", lw=1, label="Γ")
     contact = p["contact"] > 0
     ax.plot(p["x"][contact], p["y"][contact], "r.", ms=4, label="contact")
     ax.set_aspect("equal")
