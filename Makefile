@@ -6,7 +6,8 @@ JOBS ?= 2
 LEVELS ?= 7-12
 DEBIAN_PACKAGES = cmake g++ make pkg-config libfftw3-dev libeigen3-dev libcli11-dev \
                   nlohmann-json3-dev libfmt-dev libgtest-dev libbenchmark-dev \
-                  libmuparser-dev libtomlplusplus-dev python3 python3-numpy python3-matplotlib python3-vtk9
+                  libmuparser-dev libtomlplusplus-dev python3 python3-dev python3-numpy python3-matplotlib \
+                  python3-vtk9 python3-pytest pybind11-dev
 
 .PHONY: deps configure build run test bench clean
 

@@ -111,16 +111,6 @@ std::pair<int, int> parse_levels(const std::string& text) {
   return {a, b};
 }
 
-std::string newton_failure_line(const fictus::Solution& s) {
-  std::string line = "solver.max_newton: Newton did not converge: " + s.newton.failure + "; history (active points, residual):";
-  for (const fictus::NewtonStep& step : s.newton.history) {
-    char buffer[64];
-    std::snprintf(buffer, sizeof buffer, " (%d, %.2e)", step.n_active, step.residual);
-    line += buffer;
-  }
-  return line;
-}
-
 int run_solve(const fictus::SolverOptions& cli_options, const SolveArguments& args, const Overrides& overrides,
               CLI::Option* out_option) {
   fictus::ProblemSpec spec;
@@ -141,7 +131,7 @@ int run_solve(const fictus::SolverOptions& cli_options, const SolveArguments& ar
 
   const fictus::Problem& problem = spec.problem;
   const fictus::Solution solution = fictus::solve(problem, spec.options);
-  if (!solution.newton.converged) throw std::runtime_error(newton_failure_line(solution));
+  if (!solution.newton.converged) throw std::runtime_error(fictus::describe_newton_failure(solution));
   print_summary(solution);
   if (!spec.output.dir.empty()) {
     const fs::path dir = spec.output.dir;

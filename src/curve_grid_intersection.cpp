@@ -141,6 +141,44 @@ std::pair<std::size_t, std::size_t> CurveGridIntersection::pieces_in(double ta, 
   return {std::size_t(first - pieces_.begin()), std::size_t(last - pieces_.begin())};
 }
 
+void CurveGridIntersection::row_rule(int iy, int q, std::vector<CellQuadraturePoint>& out) const {
+  out.clear();
+  const GaussRule& rule = gauss_legendre(q);
+  const double h = grid_.h();
+  std::size_t next_cut = row_begin_[iy];
+  const std::size_t end_cut = row_begin_[iy + 1];
+  std::vector<QuadraturePoint> cut_points;
+  // Node flags of the row's two grid lines, walked left to right with the crossing lists.
+  const auto& lower = row_crossings_[iy];
+  const auto& upper = row_crossings_[iy + 1];
+  std::size_t lo_k = 0, up_k = 0;
+  auto inside_lower = [&](int i) {
+    while (lo_k < lower.size() && lower[lo_k] < grid_.x(i)) ++lo_k;
+    return lo_k % 2 == 1;
+  };
+  auto inside_upper = [&](int i) {
+    while (up_k < upper.size() && upper[up_k] < grid_.x(i)) ++up_k;
+    return up_k % 2 == 1;
+  };
+  bool left_lower = inside_lower(0), left_upper = inside_upper(0);
+  for (int ix = 0; ix < grid_.nx(); ++ix) {
+    const bool right_lower = inside_lower(ix + 1), right_upper = inside_upper(ix + 1);
+    if (next_cut < end_cut && cut_cells_[next_cut].ix == ix) {
+      cut_points.clear();
+      cut_cell_rule(cut_cells_[next_cut], q, cut_points);
+      for (const QuadraturePoint& p : cut_points) out.push_back({ix, p.x, p.y, p.weight});
+      ++next_cut;
+    } else if (left_lower && left_upper && right_lower && right_upper) {
+      for (int b = 0; b < q; ++b)
+        for (int a = 0; a < q; ++a)
+          out.push_back({ix, grid_.x(ix) + rule.nodes[a] * h, grid_.y(iy) + rule.nodes[b] * h,
+                         rule.weights[a] * rule.weights[b] * h * h});
+    }
+    left_lower = right_lower;
+    left_upper = right_upper;
+  }
+}
+
 void CurveGridIntersection::cut_cell_rule(const CutCell& cell, int q, std::vector<QuadraturePoint>& out) const {
   const double h = grid_.h();
   const double lo[2] = {grid_.x(cell.ix), grid_.y(cell.iy)};

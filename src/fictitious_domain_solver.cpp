@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <fstream>
 #include <stdexcept>
@@ -139,7 +140,7 @@ struct FictitiousDomainSolver::State {
 FictitiousDomainSolver::FictitiousDomainSolver(const Problem& problem, int threads, int load_quadrature) {
   if (problem.N < 8) throw std::invalid_argument("domain.N: need N >= 8, got " + std::to_string(problem.N));
   if (!(problem.c >= 0) || !std::isfinite(problem.c)) throw std::invalid_argument("data.c: must be finite and >= 0");
-  if (!problem.f) throw std::invalid_argument("data.f: not given");
+  if (!problem.f && !problem.f_vectorized) throw std::invalid_argument("data.f: not given");
   if (threads < 1) throw std::invalid_argument("solver.threads: must be >= 1");
   Grid grid(problem.box, problem.N, problem.boundary);
   state_ = std::make_unique<State>(State{problem, grid, threads, load_quadrature, make_fast_solver(grid, problem.c, threads),
@@ -153,7 +154,7 @@ const Grid& FictitiousDomainSolver::grid() const { return state_->grid; }
 Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions options, bool compute_field) {
   options.validate();
   if (!problem.gamma) throw std::invalid_argument("geometry: no curve given");
-  if (!problem.g && !problem.g_along_curve) throw std::invalid_argument("data.g: not given");
+  if (!problem.g && !problem.g_along_curve && !problem.g_vectorized) throw std::invalid_argument("data.g: not given");
   State& st = *state_;
   const Grid& grid = st.grid;
   const double h = grid.h();
@@ -163,7 +164,8 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
 
   // Load and u₀ = A⁻¹f (A⁺f for a singular A), once per solver.
   if (!st.have_u0) {
-    st.u0 = assemble_load(grid, st.problem.f, st.load_quadrature, st.threads);
+    st.u0 = st.problem.f_vectorized ? assemble_load(grid, st.problem.f_vectorized, st.load_quadrature, st.threads)
+                                    : assemble_load(grid, st.problem.f, st.load_quadrature, st.threads);
     st.load_total = 0;
     for (double v : st.u0) {
       if (!std::isfinite(v)) throw std::invalid_argument("data.f: not finite somewhere in the box");
@@ -254,9 +256,15 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
 
   // Obstacle at the collocation points, then semismooth Newton.
   sol.g.resize(m);
+  if (problem.g_vectorized && !problem.g_along_curve) {
+    std::vector<double> x(m), y(m);
+    for (int i = 0; i < m; ++i) x[i] = setup.collocation.point[i].x, y[i] = setup.collocation.point[i].y;
+    problem.g_vectorized(m, x.data(), y.data(), sol.g.data());
+  }
   for (int i = 0; i < m; ++i) {
     const Point p = setup.collocation.point[i];
-    sol.g[i] = problem.g_along_curve ? problem.g_along_curve(p.x, p.y, setup.collocation.s[i]) : problem.g(p.x, p.y);
+    if (problem.g_along_curve) sol.g[i] = problem.g_along_curve(p.x, p.y, setup.collocation.s[i]);
+    else if (!problem.g_vectorized) sol.g[i] = problem.g(p.x, p.y);
     if (!std::isfinite(sol.g[i]))
       throw std::invalid_argument("data.g: not finite at the collocation point (" + std::to_string(p.x) + ", " +
                                   std::to_string(p.y) + ")");
@@ -303,18 +311,34 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
     sol.signorini.max_complementarity = std::max(sol.signorini.max_complementarity, std::abs(gap * dn));
   }
 
-  if (problem.exact && compute_field) {
-    for (const Point& p : setup.collocation.point)
-      if (!std::isfinite(problem.exact(p.x, p.y)))
-        throw std::invalid_argument("data.exact: not finite at (" + std::to_string(p.x) + ", " + std::to_string(p.y) + ")");
-    const GradientField gradient = problem.exact_gradient ? problem.exact_gradient
-                                                          : numerical_gradient(problem.exact, grid.box().x1 - grid.box().x0);
-    sol.errors = compute_errors(sol.u, *setup.gamma_geometry, problem.exact, gradient, options.error_quadrature, st.threads);
+  if ((problem.exact || problem.exact_vectorized) && compute_field) {
+    const VectorizedField exact = problem.exact_vectorized ? problem.exact_vectorized : vectorize(problem.exact);
+    std::vector<double> x(m), y(m), values(m);
+    for (int i = 0; i < m; ++i) x[i] = setup.collocation.point[i].x, y[i] = setup.collocation.point[i].y;
+    exact(m, x.data(), y.data(), values.data());
+    for (int i = 0; i < m; ++i)
+      if (!std::isfinite(values[i]))
+        throw std::invalid_argument("data.exact: not finite at (" + std::to_string(x[i]) + ", " + std::to_string(y[i]) + ")");
+    if (problem.exact_vectorized)
+      sol.errors = compute_errors(sol.u, *setup.gamma_geometry, problem.exact_vectorized, {}, options.error_quadrature, st.threads);
+    else
+      sol.errors = compute_errors(sol.u, *setup.gamma_geometry, problem.exact, problem.exact_gradient,
+                                  options.error_quadrature, st.threads);
     clock.mark("errors");
   }
   sol.options = options;
   sol.peak_memory_bytes = peak_memory_bytes();
   return sol;
+}
+
+std::string describe_newton_failure(const Solution& s) {
+  std::string line = "solver.max_newton: Newton did not converge: " + s.newton.failure + "; history (active points, residual):";
+  for (const NewtonStep& step : s.newton.history) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, " (%d, %.2e)", step.n_active, step.residual);
+    line += buffer;
+  }
+  return line;
 }
 
 Solution solve(const Problem& problem, SolverOptions options) {

@@ -26,6 +26,11 @@ struct QuadraturePoint {
   double x, y, weight;
 };
 
+struct CellQuadraturePoint {
+  int ix;  // the cell (ix, iy) of the row it belongs to
+  double x, y, weight;
+};
+
 class CurveGridIntersection {
  public:
   /// Throws std::invalid_argument("<what>: …") if the curve is not strictly inside the box.
@@ -50,6 +55,10 @@ class CurveGridIntersection {
   /// Quadrature points of ω ∩ cell for a cut cell: q×q Gauss on sub-rectangles bounded by the
   /// exact curve crossings (integrates along lines transversal to the curve).
   void cut_cell_rule(const CutCell& cell, int q, std::vector<QuadraturePoint>& out) const;
+
+  /// Quadrature points of ω ∩ (cell row iy), cells in increasing ix: q×q Gauss on cells inside ω,
+  /// the curve-following rule on cut cells. `out` is cleared first.
+  void row_rule(int iy, int q, std::vector<CellQuadraturePoint>& out) const;
 
  private:
   const Curve& curve_;
@@ -77,47 +86,25 @@ template <int K, class F>
 std::array<double, K> integrate_over_domain(const CurveGridIntersection& geometry, int q, F&& fn,
                                             int threads) {
   const Grid& grid = geometry.grid();
-  const GaussRule& rule = gauss_legendre(q);
-  const double h = grid.h();
   std::array<double, K> total{};
 #pragma omp parallel num_threads(threads < 1 ? 1 : threads)
   {
     std::array<double, K> local{};
-    std::vector<QuadraturePoint> rule_points;
-    std::vector<char> below, above;
+    std::vector<CellQuadraturePoint> points;
 #pragma omp for schedule(dynamic, 8)
     for (int iy = 0; iy < grid.ny(); ++iy) {
       // Sums per cell, then per row, then over rows: keeps round-off at ~1e-15 of the total.
-      std::array<double, K> row_sum{};
-      below.resize(grid.nx() + 1);
-      above.resize(grid.nx() + 1);
-      for (int i = 0; i <= grid.nx(); ++i) {
-        below[i] = geometry.node_inside(i, iy);
-        above[i] = geometry.node_inside(i, iy + 1);
-      }
-      std::size_t next_cut = geometry.row_begin(iy);
-      const std::size_t end_cut = geometry.row_begin(iy + 1);
-      for (int ix = 0; ix < grid.nx(); ++ix) {
-        std::array<double, K> cell_sum{};
-        if (next_cut < end_cut && geometry.cut_cells()[next_cut].ix == ix) {
-          rule_points.clear();
-          geometry.cut_cell_rule(geometry.cut_cells()[next_cut], q, rule_points);
-          for (const QuadraturePoint& p : rule_points) {
-            const auto v = fn(ix, iy, p.x, p.y);
-            for (int k = 0; k < K; ++k) cell_sum[k] += p.weight * v[k];
-          }
-          ++next_cut;
-        } else if (below[ix] && below[ix + 1] && above[ix] && above[ix + 1]) {
-          for (int b = 0; b < q; ++b)
-            for (int a = 0; a < q; ++a) {
-              const auto v = fn(ix, iy, grid.x(ix) + rule.nodes[a] * h, grid.y(iy) + rule.nodes[b] * h);
-              const double w = rule.weights[a] * rule.weights[b] * h * h;
-              for (int k = 0; k < K; ++k) cell_sum[k] += w * v[k];
-            }
+      geometry.row_rule(iy, q, points);
+      std::array<double, K> row_sum{}, cell_sum{};
+      for (std::size_t k = 0; k < points.size(); ++k) {
+        const CellQuadraturePoint& p = points[k];
+        const auto v = fn(p.ix, iy, p.x, p.y);
+        for (int c = 0; c < K; ++c) cell_sum[c] += p.weight * v[c];
+        if (k + 1 == points.size() || points[k + 1].ix != p.ix) {
+          for (int c = 0; c < K; ++c) row_sum[c] += cell_sum[c], cell_sum[c] = 0.0;
         }
-        for (int k = 0; k < K; ++k) row_sum[k] += cell_sum[k];
       }
-      for (int k = 0; k < K; ++k) local[k] += row_sum[k];
+      for (int c = 0; c < K; ++c) local[c] += row_sum[c];
     }
 #pragma omp critical
     for (int k = 0; k < K; ++k) total[k] += local[k];

@@ -78,6 +78,9 @@ class FictitiousDomainSolver {
   std::unique_ptr<State> state_;
 };
 
+/// The one-line report of a Newton failure, with its history (what the CLI and the bindings print).
+std::string describe_newton_failure(const Solution& solution);
+
 /// One problem, one call (a thin wrapper over FictitiousDomainSolver).
 Solution solve(const Problem& problem, SolverOptions options);
 

@@ -7,9 +7,16 @@
 namespace fictus {
 
 using ScalarField = std::function<double(double x, double y)>;
+/// A field evaluated on many points at once: out[k] = F(x[k], y[k]) for k < n (e.g. a numpy
+/// callable). Called with one batch per cell row; must be thread-safe when threads > 1.
+using VectorizedField = std::function<void(std::size_t n, const double* x, const double* y, double* out)>;
+
+/// Pointwise field as a vectorized one.
+VectorizedField vectorize(ScalarField f);
 
 /// q = Gauss points per direction (q = 2 is O(h⁴) per cell, enough for the Q1 rates when f is
 /// smooth inside cells). f must be thread-safe (it is called from `threads` threads).
 GridVector assemble_load(const Grid& grid, const ScalarField& f, int q = 2, int threads = 1);
+GridVector assemble_load(const Grid& grid, const VectorizedField& f, int q = 2, int threads = 1);
 
 }  // namespace fictus

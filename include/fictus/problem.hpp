@@ -21,6 +21,8 @@ struct Problem {
   ScalarField g;                        // obstacle, sampled at the collocation points on γ
   /// Optional obstacle that also depends on the arc length s along γ (used instead of g when set).
   std::function<double(double x, double y, double s)> g_along_curve;
+  /// Optional batch forms (e.g. numpy callables), used instead of f, g, exact when set.
+  VectorizedField f_vectorized, g_vectorized, exact_vectorized;
   ScalarField exact;                    // optional exact solution on ω (errors are computed if set)
   GradientField exact_gradient;         // optional ∇u (central differences of `exact` if unset)
 };

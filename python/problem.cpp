@@ -1,0 +1,202 @@
+// fictus.Problem: built from a dict, TOML text, keyword arguments or the paper's experiment. Dicts
+// and keywords are turned into the same TOML the CLI reads, so every check and message is the CLI's.
+// Data may be expressions (str) or Python callables vectorized over numpy arrays: f(x, y) -> array.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+
+#include "bindings.hpp"
+#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/paper_problem.hpp"
+#include "fictus/problem_file.hpp"
+#include "python_problem.hpp"
+
+namespace py = pybind11;
+
+namespace fictus::python {
+
+namespace {
+
+/// Where each flat keyword goes.
+const char* section_of(const std::string& key) {
+  static const std::map<std::string, const char*> sections = {
+      {"N", "domain"}, {"box", "domain"}, {"boundary", "domain"},
+      {"variant", "formulation"}, {"multipliers", "formulation"}, {"offset", "formulation"}, {"rho", "formulation"},
+      {"normal_shift", "formulation"},
+      {"c", "data"}, {"f", "data"}, {"g", "data"}, {"exact", "data"},
+      {"schur", "solver"}, {"krylov_tolerance", "solver"}, {"krylov_max_iterations", "solver"},
+      {"newton_tolerance", "solver"}, {"max_newton", "solver"}, {"start", "solver"}, {"threads", "solver"},
+      {"load_quadrature", "solver"}, {"error_quadrature", "solver"}, {"condition_number", "solver"}};
+  const auto it = sections.find(key);
+  return it == sections.end() ? nullptr : it->second;
+}
+
+void insert(toml::table& table, const std::string& key, py::handle value, const std::string& where);
+
+toml::array to_array(py::handle list, const std::string& where) {
+  toml::array a;
+  for (py::handle item : list) {
+    toml::table wrapper;
+    insert(wrapper, "v", item, where);
+    a.push_back(*wrapper.get("v"));
+  }
+  return a;
+}
+
+void insert(toml::table& table, const std::string& key, py::handle value, const std::string& where) {
+  if (py::isinstance<py::bool_>(value)) table.insert_or_assign(key, value.cast<bool>());
+  else if (py::isinstance<py::int_>(value)) table.insert_or_assign(key, value.cast<int64_t>());
+  else if (py::isinstance<py::float_>(value)) table.insert_or_assign(key, value.cast<double>());
+  else if (py::isinstance<py::str>(value)) table.insert_or_assign(key, value.cast<std::string>());
+  else if (py::isinstance<py::dict>(value)) {
+    toml::table sub;
+    for (auto [k, v] : value.cast<py::dict>()) insert(sub, py::str(k), v, where + "." + std::string(py::str(k)));
+    table.insert_or_assign(key, std::move(sub));
+  } else if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value) || py::isinstance<py::array>(value)) {
+    const py::object items = py::isinstance<py::array>(value) ? value.attr("tolist")() : py::reinterpret_borrow<py::object>(value);
+    table.insert_or_assign(key, to_array(items, where));
+  } else {
+    throw std::invalid_argument(where + ": unsupported value of type " + std::string(py::str(value.get_type().attr("__name__"))));
+  }
+}
+
+}  // namespace
+
+VectorizedField PyProblem::wrap(py::function fn, const std::string& key) {
+  // The callable is released under the GIL whenever the last copy of the field goes.
+  std::shared_ptr<py::function> holder(new py::function(std::move(fn)), [](py::function* f) {
+    py::gil_scoped_acquire gil;
+    delete f;
+  });
+  auto errors = errors_;
+  return [holder, key, errors](std::size_t n, const double* x, const double* y, double* out) {
+    // Called from solver threads: never throw through them; record the error, return NaN.
+    py::gil_scoped_acquire gil;
+    try {
+      py::array_t<double> xs(n), ys(n);
+      std::copy(x, x + n, xs.mutable_data());
+      std::copy(y, y + n, ys.mutable_data());
+      const auto values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure((*holder)(xs, ys));
+      if (!values || (values.size() != py::ssize_t(n) && values.size() != 1))
+        throw std::invalid_argument(key + ": the callable must return one number per point (an array of " +
+                                    std::to_string(n) + ")");
+      for (std::size_t k = 0; k < n; ++k) out[k] = values.data()[values.size() == 1 ? 0 : k];
+    } catch (const std::exception& e) {
+      std::lock_guard lock(errors->mutex);
+      if (errors->message.empty()) errors->message = key + ": the callable failed: " + e.what();
+      std::fill(out, out + n, std::nan(""));
+    }
+  };
+}
+
+PyProblem PyProblem::from_config(py::dict config) {
+  PyProblem p;
+  py::dict sections;
+  std::map<std::string, py::function> callables;
+  for (auto [k, v] : config) {
+    const std::string key = py::str(k);
+    if (key == "domain" || key == "geometry" || key == "formulation" || key == "data" || key == "solver" || key == "output") {
+      if (!py::isinstance<py::dict>(v)) throw std::invalid_argument(key + ": expected a dict");
+      py::dict copy;
+      for (auto [kk, vv] : v.cast<py::dict>()) {
+        if (!sections.contains(key)) sections[py::str(key)] = py::dict();
+        sections[py::str(key)][kk] = vv;
+      }
+      if (!sections.contains(key)) sections[py::str(key)] = py::dict();
+    } else if (const char* section = section_of(key)) {
+      if (!sections.contains(section)) sections[section] = py::dict();
+      sections[section][py::str(key)] = v;
+    } else {
+      throw std::invalid_argument(key + ": unknown keyword");
+    }
+  }
+  // Callables in [data] are attached after parsing; the TOML gets placeholders.
+  if (sections.contains("data")) {
+    py::dict data = sections["data"];
+    for (const char* key : {"f", "g", "exact"}) {
+      if (data.contains(key) && !py::isinstance<py::str>(data[key]) && py::isinstance<py::function>(data[key])) {
+        callables[key] = data[key].cast<py::function>();
+        data[key] = py::str("0");
+      }
+    }
+  }
+  toml::table root;
+  for (auto [k, v] : sections) insert(root, py::str(k), v, py::str(k));
+  std::ostringstream text;
+  text << root;
+  p.spec = parse_problem_text(text.str(), "problem");
+  Problem& problem = p.spec.problem;
+  for (auto& [key, fn] : callables) {
+    VectorizedField field = p.wrap(fn, "data." + key);
+    if (key == "f") problem.f = nullptr, problem.f_vectorized = field;
+    if (key == "g") problem.g = nullptr, problem.g_along_curve = nullptr, problem.g_vectorized = field;
+    if (key == "exact") problem.exact = nullptr, problem.exact_vectorized = field;
+  }
+  return p;
+}
+
+PyProblem PyProblem::paper(int N, double c, const std::string& boundary, py::dict options) {
+  PyProblem p;
+  if (boundary != "dirichlet" && boundary != "periodic")
+    throw std::invalid_argument("domain.boundary: expected \"dirichlet\" or \"periodic\"");
+  p.spec.problem = paper_problem(N, c, boundary == "periodic" ? Boundary::periodic : Boundary::dirichlet);
+  p.spec.options.multipliers = 0;
+  // Options through the same reader: a minimal file around them.
+  if (!options.empty()) {
+    py::dict config;
+    config["geometry"] = py::dict(py::arg("shape") = "circle", py::arg("center") = py::make_tuple(0.5, 0.5),
+                                  py::arg("radius") = 0.25);
+    config["data"] = py::dict(py::arg("f") = "0", py::arg("g") = "0");
+    for (auto [k, v] : options) {
+      const std::string key = py::str(k);
+      const char* section = section_of(key);
+      if (!section || std::string(section) == "domain" || std::string(section) == "data")
+        throw std::invalid_argument(key + ": not an option of the paper's problem (use Problem(...) for data and domain)");
+      if (!config.contains(section)) config[section] = py::dict();
+      config[section][py::str(key)] = v;
+    }
+    p.spec.options = from_config(config).spec.options;
+  }
+  return p;
+}
+
+void bind_problem(py::module_& m) {
+  py::class_<PyProblem>(m, "Problem", R"doc(A Signorini problem and the solver options.
+
+    Problem(domain=..., geometry=..., formulation=..., data=..., solver=..., **flat)
+        Sections as dicts with the keys of a problem file (docs/problem_files.md), and/or flat
+        keywords (N, box, boundary, variant, multipliers, offset, rho, normal_shift, c, f, g, exact,
+        schur, krylov_tolerance, newton_tolerance, max_newton, start, threads, ...).
+        f, g, exact: expressions (str) or callables vectorized over numpy arrays, f(x, y) -> array.
+    Problem.from_dict(d), Problem.from_toml(text), Problem.paper(N=256, c=1.0, boundary="dirichlet", **options)
+)doc")
+      .def(py::init([](py::kwargs kwargs) { return PyProblem::from_config(kwargs); }))
+      .def_static("from_dict", [](py::dict d) { return PyProblem::from_config(d); }, py::arg("config"))
+      .def_static("from_toml",
+                  [](const std::string& text) {
+                    PyProblem p;
+                    p.spec = parse_problem_text(text, "problem");
+                    return p;
+                  },
+                  py::arg("text"))
+      .def_static("paper",
+                  [](int N, double c, const std::string& boundary, py::kwargs options) {
+                    return PyProblem::paper(N, c, boundary, options);
+                  },
+                  py::arg("N") = 256, py::arg("c") = 1.0, py::arg("boundary") = "dirichlet")
+      .def_property_readonly("N", [](const PyProblem& p) { return p.spec.problem.N; })
+      .def_property_readonly("warnings", [](const PyProblem& p) { return p.spec.warnings; })
+      .def("solve", &PyProblem::solve, py::arg("field") = true,
+           "Solves (the GIL is released meanwhile) and returns a Solution; raises ValueError on bad input "
+           "and RuntimeError when Newton does not converge, with the CLI's messages.");
+}
+
+}  // namespace fictus::python

@@ -1,0 +1,58 @@
+#pragma once
+#include <pybind11/pybind11.h>
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/problem_file.hpp"
+
+namespace fictus::python {
+
+
+/// Errors raised inside Python callables while the solver ran (they cannot cross its threads).
+struct CallbackErrors {
+  std::mutex mutex;
+  std::string message;
+};
+
+/// A solved problem, as Python sees it.
+class PySolution {
+ public:
+  PySolution(std::shared_ptr<const Solution> s, Problem problem) : s_(std::move(s)), problem_(std::move(problem)) {
+    const int m = s_->collocation.m;
+    contact_.assign(s_->newton.active.begin(), s_->newton.active.end());
+    points_.resize(2 * m);
+    normals_.resize(2 * m);
+    for (int i = 0; i < m; ++i) {
+      points_[2 * i] = s_->collocation.point[i].x, points_[2 * i + 1] = s_->collocation.point[i].y;
+      normals_[2 * i] = s_->collocation.normal[i].x, normals_[2 * i + 1] = s_->collocation.normal[i].y;
+    }
+  }
+  const Solution& s() const { return *s_; }
+  const Problem& problem() const { return problem_; }
+  const std::vector<double>& points() const { return points_; }
+  const std::vector<double>& normals() const { return normals_; }
+  const std::vector<bool>& contact_flags() const { return contact_; }
+
+ private:
+  std::shared_ptr<const Solution> s_;
+  Problem problem_;
+  std::vector<double> points_, normals_;
+  std::vector<bool> contact_;
+};
+
+struct PyProblem {
+  ProblemSpec spec;
+  std::shared_ptr<CallbackErrors> errors_ = std::make_shared<CallbackErrors>();
+
+  static PyProblem from_config(pybind11::dict config);
+  static PyProblem paper(int N, double c, const std::string& boundary, pybind11::dict options);
+  VectorizedField wrap(pybind11::function fn, const std::string& key);
+  PySolution solve(bool field);
+};
+
+}  // namespace fictus::python

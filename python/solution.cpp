@@ -1,0 +1,193 @@
+// fictus.Solution: the grid field û as a 2-D numpy array with its coordinates, the per-point
+// quantities on γ (views of the solver's arrays, no copies), iterations, timings, errors, options.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <memory>
+#include <stdexcept>
+
+#include "bindings.hpp"
+#include "fictus/fictitious_domain_solver.hpp"
+#include "python_problem.hpp"
+
+namespace py = pybind11;
+
+namespace fictus::python {
+
+PySolution PyProblem::solve(bool field) {
+  {
+    std::lock_guard lock(errors_->mutex);
+    errors_->message.clear();
+  }
+  std::shared_ptr<const Solution> solution;
+  try {
+    py::gil_scoped_release release;
+    if (field) {
+      solution = std::make_shared<const Solution>(fictus::solve(spec.problem, spec.options));
+    } else {
+      FictitiousDomainSolver solver(spec.problem, spec.options.threads, spec.options.load_quadrature);
+      solution = std::make_shared<const Solution>(solver.solve(spec.problem, spec.options, false));
+    }
+  } catch (const std::invalid_argument&) {
+    std::lock_guard lock(errors_->mutex);
+    if (!errors_->message.empty()) throw std::invalid_argument(errors_->message);
+    throw;
+  }
+  if (!errors_->message.empty()) throw std::invalid_argument(errors_->message);
+  if (!solution->newton.converged) throw std::runtime_error(describe_newton_failure(*solution));
+  return PySolution(solution, spec.problem);
+}
+
+namespace {
+
+/// A 1-D view of a vector owned by the Solution object `owner` (no copy).
+py::array_t<double> view(const std::vector<double>& v, py::handle owner) {
+  return py::array_t<double>({py::ssize_t(v.size())}, {py::ssize_t(sizeof(double))}, v.data(), owner);
+}
+
+py::dict options_dict(const SolverOptions& o) {
+  py::dict d;
+  d["variant"] = to_string(o.variant);
+  d["multipliers"] = o.multipliers;
+  d["offset"] = o.offset;
+  d["rho"] = o.rho;
+  d["normal_shift"] = o.normal_shift;
+  d["start"] = o.start_all_active ? "all" : "zero";
+  d["schur"] = to_string(o.inner);
+  d["krylov_tolerance"] = o.krylov_tolerance;
+  d["krylov_max_iterations"] = o.krylov_max_iterations;
+  d["newton_tolerance"] = o.newton_tolerance;
+  d["max_newton"] = o.max_newton;
+  d["load_quadrature"] = o.load_quadrature;
+  d["error_quadrature"] = o.error_quadrature;
+  d["condition_number"] = o.condition_number;
+  d["threads"] = o.threads;
+  return d;
+}
+
+}  // namespace
+
+void bind_solution(py::module_& m) {
+  py::class_<PySolution>(m, "Solution", "The result of Problem.solve(); arrays are numpy arrays.")
+      .def_property_readonly("u",
+                             [](const PySolution& p) {
+                               // û at all (ny+1) × (nx+1) nodes, row j = y_j (zero on a Dirichlet boundary).
+                               const Solution& s = p.s();
+                               const Grid& g = s.grid;
+                               py::array_t<double> u({g.ny() + 1, g.nx() + 1});
+                               auto a = u.mutable_unchecked<2>();
+                               for (int j = 0; j <= g.ny(); ++j)
+                                 for (int i = 0; i <= g.nx(); ++i)
+                                   a(j, i) = g.has_unknown(i, j) && !s.u.empty() ? s.u[g.index(i, j)] : 0.0;
+                               return u;
+                             })
+      .def_property_readonly("x",
+                             [](const PySolution& p) {
+                               const Grid& g = p.s().grid;
+                               py::array_t<double> x(g.nx() + 1);
+                               for (int i = 0; i <= g.nx(); ++i) x.mutable_data()[i] = g.x(i);
+                               return x;
+                             })
+      .def_property_readonly("y",
+                             [](const PySolution& p) {
+                               const Grid& g = p.s().grid;
+                               py::array_t<double> y(g.ny() + 1);
+                               for (int j = 0; j <= g.ny(); ++j) y.mutable_data()[j] = g.y(j);
+                               return y;
+                             })
+      .def_property_readonly("points",
+                             [](py::object self) {
+                               const auto& p = self.cast<const PySolution&>().points();
+                               return py::array_t<double>({py::ssize_t(p.size() / 2), py::ssize_t(2)},
+                                                          {py::ssize_t(2 * sizeof(double)), py::ssize_t(sizeof(double))},
+                                                          p.data(), self);
+                             })
+      .def_property_readonly("normals",
+                             [](py::object self) {
+                               const auto& p = self.cast<const PySolution&>().normals();
+                               return py::array_t<double>({py::ssize_t(p.size() / 2), py::ssize_t(2)},
+                                                          {py::ssize_t(2 * sizeof(double)), py::ssize_t(sizeof(double))},
+                                                          p.data(), self);
+                             })
+      .def_property_readonly("s", [](py::object self) { return view(self.cast<const PySolution&>().s().collocation.s, self); },
+                             "arc length of each collocation point")
+      .def_property_readonly("g", [](py::object self) { return view(self.cast<const PySolution&>().s().g, self); })
+      .def_property_readonly("u_gamma", [](py::object self) { return view(self.cast<const PySolution&>().s().trace, self); },
+                             "B_γû at the collocation points")
+      .def_property_readonly("dudn",
+                             [](py::object self) { return view(self.cast<const PySolution&>().s().normal_derivative, self); },
+                             "C_γû at the collocation points")
+      .def_property_readonly("lambda_", [](py::object self) { return view(self.cast<const PySolution&>().s().lambda, self); },
+                             "the multipliers (controls on Γ in the smooth variant)")
+      .def_property_readonly("contact",
+                             [](const PySolution& p) {
+                               const auto& c = p.contact_flags();
+                               py::array_t<bool> a(py::ssize_t(c.size()));
+                               for (std::size_t i = 0; i < c.size(); ++i) a.mutable_data()[i] = c[i];
+                               return a;
+                             })
+      .def_property_readonly("gamma_points",
+                             [](const PySolution& p) {
+                               const Solution& s = p.s();
+                               py::array_t<double> a({py::ssize_t(s.collocation.m), py::ssize_t(2)});
+                               auto r = a.mutable_unchecked<2>();
+                               for (int i = 0; i < s.collocation.m; ++i) {
+                                 const Point q = s.Gamma->position(s.collocation.t[i]);
+                                 r(i, 0) = q.x, r(i, 1) = q.y;
+                               }
+                               return a;
+                             },
+                             "the points of Γ carrying λ (= points in the non-smooth variant)")
+      .def_property_readonly("iterations", [](const PySolution& p) { return p.s().newton.iterations; })
+      .def_property_readonly("converged", [](const PySolution& p) { return p.s().newton.converged; })
+      .def_property_readonly("fast_solves", [](const PySolution& p) { return p.s().fast_solves; })
+      .def_property_readonly("multipliers", [](const PySolution& p) { return p.s().collocation.m; })
+      .def_property_readonly("delta", [](const PySolution& p) { return p.s().delta; })
+      .def_property_readonly("condition_number", [](const PySolution& p) { return p.s().condition_number; })
+      .def_property_readonly("peak_memory_bytes", [](const PySolution& p) { return p.s().peak_memory_bytes; })
+      .def_property_readonly("timings",
+                             [](const PySolution& p) {
+                               py::dict d;
+                               for (const auto& [phase, seconds] : p.s().timings.phases) d[py::str(phase)] = seconds;
+                               d["total"] = p.s().timings.total;
+                               return d;
+                             })
+      .def_property_readonly("signorini",
+                             [](const PySolution& p) {
+                               const SignoriniCheck& c = p.s().signorini;
+                               py::dict d;
+                               d["min_gap"] = c.min_gap;
+                               d["min_normal_derivative"] = c.min_normal_derivative;
+                               d["max_complementarity"] = c.max_complementarity;
+                               return d;
+                             })
+      .def_property_readonly("errors",
+                             [](const PySolution& p) -> py::object {
+                               if (!p.s().errors) return py::none();
+                               const ErrorNorms& e = *p.s().errors;
+                               py::dict d;
+                               d["l2_omega"] = e.l2_omega, d["h1_omega"] = e.h1_omega, d["h1semi_omega"] = e.h1semi_omega;
+                               d["l2_gamma"] = e.l2_gamma, d["rel_l2_omega"] = e.rel_l2_omega;
+                               d["rel_h1_omega"] = e.rel_h1_omega, d["rel_h1semi_omega"] = e.rel_h1semi_omega;
+                               d["rel_l2_gamma"] = e.rel_l2_gamma;
+                               return d;
+                             })
+      .def_property_readonly("options",
+                             [](const PySolution& p) {
+                               py::dict d = options_dict(p.s().options);
+                               d["N"] = p.problem().N;
+                               d["c"] = p.problem().c;
+                               d["boundary"] = p.problem().boundary == Boundary::periodic ? "periodic" : "dirichlet";
+                               return d;
+                             })
+      .def("__repr__", [](const PySolution& p) {
+        const Solution& s = p.s();
+        return "<fictus.Solution N=" + std::to_string(s.grid.nx()) + " m=" + std::to_string(s.collocation.m) +
+               " newton=" + std::to_string(s.newton.iterations) + " active=" +
+               std::to_string(std::count(s.newton.active.begin(), s.newton.active.end(), 1)) + ">";
+      });
+}
+
+}  // namespace fictus::python

@@ -1,0 +1,123 @@
+"""fictus from Python: the same numbers as the CLI, callables = expressions, bad input raises."""
+import csv
+import json
+import os
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import fictus
+
+EXE = os.environ.get("FICTUS_EXE", "fictus")
+EXAMPLES = os.environ.get("FICTUS_EXAMPLES", os.path.join(os.path.dirname(__file__), "..", "..", "examples"))
+
+
+def cli_solve(tmp_path, *args):
+    out = tmp_path / "cli"
+    subprocess.run([EXE, "solve", *args, "--out", str(out)], check=True, capture_output=True)
+    with open(out / "results.json") as handle:
+        results = json.load(handle)
+    with open(out / "points.csv") as handle:
+        points = list(csv.DictReader(handle))
+    return results, points
+
+
+def test_paper_problem_matches_the_cli(tmp_path):
+    results, points = cli_solve(tmp_path, "--N", "128", "--variant", "nonsmooth")
+    s = fictus.Problem.paper(N=128, variant="nonsmooth").solve()
+    assert s.iterations == results["newton"]["iterations"]
+    assert int(s.contact.sum()) == results["newton"]["n_active"]
+    for key, value in results["errors"].items():
+        assert s.errors[key] == pytest.approx(value, rel=1e-12), key
+    lam = np.array([float(p["lambda"]) for p in points])
+    np.testing.assert_allclose(s.lambda_, lam, rtol=1e-13, atol=1e-15)
+    assert s.options["variant"] == "nonsmooth" and s.options["N"] == 128
+
+
+def test_problem_file_text_matches_the_cli(tmp_path):
+    path = os.path.join(EXAMPLES, "circle.toml")
+    results, _ = cli_solve(tmp_path, path, "--N", "128")
+    with open(path) as handle:
+        problem = fictus.Problem.from_toml(handle.read().replace("N = 256", "N = 128"))
+    s = problem.solve()
+    assert s.errors["rel_l2_omega"] == pytest.approx(results["errors"]["rel_l2_omega"], rel=1e-12)
+
+
+CIRCLE = {
+    "domain": {"N": 128},
+    "geometry": {"shape": "circle", "center": [0.5, 0.5], "radius": 0.3},
+    "formulation": {"variant": "smooth"},
+}
+
+
+def test_callables_and_expressions_agree():
+    expressions = dict(CIRCLE, data={
+        "exact": "max(0, x - 0.5)^3",
+        "f": "-6 * max(0, x - 0.5) + max(0, x - 0.5)^3",
+        "g": "max(0, x - 0.5)^3 - 0.1 * max(0, 0.5 - x)",
+    })
+    pos = lambda v: np.maximum(v, 0.0)  # noqa: E731
+    callables = dict(CIRCLE, data={
+        "exact": lambda x, y: pos(x - 0.5) ** 3,
+        "f": lambda x, y: -6 * pos(x - 0.5) + pos(x - 0.5) ** 3,
+        "g": lambda x, y: pos(x - 0.5) ** 3 - 0.1 * pos(0.5 - x),
+    })
+    a = fictus.Problem.from_dict(expressions).solve()
+    b = fictus.Problem.from_dict(callables).solve()
+    np.testing.assert_allclose(a.lambda_, b.lambda_, rtol=1e-10, atol=1e-12)
+    np.testing.assert_array_equal(a.contact, b.contact)
+    for key in ("rel_l2_omega", "rel_h1_omega", "rel_l2_gamma"):
+        assert a.errors[key] == pytest.approx(b.errors[key], rel=1e-8), key
+    assert a.errors["rel_l2_omega"] < 1e-3
+
+
+def test_keyword_arguments_and_arrays():
+    s = fictus.Problem(geometry=CIRCLE["geometry"], N=64, variant="nonsmooth", f="10 * (x - 0.5)", g="0").solve()
+    assert s.u.shape == (65, 65) and s.x.shape == (65,) and s.y.shape == (65,)
+    assert np.all(s.u[0, :] == 0) and np.all(s.u[:, 0] == 0)
+    assert s.points.shape == (s.multipliers, 2) and s.normals.shape == (s.multipliers, 2)
+    np.testing.assert_allclose(np.hypot(s.normals[:, 0], s.normals[:, 1]), 1.0, rtol=1e-12)
+    gap = s.u_gamma - s.g
+    assert np.all(gap[s.contact] == pytest.approx(0.0, abs=1e-10))
+    assert np.all(s.dudn[~s.contact] == pytest.approx(0.0, abs=1e-10))
+    assert s.signorini["max_complementarity"] <= 1e-10
+    assert s.timings["total"] > 0 and s.errors is None
+    assert s.points.base is not None  # a view of the solver's memory, not a copy
+
+
+@pytest.mark.parametrize("config, message", [
+    (dict(CIRCLE, data={"f": "1", "g": "0"}, solver={"tolerance": 1e-8}), "solver.tolerance: unknown key"),
+    (dict(CIRCLE, data={"f": "sin(x", "g": "0"}), "data.f: cannot parse"),
+    (dict(CIRCLE, data={"f": "1", "g": "0", "c": float("nan")}), "data.c: must be finite"),
+    (dict(CIRCLE, data={"f": "1", "g": "0"}, formulation={"multipliers": 5000}), "formulation.multipliers"),
+])
+def test_bad_input_raises_with_the_cli_message(config, message):
+    with pytest.raises(ValueError, match=message.replace("(", r"\(")):
+        fictus.Problem.from_dict(config).solve()
+
+
+def test_callable_errors_are_reported():
+    def broken(x, y):
+        raise ZeroDivisionError("boom")
+    with pytest.raises(ValueError, match="data.f: the callable failed: .*boom"):
+        fictus.Problem.from_dict(dict(CIRCLE, data={"f": broken, "g": "0"})).solve()
+
+
+def test_newton_failure_raises_runtime_error():
+    with pytest.raises(RuntimeError, match="solver.max_newton: Newton did not converge"):
+        fictus.Problem.paper(N=128, variant="nonsmooth", max_newton=1).solve()
+
+
+def test_solve_releases_the_gil():
+    ticks = []
+    problem = fictus.Problem.paper(N=1024)
+    worker = threading.Thread(target=problem.solve)
+    worker.start()
+    while worker.is_alive():
+        ticks.append(time.perf_counter())
+        time.sleep(0.001)
+    worker.join()
+    assert len(ticks) > 20  # the main thread ran while the solver worked
