@@ -47,6 +47,12 @@ py::array_t<double> view(const std::vector<double>& v, py::handle owner) {
   return py::array_t<double>({py::ssize_t(v.size())}, {py::ssize_t(sizeof(double))}, v.data(), owner);
 }
 
+/// An (n, 2) view of interleaved pairs owned by `owner` (no copy).
+py::array_t<double> pairs_view(const std::vector<double>& v, py::handle owner) {
+  return py::array_t<double>({py::ssize_t(v.size() / 2), py::ssize_t(2)},
+                             {py::ssize_t(2 * sizeof(double)), py::ssize_t(sizeof(double))}, v.data(), owner);
+}
+
 py::dict options_dict(const SolverOptions& o) {
   py::dict d;
   d["variant"] = to_string(o.variant);
@@ -97,20 +103,9 @@ void bind_solution(py::module_& m) {
                                for (int j = 0; j <= g.ny(); ++j) y.mutable_data()[j] = g.y(j);
                                return y;
                              })
-      .def_property_readonly("points",
-                             [](py::object self) {
-                               const auto& p = self.cast<const PySolution&>().points();
-                               return py::array_t<double>({py::ssize_t(p.size() / 2), py::ssize_t(2)},
-                                                          {py::ssize_t(2 * sizeof(double)), py::ssize_t(sizeof(double))},
-                                                          p.data(), self);
-                             })
+      .def_property_readonly("points", [](py::object self) { return pairs_view(self.cast<const PySolution&>().points(), self); })
       .def_property_readonly("normals",
-                             [](py::object self) {
-                               const auto& p = self.cast<const PySolution&>().normals();
-                               return py::array_t<double>({py::ssize_t(p.size() / 2), py::ssize_t(2)},
-                                                          {py::ssize_t(2 * sizeof(double)), py::ssize_t(sizeof(double))},
-                                                          p.data(), self);
-                             })
+                             [](py::object self) { return pairs_view(self.cast<const PySolution&>().normals(), self); })
       .def_property_readonly("s", [](py::object self) { return view(self.cast<const PySolution&>().s().collocation.s, self); },
                              "arc length of each collocation point")
       .def_property_readonly("g", [](py::object self) { return view(self.cast<const PySolution&>().s().g, self); })

@@ -94,11 +94,12 @@ Eigen::VectorXd to_eigen(const std::vector<double>& v) {
 
 namespace {
 
-Eigen::VectorXd row_sums(const SparseRows& rows, const Grid& grid) {
-  GridVector ones(grid.n_unknowns(), 1.0);
-  std::vector<double> out;
-  rows.multiply(ones, out);
-  return to_eigen(out);
+/// R·1: the sum of each row's entries.
+Eigen::VectorXd row_sums(const SparseRows& rows) {
+  Eigen::VectorXd sums = Eigen::VectorXd::Zero(rows.n_rows());
+  for (int r = 0; r < rows.n_rows(); ++r)
+    for (std::size_t k = rows.row_begin[r]; k < rows.row_begin[r + 1]; ++k) sums(r) += rows.entries[k].value;
+  return sums;
 }
 
 }  // namespace
@@ -227,8 +228,8 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
     setup->b0 = to_eigen(b0);
     setup->c0 = to_eigen(c0);
     if (st.fast->singular())
-      setup->mode = ConstantMode{row_sums(setup->B_gamma, grid), row_sums(setup->C_gamma, grid),
-                                 row_sums(setup->B_Gamma, grid), st.load_total};
+      setup->mode = ConstantMode{row_sums(setup->B_gamma), row_sums(setup->C_gamma), row_sums(setup->B_Gamma),
+                                 st.load_total};
     clock.mark("geometry");
 
     if (options.inner == InnerSolver::green) {

@@ -9,6 +9,7 @@
 namespace {
 
 // A = K + cM assembled cell by cell from the Q1 element matrices (independent of the tensor form).
+// Dirichlet: boundary nodes dropped; periodic: Grid::index wraps the node indices.
 Eigen::SparseMatrix<double> assemble_q1(const fictus::Grid& grid, double c) {
   const double h = grid.h();
   const int ci[4] = {0, 1, 1, 0}, cj[4] = {0, 0, 1, 1};  // corners counter-clockwise
@@ -66,24 +67,6 @@ TEST(DstSolver, RejectsNegativeReaction) {
 
 namespace {
 
-// Periodic Q1 matrix, assembled cell by cell with wrapped node indices.
-Eigen::SparseMatrix<double> assemble_periodic_q1(const fictus::Grid& grid, double c) {
-  const double h = grid.h();
-  const int ci[4] = {0, 1, 1, 0}, cj[4] = {0, 0, 1, 1};
-  const double K[4][4] = {{4, -1, -2, -1}, {-1, 4, -1, -2}, {-2, -1, 4, -1}, {-1, -2, -1, 4}};
-  const double M[4][4] = {{4, 2, 1, 2}, {2, 4, 2, 1}, {1, 2, 4, 2}, {2, 1, 2, 4}};
-  std::vector<Eigen::Triplet<double>> t;
-  for (int iy = 0; iy < grid.ny(); ++iy)
-    for (int ix = 0; ix < grid.nx(); ++ix)
-      for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b)
-          t.emplace_back(int(grid.index(ix + ci[a], iy + cj[a])), int(grid.index(ix + ci[b], iy + cj[b])),
-                         K[a][b] / 6.0 + c * h * h * M[a][b] / 36.0);
-  Eigen::SparseMatrix<double> A(grid.n_unknowns(), grid.n_unknowns());
-  A.setFromTriplets(t.begin(), t.end());
-  return A;
-}
-
 Eigen::Map<const Eigen::VectorXd> view(const fictus::GridVector& v) { return {v.data(), Eigen::Index(v.size())}; }
 
 class PeriodicSolverTest : public ::testing::TestWithParam<double> {};
@@ -98,7 +81,7 @@ TEST_P(PeriodicSolverTest, MatchesSparseDirectSolve) {
   for (double& v : r) v = dist(rng);
   fictus::GridVector u = r;
   solver->solve_in_place(u);
-  const Eigen::SparseMatrix<double> A = assemble_periodic_q1(grid, c);
+  const Eigen::SparseMatrix<double> A = assemble_q1(grid, c);
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(A);
   ASSERT_EQ(lu.info(), Eigen::Success);
   const Eigen::VectorXd reference = lu.solve(view(r));
@@ -123,7 +106,7 @@ TEST(PeriodicSolver, SingularCaseIsThePseudoInverse) {
   const double mean = view(r).mean();
   EXPECT_LE((view(Au) - (view(r).array() - mean).matrix()).norm() / view(r).norm(), 1e-12);
   EXPECT_NEAR(view(u).mean(), 0.0, 1e-14);
-  const Eigen::SparseMatrix<double> A = assemble_periodic_q1(grid, 0.0);
+  const Eigen::SparseMatrix<double> A = assemble_q1(grid, 0.0);
   EXPECT_LE((A * view(u) - view(Au)).norm(), 1e-12);  // the fast apply is the assembled A
 }
 
