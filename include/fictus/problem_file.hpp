@@ -25,7 +25,7 @@ struct ProblemSpec {
 ProblemSpec read_problem_file(const std::string& path);
 ProblemSpec parse_problem_text(const std::string& text, const std::string& source = "problem");
 
-/// Builds the curve of a [geometry] table given as TOML text (used by tests and bindings).
+/// The names `[output] files` accepts.
 const std::vector<std::string>& output_file_names();
 
 }  // namespace fictus
