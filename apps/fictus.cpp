@@ -34,6 +34,7 @@ struct SolveArguments {
   std::string schur = "green";
   std::string start = "all";
   std::string out;
+  std::vector<std::string> files;
 };
 
 /// Flags that override a problem file: applied only when given on the command line.
@@ -65,6 +66,12 @@ void add_solver_options(CLI::App& cmd, fictus::SolverOptions& o, SolveArguments&
       [&](fictus::ProblemSpec& s) { s.options.inner = fictus::parse_inner_solver(a.schur); });
   add(cmd.add_option("--krylov-tol", o.krylov_tolerance, "relative GMRES tolerance"),
       [&](fictus::ProblemSpec& s) { s.options.krylov_tolerance = o.krylov_tolerance; });
+  add(cmd.add_option("--krylov-max-iterations", o.krylov_max_iterations, "GMRES operator applications per solve"),
+      [&](fictus::ProblemSpec& s) { s.options.krylov_max_iterations = o.krylov_max_iterations; });
+  add(cmd.add_option("--load-quadrature", o.load_quadrature, "Gauss points per direction for the load"),
+      [&](fictus::ProblemSpec& s) { s.options.load_quadrature = o.load_quadrature; });
+  add(cmd.add_option("--error-quadrature", o.error_quadrature, "Gauss points per direction for the errors"),
+      [&](fictus::ProblemSpec& s) { s.options.error_quadrature = o.error_quadrature; });
   add(cmd.add_option("--newton-tol", o.newton_tolerance, "relative Newton residual tolerance"),
       [&](fictus::ProblemSpec& s) { s.options.newton_tolerance = o.newton_tolerance; });
   add(cmd.add_option("--max-newton", o.max_newton, "maximum Newton steps"),
@@ -242,6 +249,16 @@ int main(int argc, char** argv) {
         s.problem.boundary = solve_args.boundary == "periodic" ? fictus::Boundary::periodic : fictus::Boundary::dirichlet;
       });
   add_solver_options(*solve_cmd, solve_options, solve_args, &overrides);
+  overrides.items.emplace_back(
+      solve_cmd->add_option("--files", solve_args.files, "output files, comma-separated (results.json,points.csv,solution.vti,curves.vtp)")
+          ->delimiter(','),
+      [&](fictus::ProblemSpec& s) {
+        for (const std::string& f : solve_args.files)
+          if (std::find(fictus::output_file_names().begin(), fictus::output_file_names().end(), f) ==
+              fictus::output_file_names().end())
+            throw std::invalid_argument("output.files: unknown file \"" + f + "\"");
+        s.output.files = solve_args.files;
+      });
 
   std::string plot_dir;
   CLI::App* plot_cmd = app.add_subcommand("plot", "PNG plots of the results in a folder (matplotlib)");
