@@ -101,19 +101,18 @@ PyProblem PyProblem::from_config(py::dict config) {
   PyProblem p;
   py::dict sections;
   std::map<std::string, py::function> callables;
+  auto section = [&](const std::string& name) -> py::dict {  // created on first use, shared handle
+    if (!sections.contains(name)) sections[py::str(name)] = py::dict();
+    return sections[py::str(name)];
+  };
   for (auto [k, v] : config) {
     const std::string key = py::str(k);
     if (key == "domain" || key == "geometry" || key == "formulation" || key == "data" || key == "solver" || key == "output") {
       if (!py::isinstance<py::dict>(v)) throw std::invalid_argument(key + ": expected a dict");
-      py::dict copy;
-      for (auto [kk, vv] : v.cast<py::dict>()) {
-        if (!sections.contains(key)) sections[py::str(key)] = py::dict();
-        sections[py::str(key)][kk] = vv;
-      }
-      if (!sections.contains(key)) sections[py::str(key)] = py::dict();
-    } else if (const char* section = section_of(key)) {
-      if (!sections.contains(section)) sections[section] = py::dict();
-      sections[section][py::str(key)] = v;
+      py::dict target = section(key);
+      for (auto [kk, vv] : v.cast<py::dict>()) target[kk] = vv;
+    } else if (const char* name = section_of(key)) {
+      section(name)[py::str(key)] = v;
     } else {
       throw std::invalid_argument(key + ": unknown keyword");
     }

@@ -228,7 +228,6 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
   p.g_along_curve = [g, center](double x, double y, double s) {
     return g({x, y, std::atan2(y - center.y, x - center.x), s});
   };
-  p.g = [g, center](double x, double y) { return g({x, y, std::atan2(y - center.y, x - center.x), 0.0}); };
   if (data.has("exact")) {
     const Expression exact(data.string("exact", ""), {"x", "y"}, "data.exact");
     p.exact = [exact](double x, double y) { return exact({x, y}); };
