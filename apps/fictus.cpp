@@ -33,6 +33,7 @@ struct SolveArguments {
   std::string variant = "smooth";
   std::string schur = "green";
   std::string start = "all";
+  std::string normal_derivative = "reconstructed";
   std::string out;
   std::vector<std::string> files;
 };
@@ -58,7 +59,10 @@ void add_solver_options(CLI::App& cmd, fictus::SolverOptions& o, SolveArguments&
   add(cmd.add_option("--offset", o.offset, "smooth variant: distance of Γ from γ in units of the spacing L/m"),
       [&](fictus::ProblemSpec& s) { s.options.offset = o.offset; });
   add(cmd.add_option("--rho", o.rho, "ρ > 0 of the projection"), [&](fictus::ProblemSpec& s) { s.options.rho = o.rho; });
-  add(cmd.add_option("--normal-shift", o.normal_shift, "C_γ is taken this many cells h inside ω"),
+  add(cmd.add_option("--normal-derivative", a.normal_derivative,
+                     "traces: reconstructed (consistent at x_i) or shifted (cell gradient normal_shift·h inside ω)"),
+      [&](fictus::ProblemSpec& s) { s.options.normal_derivative = fictus::parse_normal_derivative(a.normal_derivative); });
+  add(cmd.add_option("--normal-shift", o.normal_shift, "shifted rule: C_γ is taken this many cells h inside ω"),
       [&](fictus::ProblemSpec& s) { s.options.normal_shift = o.normal_shift; });
   add(cmd.add_option("--start", a.start, "Newton start: all (every point active) or zero (λ = 0)"),
       [&](fictus::ProblemSpec& s) { s.options.start_all_active = a.start == "all"; });
@@ -104,6 +108,7 @@ void print_summary(const fictus::Solution& s) {
 void resolve(fictus::SolverOptions& o, const SolveArguments& a) {
   o.variant = fictus::parse_variant(a.variant);
   o.inner = fictus::parse_inner_solver(a.schur);
+  o.normal_derivative = fictus::parse_normal_derivative(a.normal_derivative);
   if (a.start != "all" && a.start != "zero")
     throw std::invalid_argument("solver.start: expected \"all\" or \"zero\", got \"" + a.start + "\"");
   o.start_all_active = a.start == "all";
@@ -275,7 +280,10 @@ int main(int argc, char** argv) {
   reproduce_cmd->add_option("--threads", reproduce_options.threads, "threads")->capture_default_str();
   reproduce_cmd->add_option("--offset", reproduce_options.offset, "smooth variant: δ in units of L/m")
       ->capture_default_str();
-  reproduce_cmd->add_option("--normal-shift", reproduce_options.normal_shift, "C_γ shift in cells")->capture_default_str();
+  reproduce_cmd->add_option("--normal-derivative", reproduce_args.normal_derivative, "reconstructed or shifted")
+      ->capture_default_str();
+  reproduce_cmd->add_option("--normal-shift", reproduce_options.normal_shift, "shifted rule: C_γ shift in cells")
+      ->capture_default_str();
 
   fictus::SolverOptions sweep_options;
   SolveArguments sweep_solver_args;

@@ -15,6 +15,7 @@ json options_to_json(const SolverOptions& o) {
               {"multipliers", o.multipliers},
               {"offset", o.offset},
               {"rho", o.rho},
+              {"normal_derivative", to_string(o.normal_derivative)},
               {"normal_shift", o.normal_shift},
               {"start", o.start_all_active ? "all" : "zero"},
               {"schur", to_string(o.inner)},

@@ -30,7 +30,7 @@ const char* section_of(const std::string& key) {
   static const std::map<std::string, const char*> sections = {
       {"N", "domain"}, {"box", "domain"}, {"boundary", "domain"},
       {"variant", "formulation"}, {"multipliers", "formulation"}, {"offset", "formulation"}, {"rho", "formulation"},
-      {"normal_shift", "formulation"},
+      {"normal_derivative", "formulation"}, {"normal_shift", "formulation"},
       {"c", "data"}, {"f", "data"}, {"g", "data"}, {"exact", "data"},
       {"schur", "solver"}, {"krylov_tolerance", "solver"}, {"krylov_max_iterations", "solver"},
       {"newton_tolerance", "solver"}, {"max_newton", "solver"}, {"start", "solver"}, {"threads", "solver"},

@@ -59,6 +59,7 @@ py::dict options_dict(const SolverOptions& o) {
   d["multipliers"] = o.multipliers;
   d["offset"] = o.offset;
   d["rho"] = o.rho;
+  d["normal_derivative"] = to_string(o.normal_derivative);
   d["normal_shift"] = o.normal_shift;
   d["start"] = o.start_all_active ? "all" : "zero";
   d["schur"] = to_string(o.inner);

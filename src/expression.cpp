@@ -3,6 +3,8 @@
 #include <muParser.h>
 
 #include <atomic>
+#include <cctype>
+#include <deque>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -21,14 +23,44 @@ std::atomic<std::uint64_t> next_id{1};
 struct Compiled {
   mu::Parser parser;
   std::vector<double> values;
+  std::deque<double> locals;  // storage of the names assigned inside the expression ("a = …, a^2")
+  std::vector<std::string> local_names;
 };
+
+/// muParser's variable factory: an unknown name becomes a local of the expression.
+double* make_local(const char* name, void* data) {
+  auto* c = static_cast<Compiled*>(data);
+  c->local_names.emplace_back(name);
+  return &c->locals.emplace_back(0.0);
+}
 
 std::unique_ptr<Compiled> compile(const std::string& text, const std::vector<std::string>& variables) {
   auto c = std::make_unique<Compiled>();
   c->values.assign(variables.size(), 0.0);
   for (std::size_t k = 0; k < variables.size(); ++k) c->parser.DefineVar(variables[k], &c->values[k]);
+  c->parser.SetVarFactory(make_local, c.get());
   c->parser.SetExpr(text);
   return c;
+}
+
+bool is_name_char(char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; }
+
+/// A local must be assigned where it first appears ("a = …, … a …"); otherwise it is a misspelt
+/// or unknown variable. Returns the first offending name, or "".
+std::string unassigned_local(const std::string& text, const std::vector<std::string>& locals) {
+  for (const std::string& name : locals) {
+    std::size_t at = 0;
+    while ((at = text.find(name, at)) != std::string::npos) {
+      const bool starts = at == 0 || !is_name_char(text[at - 1]);
+      const std::size_t end = at + name.size();
+      if (starts && (end == text.size() || !is_name_char(text[end]))) break;
+      at = end;
+    }
+    std::size_t next = at == std::string::npos ? at : text.find_first_not_of(" \t\n", at + name.size());
+    const bool assigned = next != std::string::npos && text[next] == '=' && (next + 1 == text.size() || text[next + 1] != '=');
+    if (!assigned) return name;
+  }
+  return "";
 }
 
 }  // namespace
@@ -43,7 +75,11 @@ Expression::Expression(std::string text, std::vector<std::string> variables, std
     throw std::invalid_argument(shared->key + ": empty expression");
   try {
     auto c = compile(shared->text, shared->variables);
-    c->parser.Eval();  // reports syntax errors and unknown names
+    c->parser.Eval();  // reports syntax errors
+    const std::string unknown = unassigned_local(shared->text, c->local_names);
+    if (!unknown.empty())
+      throw std::invalid_argument(shared->key + ": cannot parse \"" + shared->text + "\": unknown variable \"" + unknown +
+                                  "\" (a local name must be assigned first: \"" + unknown + " = …, …\")");
   } catch (const mu::Parser::exception_type& e) {
     throw std::invalid_argument(shared->key + ": cannot parse \"" + shared->text + "\": " + e.GetMsg());
   }

@@ -13,6 +13,7 @@
 #include "fictus/schur_complement.hpp"
 #include "fictus/shapes.hpp"
 #include "fictus/green_table.hpp"
+#include "fictus/kink_correction.hpp"
 #include "fictus/load_vector.hpp"
 #include "fictus/trace_operators.hpp"
 
@@ -20,11 +21,19 @@ namespace fictus {
 
 const char* to_string(Variant v) { return v == Variant::smooth ? "smooth" : "nonsmooth"; }
 const char* to_string(InnerSolver s) { return s == InnerSolver::green ? "green" : "krylov"; }
+const char* to_string(NormalDerivative d) { return d == NormalDerivative::shifted ? "shifted" : "reconstructed"; }
 
 Variant parse_variant(const std::string& text) {
   if (text == "smooth") return Variant::smooth;
   if (text == "nonsmooth" || text == "non-smooth") return Variant::nonsmooth;
   throw std::invalid_argument("formulation.variant: expected \"smooth\" or \"nonsmooth\", got \"" + text + "\"");
+}
+
+NormalDerivative parse_normal_derivative(const std::string& text) {
+  if (text == "reconstructed") return NormalDerivative::reconstructed;
+  if (text == "shifted") return NormalDerivative::shifted;
+  throw std::invalid_argument("formulation.normal_derivative: expected \"reconstructed\" or \"shifted\", got \"" + text +
+                              "\"");
 }
 
 InnerSolver parse_inner_solver(const std::string& text) {
@@ -112,6 +121,8 @@ struct CurveSetup {
   double delta = 0;
   std::unique_ptr<CurveGridIntersection> gamma_geometry, offset_geometry;
   SparseRows B_gamma, C_gamma, B_Gamma;
+  SparseRows loads;      // rows carrying λ in the Schur complement: B_Γ, or B_Γ + R (kink correction)
+  DirectTerms direct;    // D_B, D_C of the kink correction (non-smooth variant, reconstructed traces)
   std::unique_ptr<SchurComplement> schur;
   Eigen::VectorXd b0, c0;
   std::optional<ConstantMode> mode;
@@ -120,7 +131,8 @@ struct CurveSetup {
   bool matches(const Problem& problem, const SolverOptions& o) const {
     const SolverOptions& s = options;
     return problem.gamma == gamma && o.variant == s.variant && o.multipliers == s.multipliers &&
-           o.offset == s.offset && o.normal_shift == s.normal_shift && o.inner == s.inner &&
+           o.offset == s.offset && o.normal_derivative == s.normal_derivative && o.normal_shift == s.normal_shift &&
+           o.inner == s.inner &&
            o.krylov_tolerance == s.krylov_tolerance && o.krylov_max_iterations == s.krylov_max_iterations;
   }
 };
@@ -211,6 +223,10 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
         throw std::invalid_argument("formulation.variant: the smooth variant needs a curve with a continuous normal "
                                     "(use \"nonsmooth\" for polygons)");
       setup->delta = options.offset * spacing;
+      // The biquadratic stencil of C_γ reaches 1.5·√2·h from x_i; it must stay clear of Γ's kink.
+      if (options.normal_derivative == NormalDerivative::reconstructed && setup->delta < 3 * h)
+        throw std::invalid_argument("formulation.offset: Γ at δ = offset·L/m = " + std::to_string(setup->delta / h) +
+                                    " h is within reach of the C_γ stencil (need δ >= 3h: a larger offset or a smaller m)");
       setup->Gamma = std::make_shared<OffsetCurve>(problem.gamma, setup->delta);
       check_simple(*setup->Gamma, "formulation.offset");
       check_inside_box(*setup->Gamma, grid.box(), 2 * h, "formulation.offset");
@@ -220,8 +236,21 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
     }
     const Collocation& points = setup->collocation;
     setup->B_gamma = point_value_rows(grid, points.point);
-    setup->C_gamma = normal_derivative_rows(grid, points.point, points.normal, options.normal_shift * h);
     setup->B_Gamma = arc_integral_rows(setup->Gamma_geometry(), points.arc_begin, points.arc_end);
+    if (options.normal_derivative == NormalDerivative::shifted) {
+      setup->C_gamma = normal_derivative_rows(grid, points.point, points.normal, options.normal_shift * h);
+      setup->loads = setup->B_Gamma;
+    } else {
+      setup->C_gamma = normal_derivative_rows_centered(grid, points.point, points.normal, 2);
+      if (options.variant == Variant::nonsmooth) {
+        KinkCorrection kink = kink_correction(*setup->gamma_geometry, points, setup->B_gamma, setup->C_gamma,
+                                              st.problem.c, st.threads);
+        setup->loads = add_rows(setup->B_Gamma, kink.galerkin);
+        setup->direct = std::move(kink.direct);
+      } else {
+        setup->loads = setup->B_Gamma;
+      }
+    }
     std::vector<double> b0, c0;
     setup->B_gamma.multiply(st.u0, b0);
     setup->C_gamma.multiply(st.u0, c0);
@@ -237,14 +266,16 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
         st.green = std::make_unique<GreenTable>(grid, st.problem.c, st.threads);
         clock.mark("green_table");
       }
-      setup->schur = std::make_unique<ExplicitSchur>(*st.green, setup->B_gamma, setup->C_gamma, setup->B_Gamma, st.threads);
+      setup->schur = std::make_unique<ExplicitSchur>(*st.green, setup->B_gamma, setup->C_gamma, setup->loads, st.threads,
+                                                     setup->direct);
       clock.mark("schur");
     } else {
       GmresOptions gmres_options;
       gmres_options.relative_tolerance = options.krylov_tolerance;
       gmres_options.max_iterations = options.krylov_max_iterations;
       gmres_options.restart = m + 1;
-      setup->schur = std::make_unique<ImplicitSchur>(*st.fast, setup->B_gamma, setup->C_gamma, setup->B_Gamma, gmres_options);
+      setup->schur = std::make_unique<ImplicitSchur>(*st.fast, setup->B_gamma, setup->C_gamma, setup->loads, gmres_options,
+                                                     setup->direct);
     }
     setup->options = requested;  // as asked (m = 0 stays 0), so the next request compares equal
     st.setup = std::move(setup);
@@ -293,8 +324,13 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
     ++fast_solves;
     for (std::size_t k = 0; k < u.size(); ++k) u[k] += st.u0[k] + sol.alpha;
     sol.u = std::move(u);
-    setup.B_gamma.multiply(sol.u, sol.trace);
-    setup.C_gamma.multiply(sol.u, sol.normal_derivative);
+    if (setup.direct.empty()) {
+      setup.B_gamma.multiply(sol.u, sol.trace);
+      setup.C_gamma.multiply(sol.u, sol.normal_derivative);
+    } else {  // traces of the kink-corrected field: those of the Newton solution
+      sol.trace.assign(sol.newton.trace.data(), sol.newton.trace.data() + m);
+      sol.normal_derivative.assign(sol.newton.normal_derivative.data(), sol.newton.normal_derivative.data() + m);
+    }
     clock.mark("final_solve");
   } else {
     sol.trace.assign(sol.newton.trace.data(), sol.newton.trace.data() + m);

@@ -215,6 +215,7 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
   o.multipliers = formulation.integer("multipliers", 0);
   o.offset = formulation.number("offset", o.offset);
   o.rho = formulation.number("rho", o.rho);
+  o.normal_derivative = parse_normal_derivative(formulation.string("normal_derivative", to_string(o.normal_derivative)));
   o.normal_shift = formulation.number("normal_shift", o.normal_shift);
   formulation.finish();
 

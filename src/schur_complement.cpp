@@ -1,13 +1,14 @@
 #include "fictus/schur_complement.hpp"
 
 #include <algorithm>
+#include <utility>
 
 namespace fictus {
 
 ImplicitSchur::ImplicitSchur(const FastSolver& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
-                             const SparseRows& B_Gamma, const GmresOptions& options)
-    : solver_(solver), B_gamma_(B_gamma), C_gamma_(C_gamma), B_Gamma_(B_Gamma), options_(options),
-      work_(solver.grid().n_unknowns()) {}
+                             const SparseRows& loads, const GmresOptions& options, DirectTerms direct)
+    : solver_(solver), B_gamma_(B_gamma), C_gamma_(C_gamma), B_Gamma_(loads), options_(options),
+      direct_(std::move(direct)), work_(solver.grid().n_unknowns()) {}
 
 void ImplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const {
   lambda_.assign(lambda.data(), lambda.data() + lambda.size());
@@ -19,6 +20,10 @@ void ImplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Ei
   sb = Eigen::Map<const Eigen::VectorXd>(rows_.data(), Eigen::Index(rows_.size()));
   C_gamma_.multiply(work_, rows_);
   sc = Eigen::Map<const Eigen::VectorXd>(rows_.data(), Eigen::Index(rows_.size()));
+  if (!direct_.empty()) {
+    sb += direct_.trace * lambda;
+    sc += direct_.normal_derivative * lambda;
+  }
 }
 
 LinearSolveReport ImplicitSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
@@ -67,8 +72,13 @@ Eigen::MatrixXd green_block(const GreenTable& green, const SparseRows& R, const 
 }
 
 ExplicitSchur::ExplicitSchur(const GreenTable& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
-                             const SparseRows& B_Gamma, int threads)
-    : S_B_(green_block(green, B_gamma, B_Gamma, threads)), S_C_(green_block(green, C_gamma, B_Gamma, threads)) {}
+                             const SparseRows& loads, int threads, const DirectTerms& direct)
+    : S_B_(green_block(green, B_gamma, loads, threads)), S_C_(green_block(green, C_gamma, loads, threads)) {
+  if (!direct.empty()) {
+    S_B_ += Eigen::MatrixXd(direct.trace);
+    S_C_ += Eigen::MatrixXd(direct.normal_derivative);
+  }
+}
 
 void ExplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const {
   sb = S_B_ * lambda;

@@ -1,8 +1,12 @@
 #include "fictus/trace_operators.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <numbers>
 #include <stdexcept>
+
+#include <Eigen/Dense>
 
 #include "fictus/quadrature.hpp"
 
@@ -31,6 +35,11 @@ class RowBuilder {
     add(ix + 1, iy, w * xi * (1 - eta));
     add(ix, iy + 1, w * (1 - xi) * eta);
     add(ix + 1, iy + 1, w * xi * eta);
+  }
+  /// w times the entries of row r of `other` (built on the same grid).
+  void add_row(const SparseRows& other, int r, double w) {
+    for (std::size_t k = other.row_begin[r]; k < other.row_begin[r + 1]; ++k)
+      add(other.entries[k].i, other.entries[k].j, w * other.entries[k].value);
   }
   void end_row() { rows_.row_begin.push_back(rows_.entries.size()); }
 
@@ -78,6 +87,112 @@ SparseRows normal_derivative_rows(const Grid& grid, const std::vector<Point>& po
     builder.add(ix + 1, iy, (n.x * (1 - eta) - n.y * xi) / h);
     builder.add(ix, iy + 1, (-n.x * eta + n.y * (1 - xi)) / h);
     builder.add(ix + 1, iy + 1, (n.x * eta + n.y * xi) / h);
+    builder.end_row();
+  }
+  return rows;
+}
+
+namespace {
+
+/// Values and derivatives at ξ of the 1-D Lagrange basis on the nodes first, first + 1, …, first + p.
+struct LagrangeBasis {
+  std::array<double, 4> value{}, derivative{};
+};
+
+LagrangeBasis lagrange_basis(int first, int p, double xi) {
+  LagrangeBasis b;
+  for (int a = 0; a <= p; ++a) {
+    const double xa = first + a;
+    double value = 1.0, derivative = 0.0;
+    for (int c = 0; c <= p; ++c) {
+      if (c == a) continue;
+      const double xc = first + c;
+      derivative = derivative * (xi - xc) / (xa - xc) + value / (xa - xc);
+      value *= (xi - xc) / (xa - xc);
+    }
+    b.value[a] = value;
+    b.derivative[a] = derivative;
+  }
+  return b;
+}
+
+}  // namespace
+
+SparseRows normal_derivative_rows_centered(const Grid& grid, const std::vector<Point>& points,
+                                           const std::vector<Point>& normals, int degree) {
+  if (points.size() != normals.size()) throw std::invalid_argument("normal_derivative_rows: size mismatch");
+  if (degree < 1 || degree > 3) throw std::invalid_argument("normal_derivative_rows_centered: degree must be 1, 2 or 3");
+  SparseRows rows;
+  RowBuilder builder(grid, rows);
+  const double h = grid.h();
+  for (std::size_t r = 0; r < points.size(); ++r) {
+    const Point p = points[r], n = normals[r];
+    // Local coordinates in cells from the lower-left node of the cell of p; the stencil's first
+    // node: the cell itself (p = 1), the nearest node − 1 (p = 2), the cell's node − 1 (p = 3).
+    const int ix = grid.cell_x(p.x), iy = grid.cell_y(p.y);
+    const double xi = (p.x - grid.x(ix)) / h, eta = (p.y - grid.y(iy)) / h;
+    auto first = [&](double t) { return degree == 2 ? (t < 0.5 ? -1 : 0) : (degree == 3 ? -1 : 0); };
+    const int fx = first(xi), fy = first(eta);
+    const LagrangeBasis bx = lagrange_basis(fx, degree, xi), by = lagrange_basis(fy, degree, eta);
+    for (int b = 0; b <= degree; ++b)
+      for (int a = 0; a <= degree; ++a)
+        builder.add(ix + fx + a, iy + fy + b,
+                    (n.x * bx.derivative[a] * by.value[b] + n.y * bx.value[a] * by.derivative[b]) / h);
+    builder.end_row();
+  }
+  return rows;
+}
+
+SparseRows one_sided_rows(const CurveGridIntersection& gamma, const std::vector<Point>& points,
+                          const std::vector<Point>& normals, OneSidedTrace trace, int degree, double radius) {
+  if (points.size() != normals.size()) throw std::invalid_argument("one_sided_rows: size mismatch");
+  if (degree < 1 || degree > 2) throw std::invalid_argument("one_sided_rows: degree must be 1 or 2");
+  const Grid& grid = gamma.grid();
+  const double h = grid.h();
+  const int n_terms = degree == 1 ? 3 : 6;  // 1, ξ, η (+ ξ²/2, ξη, η²/2), ξ = (x − x_i)/h
+  SparseRows rows;
+  RowBuilder builder(grid, rows);
+  std::vector<std::array<int, 2>> nodes;
+  std::vector<double> dx, dy, w;
+  Eigen::MatrixXd M;
+  Eigen::VectorXd W;
+  for (std::size_t r = 0; r < points.size(); ++r) {
+    const Point p = points[r], n = normals[r];
+    // Nodes of ω in a disc around x_i; the disc grows by ½ cell until the fit is well posed.
+    for (double R = radius;; R += 0.5) {
+      if (R > radius + 8) throw std::runtime_error("one_sided_rows: too few nodes of ω near a collocation point");
+      nodes.clear(), dx.clear(), dy.clear(), w.clear();
+      const double cx = (p.x - grid.box().x0) / h, cy = (p.y - grid.box().y0) / h;
+      for (int j = std::max(int(std::floor(cy - R)), 0); j <= std::min(int(std::ceil(cy + R)), grid.ny()); ++j)
+        for (int i = std::max(int(std::floor(cx - R)), 0); i <= std::min(int(std::ceil(cx + R)), grid.nx()); ++i) {
+          const double ex = (grid.x(i) - p.x) / h, ey = (grid.y(j) - p.y) / h;
+          const double d2 = ex * ex + ey * ey;
+          if (d2 > R * R || !gamma.node_inside(i, j)) continue;
+          nodes.push_back({i, j});
+          dx.push_back(ex), dy.push_back(ey);
+          const double q = 1.0 - d2 / (R * R);
+          w.push_back(std::sqrt(q * q + 1e-3));  // square root of the weight
+        }
+      const int K = int(nodes.size());
+      if (K < 2 * n_terms) continue;
+      M.resize(K, n_terms);
+      W.resize(K);
+      for (int k = 0; k < K; ++k) {
+        M(k, 0) = w[k], M(k, 1) = w[k] * dx[k], M(k, 2) = w[k] * dy[k];
+        if (degree == 2)
+          M(k, 3) = w[k] * 0.5 * dx[k] * dx[k], M(k, 4) = w[k] * dx[k] * dy[k], M(k, 5) = w[k] * 0.5 * dy[k] * dy[k];
+        W(k) = w[k];
+      }
+      const Eigen::JacobiSVD<Eigen::MatrixXd> svd(M);
+      const auto& sv = svd.singularValues();
+      if (sv(n_terms - 1) > 1e-3 * sv(0)) break;
+    }
+    // Coefficients of the fit as linear functionals of the nodal values: (WM)⁺W.
+    const Eigen::MatrixXd coefficients = M.completeOrthogonalDecomposition().pseudoInverse() * W.asDiagonal();
+    for (int k = 0; k < int(nodes.size()); ++k)
+      builder.add(nodes[k][0], nodes[k][1],
+                  trace == OneSidedTrace::value ? coefficients(0, k)
+                                                : (n.x * coefficients(1, k) + n.y * coefficients(2, k)) / h);
     builder.end_row();
   }
   return rows;

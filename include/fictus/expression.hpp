@@ -1,7 +1,9 @@
 #pragma once
 // User expressions (muParser syntax: + - * / ^, sin, cos, exp, sqrt, abs, min, max, a ? b : c, _pi …)
-// in named variables, e.g. "x^2 + sin(y)" in (x, y). Parsed and checked once at construction;
-// evaluation is thread-safe (one compiled parser per thread, made on first use).
+// in named variables, e.g. "x^2 + sin(y)" in (x, y). Comma-separated parts may name intermediate
+// values, and the last part is the value: "r2 = (x - 0.5)^2 + y^2, exp(-r2) * r2" (a local must be
+// assigned where it first appears). Parsed and checked once at construction; evaluation is
+// thread-safe (one compiled parser per thread, made on first use).
 #include <cstdint>
 #include <initializer_list>
 #include <memory>

@@ -29,18 +29,26 @@ struct Problem {
 
 enum class Variant { nonsmooth, smooth };
 enum class InnerSolver { green, krylov };
+/// How the traces B_γ u and C_γ u are taken (docs/math.md, "Trace matrices"):
+///   reconstructed  consistent at x_i: smooth variant, the gradient of the biquadratic interpolant
+///                  (O(h²)); non-smooth variant, the traces of the kink-corrected field;
+///   shifted        C_γ = the cell gradient at x_i − normal_shift·h·n_i (first order at best).
+enum class NormalDerivative { reconstructed, shifted };
 
 const char* to_string(Variant v);
 const char* to_string(InnerSolver s);
+const char* to_string(NormalDerivative d);
 Variant parse_variant(const std::string& text);          // throws naming "formulation.variant"
 InnerSolver parse_inner_solver(const std::string& text);  // throws naming "solver.schur"
+NormalDerivative parse_normal_derivative(const std::string& text);  // throws naming "formulation.normal_derivative"
 
 struct SolverOptions {
   Variant variant = Variant::smooth;
   int multipliers = 0;            // m; 0: default_multipliers()
-  double offset = 1.0;            // smooth variant: δ = offset · s, s = L/m (spacing of the points)
+  double offset = 1.5;            // smooth variant: δ = offset · s, s = L/m (spacing of the points)
   double rho = 1.0;               // ρ > 0
-  double normal_shift = 1.0;      // C_γ taken at x_i − normal_shift·h·n_i
+  NormalDerivative normal_derivative = NormalDerivative::reconstructed;
+  double normal_shift = 1.0;      // shifted rule only: C_γ taken at x_i − normal_shift·h·n_i
   bool start_all_active = true;   // Newton start: all points active, else λ = 0
   InnerSolver inner = InnerSolver::green;
   double krylov_tolerance = 1e-10;  // relative GMRES residual

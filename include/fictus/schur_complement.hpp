@@ -1,6 +1,9 @@
 #pragma once
 // The Schur complement of the discrete problem (3) with respect to λ:
 //   u(λ) = u₀ + A⁻¹ B_Γᵀ λ,   S_B = B_γ A⁻¹ B_Γᵀ,   S_C = C_γ A⁻¹ B_Γᵀ   (m × m).
+// In the non-smooth variant the traces are those of the kink-corrected field (kink_correction.hpp):
+// the load rows are B_Γ + R and sparse terms D_B, D_C act on λ directly:
+//   S_B = B_γ A⁻¹ (B_Γ + R)ᵀ + D_B,   S_C = C_γ A⁻¹ (B_Γ + R)ᵀ + D_C.
 // The Newton matrix for an active set 𝒜 takes row i of S_B if i ∈ 𝒜 and row i of S_C otherwise.
 // Two implementations behind one interface:
 //   ImplicitSchur  the paper's: never formed, one fast A⁻¹ per application, GMRES per step;
@@ -10,6 +13,7 @@
 #include <vector>
 
 #include <Eigen/Dense>
+#include <Eigen/Sparse>
 
 #include "fictus/fast_solver.hpp"
 #include "fictus/gmres.hpp"
@@ -28,6 +32,12 @@ struct ConstantMode {
   Eigen::VectorXd trace_B, trace_C;  // B_γ·1, C_γ·1
   Eigen::VectorXd arc_weights;       // ℓ = B_Γ·1
   double load_total = 0.0;           // F = 1ᵀf
+};
+
+/// Trace terms that act on λ directly (m × m; empty matrices: none).
+struct DirectTerms {
+  Eigen::SparseMatrix<double> trace, normal_derivative;  // D_B, D_C
+  bool empty() const { return trace.nonZeros() == 0 && normal_derivative.nonZeros() == 0; }
 };
 
 struct LinearSolveReport {
@@ -54,8 +64,9 @@ class SchurComplement {
 
 class ImplicitSchur final : public SchurComplement {
  public:
+  /// `loads`: the rows whose transposes carry λ into the grid (B_Γ, or B_Γ + R).
   ImplicitSchur(const FastSolver& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
-                const SparseRows& B_Gamma, const GmresOptions& options);
+                const SparseRows& loads, const GmresOptions& options, DirectTerms direct = {});
   int size() const override { return B_Gamma_.n_rows(); }
   void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override;
   LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
@@ -67,6 +78,7 @@ class ImplicitSchur final : public SchurComplement {
   const FastSolver& solver_;
   const SparseRows &B_gamma_, &C_gamma_, &B_Gamma_;
   GmresOptions options_;
+  DirectTerms direct_;
   mutable GridVector work_;
   mutable std::vector<double> lambda_, rows_;
   mutable std::size_t fast_solves_ = 0;
@@ -74,9 +86,9 @@ class ImplicitSchur final : public SchurComplement {
 
 class ExplicitSchur final : public SchurComplement {
  public:
-  /// Assembles S_B and S_C from the Green's table (threaded over columns).
+  /// Assembles S_B and S_C from the Green's table (threaded over columns); `loads` as above.
   ExplicitSchur(const GreenTable& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
-                const SparseRows& B_Gamma, int threads = 1);
+                const SparseRows& loads, int threads = 1, const DirectTerms& direct = {});
   /// From given blocks (tests).
   ExplicitSchur(Eigen::MatrixXd S_B, Eigen::MatrixXd S_C) : S_B_(std::move(S_B)), S_C_(std::move(S_C)) {}
   int size() const override { return int(S_B_.rows()); }

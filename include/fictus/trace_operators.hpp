@@ -35,6 +35,21 @@ SparseRows point_value_rows(const Grid& grid, const std::vector<Point>& points);
 SparseRows normal_derivative_rows(const Grid& grid, const std::vector<Point>& points,
                                   const std::vector<Point>& normals, double shift);
 
+/// C_γ centered: row i = n_i·∇(I u)(x_i), I the tensor-product Lagrange interpolant of `degree` p on
+/// (p+1)² nodes around x_i: p = 1 the cell of x_i (bilinear), p = 2 the 3×3 nodes around the
+/// nearest node (biquadratic, ∂u/∂n to O(h²)), p = 3 the 4×4 nodes around the cell (bicubic, O(h³)).
+SparseRows normal_derivative_rows_centered(const Grid& grid, const std::vector<Point>& points,
+                                           const std::vector<Point>& normals, int degree = 2);
+
+/// One-sided traces from the nodes of ω only: row i = p(x_i) (value) or n_i·∇p(x_i) (normal
+/// derivative), p the weighted least-squares polynomial of `degree` (1 or 2) through u at the nodes
+/// of ω within `radius` cells of x_i (weights (1 − d²/R²)², the disc grows by ½ cell until the fit is
+/// well posed). For a û kinked on γ: no node outside ω enters. Orders for smooth u: value h^(p+1),
+/// derivative h^p.
+enum class OneSidedTrace { value, normal_derivative };
+SparseRows one_sided_rows(const CurveGridIntersection& gamma, const std::vector<Point>& points,
+                          const std::vector<Point>& normals, OneSidedTrace trace, int degree = 2, double radius = 2.5);
+
 /// One row per arc [arc_begin[r], arc_end[r]] of the curve of `geometry` (q Gauss points on every
 /// piece of the arc inside one cell).
 SparseRows arc_integral_rows(const CurveGridIntersection& geometry, const std::vector<double>& arc_begin,

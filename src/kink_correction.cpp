@@ -1,0 +1,237 @@
+#include "fictus/kink_correction.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <tuple>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "fictus/quadrature.hpp"
+
+namespace fictus {
+
+namespace {
+
+constexpr double two_pi = 2.0 * std::numbers::pi;
+
+/// The point of the curve nearest to x (Newton on (p(t) − x)·p′(t) = 0 from t0, a few steps:
+/// x is within a cell or two of the curve) and the kink function q(d)⁺ there.
+struct Kink {
+  double t = 0.0;      // parameter of the nearest point, in [0, 2π)
+  double d = 0.0;      // signed distance, > 0 outside ω
+  double kappa = 0.0;  // curvature there
+  Point normal;        // outward unit normal there
+  double q() const { return d - 0.5 * kappa * d * d; }                // ψ outside ω, extended smoothly inside
+  double psi() const { return d > 0 ? q() : 0.0; }                    // q(d)⁺
+  Point grad_q() const { return (1.0 - kappa * d) * normal; }          // ∇q (d small)
+};
+
+Kink project(const Curve& curve, Point x, double t) {
+  for (int it = 0; it < 12; ++it) {
+    const Point p = curve.position(t), d1 = curve.derivative(t), d2 = curve.second_derivative(t);
+    const Point r = p - x;
+    const double f = dot(r, d1), df = dot(d1, d1) + dot(r, d2);
+    const double step = df > 0 ? f / df : f / dot(d1, d1);
+    t -= step;
+    if (std::abs(step) < 1e-14 * two_pi) break;
+  }
+  t = std::fmod(t, two_pi);
+  if (t < 0) t += two_pi;
+  Kink k;
+  k.t = t;
+  k.normal = curve.outward_normal(t);
+  k.d = dot(x - curve.position(t), k.normal);
+  k.kappa = curve.curvature(t);
+  return k;
+}
+
+/// Arc of a curve parameter: arc i covers [arc_begin[i], arc_end[i]) (the last one may wrap past 0).
+class ArcIndex {
+ public:
+  explicit ArcIndex(const Collocation& arcs) {
+    for (int i = 0; i < arcs.m; ++i) begins_.emplace_back(arcs.arc_begin[i], i);
+    std::sort(begins_.begin(), begins_.end());
+  }
+  int operator()(double t) const {
+    auto it = std::upper_bound(begins_.begin(), begins_.end(), std::make_pair(t, 1 << 30));
+    return it == begins_.begin() ? begins_.back().second : std::prev(it)->second;
+  }
+
+ private:
+  std::vector<std::pair<double, int>> begins_;
+};
+
+/// Kink values at grid nodes, computed once per node.
+class NodeKinks {
+ public:
+  NodeKinks(const Curve& curve, const Grid& grid) : curve_(curve), grid_(grid) {}
+  std::size_t key(int i, int j) const { return std::size_t(j + 2) * std::size_t(grid_.nx() + 5) + std::size_t(i + 2); }
+  /// Registers node (i, j) with a starting parameter; returns true if it is new.
+  bool add(int i, int j, double t0) { return start_.emplace(key(i, j), t0).second; }
+  void compute(int threads) {
+    std::vector<std::pair<std::size_t, double>> todo(start_.begin(), start_.end());
+    std::vector<Kink> values(todo.size());
+    const std::size_t width = std::size_t(grid_.nx() + 5);
+#pragma omp parallel for num_threads(threads < 1 ? 1 : threads) schedule(static)
+    for (std::size_t n = 0; n < todo.size(); ++n) {
+      const int i = int(todo[n].first % width) - 2, j = int(todo[n].first / width) - 2;
+      values[n] = project(curve_, {grid_.x(i), grid_.y(j)}, todo[n].second);
+    }
+    for (std::size_t n = 0; n < todo.size(); ++n) kinks_[todo[n].first] = values[n];
+  }
+  const Kink& at(int i, int j, double t0) {
+    auto it = kinks_.find(key(i, j));
+    if (it == kinks_.end()) it = kinks_.emplace(key(i, j), project(curve_, {grid_.x(i), grid_.y(j)}, t0)).first;
+    return it->second;
+  }
+  const Kink& at(int i, int j) const { return kinks_.at(key(i, j)); }
+
+ private:
+  const Curve& curve_;
+  const Grid& grid_;
+  std::unordered_map<std::size_t, double> start_;
+  std::unordered_map<std::size_t, Kink> kinks_;
+};
+
+/// Q1 on a square cell, local nodes (0,0), (1,0), (0,1), (1,1): value and gradient at (ξ, η).
+struct Q1Basis {
+  double value[4];
+  Point gradient[4];
+  Q1Basis(double xi, double eta, double h) {
+    for (int k = 0; k < 4; ++k) {
+      const int a = k & 1, b = k >> 1;
+      const double fx = a ? xi : 1 - xi, fy = b ? eta : 1 - eta;
+      value[k] = fx * fy;
+      gradient[k] = {(a ? 1.0 : -1.0) * fy / h, (b ? 1.0 : -1.0) * fx / h};
+    }
+  }
+};
+
+struct RowEntry {
+  int arc, i, j;
+  double value;
+};
+
+}  // namespace
+
+SparseRows add_rows(const SparseRows& a, const SparseRows& b) {
+  SparseRows out;
+  for (int r = 0; r < a.n_rows(); ++r) {
+    std::vector<SparseRows::Entry> row(a.entries.begin() + std::ptrdiff_t(a.row_begin[r]),
+                                       a.entries.begin() + std::ptrdiff_t(a.row_begin[r + 1]));
+    for (std::size_t k = b.row_begin[r]; k < b.row_begin[r + 1]; ++k) {
+      const auto& e = b.entries[k];
+      auto same = std::find_if(row.begin(), row.end(), [&](const SparseRows::Entry& x) { return x.index == e.index; });
+      if (same != row.end()) same->value += e.value;
+      else row.push_back(e);
+    }
+    out.entries.insert(out.entries.end(), row.begin(), row.end());
+    out.row_begin.push_back(out.entries.size());
+  }
+  return out;
+}
+
+KinkCorrection kink_correction(const CurveGridIntersection& gamma, const Collocation& arcs, const SparseRows& B_gamma,
+                               const SparseRows& C_gamma, double c, int threads) {
+  const Grid& grid = gamma.grid();
+  const Curve& curve = gamma.curve();
+  const double h = grid.h();
+  const int m = arcs.m;
+  const ArcIndex arc_of(arcs);
+  const auto& cells = gamma.cut_cells();
+  auto cell_parameter = [&](const CutCell& cell) {
+    const CurvePiece& piece = gamma.pieces()[cell.pieces.front()];
+    return 0.5 * (piece.t0 + piece.t1);
+  };
+
+  // 1. Kink values at the nodes of the cut cells.
+  NodeKinks nodes(curve, grid);
+  for (const CutCell& cell : cells)
+    for (int k = 0; k < 4; ++k) nodes.add(cell.ix + (k & 1), cell.iy + (k >> 1), cell_parameter(cell));
+  nodes.compute(threads);
+
+  // 2. r_j,k = a(ψ_j − I_hψ_j, φ_k) on every cut cell: the part outside ω is the whole cell minus
+  //    its part in ω (ψ_j's smooth extension q(d) on both), and I_hψ_j takes the element matrix.
+  //    Each quadrature point goes to the arc its nearest curve point lies on.
+  const GaussRule& rule = gauss_legendre(4);
+  constexpr int cut_q = 3;
+  // Element matrix of −Δ + c on a square Q1 cell (local nodes as in Q1Basis).
+  const double K[4][4] = {{4, -1, -1, -2}, {-1, 4, -2, -1}, {-1, -2, 4, -1}, {-2, -1, -1, 4}};
+  const double M[4][4] = {{4, 2, 2, 1}, {2, 4, 1, 2}, {2, 1, 4, 2}, {1, 2, 2, 4}};
+  std::vector<RowEntry> entries;
+#pragma omp parallel num_threads(threads < 1 ? 1 : threads)
+  {
+    std::vector<RowEntry> local;
+    std::vector<QuadraturePoint> inside;
+#pragma omp for schedule(dynamic, 16)
+    for (std::size_t n = 0; n < cells.size(); ++n) {
+      const CutCell& cell = cells[n];
+      const double t0 = cell_parameter(cell), x0 = grid.x(cell.ix), y0 = grid.y(cell.iy);
+      auto add_point = [&](double x, double y, double w) {
+        const Kink kink = project(curve, {x, y}, t0);
+        const Q1Basis basis((x - x0) / h, (y - y0) / h, h);
+        const int arc = arc_of(kink.t);
+        const double q = kink.q();
+        const Point grad = kink.grad_q();
+        for (int k = 0; k < 4; ++k)
+          local.push_back({arc, cell.ix + (k & 1), cell.iy + (k >> 1),
+                           w * (dot(grad, basis.gradient[k]) + c * q * basis.value[k])});
+      };
+      for (std::size_t b = 0; b < rule.nodes.size(); ++b)
+        for (std::size_t a = 0; a < rule.nodes.size(); ++a)
+          add_point(x0 + rule.nodes[a] * h, y0 + rule.nodes[b] * h, rule.weights[a] * rule.weights[b] * h * h);
+      inside.clear();
+      gamma.cut_cell_rule(cell, cut_q, inside);
+      for (const QuadraturePoint& p : inside) add_point(p.x, p.y, -p.weight);
+      for (int l = 0; l < 4; ++l) {
+        const Kink& kink = nodes.at(cell.ix + (l & 1), cell.iy + (l >> 1));
+        const double psi = kink.psi();
+        if (psi == 0.0) continue;
+        const int arc = arc_of(kink.t);
+        for (int k = 0; k < 4; ++k)
+          local.push_back({arc, cell.ix + (k & 1), cell.iy + (k >> 1), -psi * (K[l][k] / 6.0 + c * h * h * M[l][k] / 36.0)});
+      }
+    }
+#pragma omp critical
+    entries.insert(entries.end(), local.begin(), local.end());
+  }
+
+  // Rows r_j: entries merged per (arc, node), boundary nodes of the box dropped.
+  std::sort(entries.begin(), entries.end(), [&](const RowEntry& a, const RowEntry& b) {
+    return std::tie(a.arc, a.j, a.i) < std::tie(b.arc, b.j, b.i);
+  });
+  KinkCorrection out;
+  SparseRows& rows = out.galerkin;
+  std::size_t e = 0;
+  for (int arc = 0; arc < m; ++arc) {
+    for (; e < entries.size() && entries[e].arc == arc;) {
+      const RowEntry first = entries[e];
+      double value = 0.0;
+      for (; e < entries.size() && entries[e].arc == arc && entries[e].i == first.i && entries[e].j == first.j; ++e)
+        value += entries[e].value;
+      if (grid.has_unknown(first.i, first.j)) rows.entries.push_back({grid.index(first.i, first.j), first.i, first.j, value});
+    }
+    rows.row_begin.push_back(rows.entries.size());
+  }
+
+  // 3. D = Σ_k R_ik ψ_j(x_k) for the trace rows (nodes projected from the point's parameter).
+  auto direct = [&](const SparseRows& R) {
+    std::vector<Eigen::Triplet<double>> triplets;
+    for (int r = 0; r < R.n_rows(); ++r)
+      for (std::size_t k = R.row_begin[r]; k < R.row_begin[r + 1]; ++k) {
+        const auto& entry = R.entries[k];
+        const Kink& kink = nodes.at(entry.i, entry.j, arcs.t[r]);
+        if (kink.psi() != 0.0) triplets.emplace_back(r, arc_of(kink.t), entry.value * kink.psi());
+      }
+    Eigen::SparseMatrix<double> D(m, m);
+    D.setFromTriplets(triplets.begin(), triplets.end());
+    return D;
+  };
+  out.direct.trace = direct(B_gamma);
+  out.direct.normal_derivative = direct(C_gamma);
+  return out;
+}
+
+}  // namespace fictus
