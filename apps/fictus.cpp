@@ -96,6 +96,11 @@ void print_summary(const fictus::Solution& s) {
   if (s.condition_number) std::printf("condition number of the Newton matrix: %.3e\n", *s.condition_number);
   std::printf("Signorini checks: min gap %.2e, min du/dn %.2e, max |complementarity| %.2e\n", s.signorini.min_gap,
               s.signorini.min_normal_derivative, s.signorini.max_complementarity);
+  if (s.check)
+    std::printf("  with an independent du/dn (%s): min du/dn %.2e, max |complementarity| %.2e, "
+                "max |difference| %.2e\n",
+                s.check->rule.c_str(), s.check->min_normal_derivative, s.check->max_complementarity,
+                s.check->max_difference);
   if (s.errors)
     std::printf("relative errors: L2(omega) %.3e, H1(omega) %.3e (semi %.3e), L2(gamma) %.3e\n", s.errors->rel_l2_omega,
                 s.errors->rel_h1_omega, s.errors->rel_h1semi_omega, s.errors->rel_l2_gamma);
@@ -269,7 +274,7 @@ int main(int argc, char** argv) {
   CLI::App* plot_cmd = app.add_subcommand("plot", "PNG plots of the results in a folder (matplotlib)");
   plot_cmd->add_option("dir", plot_dir, "folder written by solve or reproduce")->required();
 
-  fictus::SolverOptions reproduce_options;
+  fictus::SolverOptions reproduce_options = fictus::paper_options(128, fictus::Variant::smooth);  // the paper's δ = L/m
   SolveArguments reproduce_args;
   std::string table = "both", levels = "7-12";
   CLI::App* reproduce_cmd = app.add_subcommand("reproduce", "reproduce the paper's Table 1 and/or Table 2");

@@ -63,12 +63,22 @@ json solution_to_json(const Problem& problem, const Solution& s) {
   j["signorini"] = {{"min_gap", s.signorini.min_gap},
                     {"min_normal_derivative", s.signorini.min_normal_derivative},
                     {"max_complementarity", s.signorini.max_complementarity}};
+  if (s.check)
+    j["signorini"]["check"] = {{"rule", s.check->rule},
+                               {"min_normal_derivative", s.check->min_normal_derivative},
+                               {"max_complementarity", s.check->max_complementarity},
+                               {"max_difference", s.check->max_difference},
+                               {"rms_difference", s.check->rms_difference}};
   if (s.errors) {
     const ErrorNorms& e = *s.errors;
     j["errors"] = {{"l2_omega", e.l2_omega},         {"h1_omega", e.h1_omega},
                    {"h1semi_omega", e.h1semi_omega}, {"l2_gamma", e.l2_gamma},
                    {"rel_l2_omega", e.rel_l2_omega}, {"rel_h1_omega", e.rel_h1_omega},
                    {"rel_h1semi_omega", e.rel_h1semi_omega}, {"rel_l2_gamma", e.rel_l2_gamma}};
+    if (s.point_errors) {
+      j["errors"]["max_trace_at_points"] = s.point_errors->max_trace;
+      j["errors"]["max_normal_derivative_at_points"] = s.point_errors->max_normal_derivative;
+    }
   }
   j["peak_memory_bytes"] = s.peak_memory_bytes;
   return j;

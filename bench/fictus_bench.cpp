@@ -66,11 +66,9 @@ struct Run {
 };
 
 Run run(int N, fictus::Variant variant, fictus::InnerSolver inner, int threads) {
-  fictus::SolverOptions o;
-  o.variant = variant;
+  fictus::SolverOptions o = fictus::paper_options(N, variant);
   o.inner = inner;
   o.threads = threads;
-  o.multipliers = fictus::paper_multipliers(N);
   o.condition_number = false;
   o.krylov_tolerance = 1e-12;  // so that both paths give λ to ~1e-9 (cond S up to 1e4)
   std::fprintf(stderr, "  N = %d, %s, %s, %d thread(s)...\n", N, fictus::to_string(variant), fictus::to_string(inner), threads);

@@ -157,6 +157,15 @@ void bind_solution(py::module_& m) {
                                d["min_gap"] = c.min_gap;
                                d["min_normal_derivative"] = c.min_normal_derivative;
                                d["max_complementarity"] = c.max_complementarity;
+                               if (const auto& k = p.s().check) {
+                                 py::dict check;
+                                 check["rule"] = k->rule;
+                                 check["min_normal_derivative"] = k->min_normal_derivative;
+                                 check["max_complementarity"] = k->max_complementarity;
+                                 check["max_difference"] = k->max_difference;
+                                 check["rms_difference"] = k->rms_difference;
+                                 d["check"] = check;
+                               }
                                return d;
                              })
       .def_property_readonly("errors",
@@ -168,6 +177,10 @@ void bind_solution(py::module_& m) {
                                d["l2_gamma"] = e.l2_gamma, d["rel_l2_omega"] = e.rel_l2_omega;
                                d["rel_h1_omega"] = e.rel_h1_omega, d["rel_h1semi_omega"] = e.rel_h1semi_omega;
                                d["rel_l2_gamma"] = e.rel_l2_gamma;
+                               if (const auto& pe = p.s().point_errors) {
+                                 d["max_trace_at_points"] = pe->max_trace;
+                                 d["max_normal_derivative_at_points"] = pe->max_normal_derivative;
+                               }
                                return d;
                              })
       .def_property_readonly("options",

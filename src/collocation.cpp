@@ -56,11 +56,8 @@ double phase_off_corners(const Curve& curve, const ArcLengthTable& arc_length, i
   return best_phase;
 }
 
-int default_multipliers(double curve_length, double box_width, double h) {
-  constexpr double paper_length = 1.9376896441095;  // perimeter of the 0.4 × 0.2 ellipse
-  const double m = 34.0 * (curve_length / box_width) / paper_length *
-                   std::pow(box_width / (128.0 * h), 0.85);
-  return std::max(8, int(std::lround(m)));
+int default_multipliers(double curve_length, double h) {
+  return std::max(8, int(std::lround(curve_length / (default_spacing_cells * h))));
 }
 
 }  // namespace fictus

@@ -123,6 +123,7 @@ struct CurveSetup {
   SparseRows B_gamma, C_gamma, B_Gamma;
   SparseRows loads;      // rows carrying λ in the Schur complement: B_Γ, or B_Γ + R (kink correction)
   DirectTerms direct;    // D_B, D_C of the kink correction (non-smooth variant, reconstructed traces)
+  std::unique_ptr<KinkCorrection> kink;
   std::unique_ptr<SchurComplement> schur;
   Eigen::VectorXd b0, c0;
   std::optional<ConstantMode> mode;
@@ -149,6 +150,39 @@ struct FictitiousDomainSolver::State {
   double load_total = 0;
   std::unique_ptr<CurveSetup> setup;
 };
+
+namespace {
+
+/// The Signorini conditions with a normal derivative D_γ from another stencil than C_γ:
+///   smooth variant (or shifted C_γ): the one-sided quadratic least-squares fit through the nodes of ω;
+///   non-smooth variant, reconstructed traces: the bicubic interpolant of the kink-corrected field.
+IndependentCheck independent_check(const CurveSetup& setup, const Solution& sol) {
+  const Collocation& points = setup.collocation;
+  const int m = points.m;
+  IndependentCheck check;
+  std::vector<double> d;
+  if (setup.kink) {
+    check.rule = "bicubic interpolant of the kink-corrected field";
+    normal_derivative_rows_centered(sol.grid, points.point, points.normal, 3).multiply(sol.u, d);
+  } else {
+    check.rule = "one-sided quadratic least-squares fit through the nodes of omega";
+    one_sided_rows(*setup.gamma_geometry, points.point, points.normal, OneSidedTrace::normal_derivative, 2, 2.5)
+        .multiply(sol.u, d);
+  }
+  check.min_normal_derivative = 1e300;
+  double sum = 0.0;
+  for (int i = 0; i < m; ++i) {
+    const double gap = sol.trace[i] - sol.g[i], difference = d[i] - sol.normal_derivative[i];
+    check.min_normal_derivative = std::min(check.min_normal_derivative, d[i]);
+    check.max_complementarity = std::max(check.max_complementarity, std::abs(gap * d[i]));
+    check.max_difference = std::max(check.max_difference, std::abs(difference));
+    sum += difference * difference;
+  }
+  check.rms_difference = std::sqrt(sum / m);
+  return check;
+}
+
+}  // namespace
 
 FictitiousDomainSolver::FictitiousDomainSolver(const Problem& problem, int threads, int load_quadrature) {
   if (problem.N < 8) throw std::invalid_argument("domain.N: need N >= 8, got " + std::to_string(problem.N));
@@ -209,7 +243,7 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
     const ArcLengthTable arc_length(gamma);
     const double L = arc_length.length();
     const SolverOptions requested = options;
-    if (options.multipliers == 0) options.multipliers = default_multipliers(L, grid.box().x1 - grid.box().x0, h);
+    if (options.multipliers == 0) options.multipliers = default_multipliers(L, h);
     const int m = options.multipliers;
     const double spacing = L / m;
     if (spacing < 2 * h)
@@ -243,10 +277,11 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
     } else {
       setup->C_gamma = normal_derivative_rows_centered(grid, points.point, points.normal, 2);
       if (options.variant == Variant::nonsmooth) {
-        KinkCorrection kink = kink_correction(*setup->gamma_geometry, points, setup->B_gamma, setup->C_gamma,
-                                              st.problem.c, st.threads);
-        setup->loads = add_rows(setup->B_Gamma, kink.galerkin);
-        setup->direct = std::move(kink.direct);
+        setup->kink = std::make_unique<KinkCorrection>(*setup->gamma_geometry, setup->collocation, st.problem.c,
+                                                       st.threads);
+        setup->loads = add_rows(setup->B_Gamma, setup->kink->galerkin());
+        setup->direct.trace = setup->kink->direct(setup->B_gamma);
+        setup->direct.normal_derivative = setup->kink->direct(setup->C_gamma);
       } else {
         setup->loads = setup->B_Gamma;
       }
@@ -317,20 +352,17 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
   clock.mark("newton");
 
   if (compute_field) {
-    // û = u₀ + A⁻¹B_Γᵀλ (+ α for a singular A).
+    // û = u₀ + A⁻¹B_Γᵀλ (+ α for a singular A); with the kink correction the field is
+    // I_h w = u₀ + A⁻¹(B_Γ + R)ᵀλ + Σ_j λ_j ψ_j, whose traces are those of the Newton system.
     GridVector u(grid.n_unknowns(), 0.0);
-    setup.B_Gamma.add_transposed(sol.lambda, u);
+    setup.loads.add_transposed(sol.lambda, u);
     st.fast->solve_in_place(u);
     ++fast_solves;
     for (std::size_t k = 0; k < u.size(); ++k) u[k] += st.u0[k] + sol.alpha;
+    if (setup.kink) setup.kink->add_kinks(sol.lambda, u);
     sol.u = std::move(u);
-    if (setup.direct.empty()) {
-      setup.B_gamma.multiply(sol.u, sol.trace);
-      setup.C_gamma.multiply(sol.u, sol.normal_derivative);
-    } else {  // traces of the kink-corrected field: those of the Newton solution
-      sol.trace.assign(sol.newton.trace.data(), sol.newton.trace.data() + m);
-      sol.normal_derivative.assign(sol.newton.normal_derivative.data(), sol.newton.normal_derivative.data() + m);
-    }
+    setup.B_gamma.multiply(sol.u, sol.trace);
+    setup.C_gamma.multiply(sol.u, sol.normal_derivative);
     clock.mark("final_solve");
   } else {
     sol.trace.assign(sol.newton.trace.data(), sol.newton.trace.data() + m);
@@ -348,6 +380,11 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
     sol.signorini.max_complementarity = std::max(sol.signorini.max_complementarity, std::abs(gap * dn));
   }
 
+  if (compute_field) {
+    sol.check = independent_check(setup, sol);
+    clock.mark("check");
+  }
+
   if ((problem.exact || problem.exact_vectorized) && compute_field) {
     const VectorizedField exact = problem.exact_vectorized ? problem.exact_vectorized : vectorize(problem.exact);
     std::vector<double> x(m), y(m), values(m);
@@ -356,6 +393,26 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
     for (int i = 0; i < m; ++i)
       if (!std::isfinite(values[i]))
         throw std::invalid_argument("data.exact: not finite at (" + std::to_string(x[i]) + ", " + std::to_string(y[i]) + ")");
+    // ∂u/∂n at the points: the given gradient, else central differences (step 1e-6·box width).
+    PointErrors pe;
+    const double step = 1e-6 * (grid.box().x1 - grid.box().x0);
+    std::vector<double> xs(4 * std::size_t(m)), ys(4 * std::size_t(m)), shifted(4 * std::size_t(m));
+    for (int i = 0; i < m; ++i)
+      for (int k = 0; k < 4; ++k) {
+        xs[4 * i + k] = x[i] + (k == 0 ? step : k == 1 ? -step : 0.0);
+        ys[4 * i + k] = y[i] + (k == 2 ? step : k == 3 ? -step : 0.0);
+      }
+    if (!problem.exact_gradient) exact(4 * std::size_t(m), xs.data(), ys.data(), shifted.data());
+    for (int i = 0; i < m; ++i) {
+      const Point n = setup.collocation.normal[i];
+      const Point grad = problem.exact_gradient
+                             ? problem.exact_gradient(x[i], y[i])
+                             : Point{(shifted[4 * i] - shifted[4 * i + 1]) / (2 * step),
+                                     (shifted[4 * i + 2] - shifted[4 * i + 3]) / (2 * step)};
+      pe.max_trace = std::max(pe.max_trace, std::abs(sol.trace[i] - values[i]));
+      pe.max_normal_derivative = std::max(pe.max_normal_derivative, std::abs(sol.normal_derivative[i] - dot(n, grad)));
+    }
+    sol.point_errors = pe;
     if (problem.exact_vectorized)
       sol.errors = compute_errors(sol.u, *setup.gamma_geometry, problem.exact_vectorized, {}, options.error_quadrature, st.threads);
     else

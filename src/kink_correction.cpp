@@ -87,6 +87,12 @@ class NodeKinks {
     return it->second;
   }
   const Kink& at(int i, int j) const { return kinks_.at(key(i, j)); }
+  /// f(i, j, kink) for every node registered before compute() (not those met later by at()).
+  template <class F>
+  void for_each(F&& f) const {
+    const std::size_t width = std::size_t(grid_.nx() + 5);
+    for (const auto& [key, t0] : start_) f(int(key % width) - 2, int(key / width) - 2, kinks_.at(key));
+  }
 
  private:
   const Curve& curve_;
@@ -133,25 +139,42 @@ SparseRows add_rows(const SparseRows& a, const SparseRows& b) {
   return out;
 }
 
-KinkCorrection kink_correction(const CurveGridIntersection& gamma, const Collocation& arcs, const SparseRows& B_gamma,
-                               const SparseRows& C_gamma, double c, int threads) {
+struct KinkCorrection::State {
+  State(const CurveGridIntersection& g, const Collocation& a) : gamma(g), arcs(a), arc_of(a), nodes(g.curve(), g.grid()) {}
+  const CurveGridIntersection& gamma;
+  const Collocation& arcs;
+  ArcIndex arc_of;
+  mutable NodeKinks nodes;
+  SparseRows galerkin;
+};
+
+KinkCorrection::~KinkCorrection() = default;
+KinkCorrection::KinkCorrection(KinkCorrection&&) noexcept = default;
+KinkCorrection& KinkCorrection::operator=(KinkCorrection&&) noexcept = default;
+
+const SparseRows& KinkCorrection::galerkin() const { return state_->galerkin; }
+
+KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Collocation& arcs, double c, int threads)
+    : state_(std::make_unique<State>(gamma, arcs)) {
   const Grid& grid = gamma.grid();
   const Curve& curve = gamma.curve();
   const double h = grid.h();
   const int m = arcs.m;
-  const ArcIndex arc_of(arcs);
+  const ArcIndex& arc_of = state_->arc_of;
+  NodeKinks& nodes = state_->nodes;
   const auto& cells = gamma.cut_cells();
   auto cell_parameter = [&](const CutCell& cell) {
     const CurvePiece& piece = gamma.pieces()[cell.pieces.front()];
     return 0.5 * (piece.t0 + piece.t1);
   };
 
-  // 1. Kink values at the nodes of the cut cells.
-  NodeKinks nodes(curve, grid);
+  // 1. Kink values at the nodes of the cut cells and of the two rings of cells around them (the band
+  //    that trace stencils reach).
   for (const CutCell& cell : cells)
-    for (int k = 0; k < 4; ++k) nodes.add(cell.ix + (k & 1), cell.iy + (k >> 1), cell_parameter(cell));
+    for (int j = cell.iy - 2; j <= cell.iy + 3; ++j)
+      for (int i = cell.ix - 2; i <= cell.ix + 3; ++i)
+        if (i >= 0 && j >= 0 && i <= grid.nx() && j <= grid.ny()) nodes.add(i, j, cell_parameter(cell));
   nodes.compute(threads);
-
   // 2. r_j,k = a(ψ_j − I_hψ_j, φ_k) on every cut cell: the part outside ω is the whole cell minus
   //    its part in ω (ψ_j's smooth extension q(d) on both), and I_hψ_j takes the element matrix.
   //    Each quadrature point goes to the arc its nearest curve point lies on.
@@ -202,8 +225,7 @@ KinkCorrection kink_correction(const CurveGridIntersection& gamma, const Colloca
   std::sort(entries.begin(), entries.end(), [&](const RowEntry& a, const RowEntry& b) {
     return std::tie(a.arc, a.j, a.i) < std::tie(b.arc, b.j, b.i);
   });
-  KinkCorrection out;
-  SparseRows& rows = out.galerkin;
+  SparseRows& rows = state_->galerkin;
   std::size_t e = 0;
   for (int arc = 0; arc < m; ++arc) {
     for (; e < entries.size() && entries[e].arc == arc;) {
@@ -215,23 +237,28 @@ KinkCorrection kink_correction(const CurveGridIntersection& gamma, const Colloca
     }
     rows.row_begin.push_back(rows.entries.size());
   }
+}
 
-  // 3. D = Σ_k R_ik ψ_j(x_k) for the trace rows (nodes projected from the point's parameter).
-  auto direct = [&](const SparseRows& R) {
-    std::vector<Eigen::Triplet<double>> triplets;
-    for (int r = 0; r < R.n_rows(); ++r)
-      for (std::size_t k = R.row_begin[r]; k < R.row_begin[r + 1]; ++k) {
-        const auto& entry = R.entries[k];
-        const Kink& kink = nodes.at(entry.i, entry.j, arcs.t[r]);
-        if (kink.psi() != 0.0) triplets.emplace_back(r, arc_of(kink.t), entry.value * kink.psi());
-      }
-    Eigen::SparseMatrix<double> D(m, m);
-    D.setFromTriplets(triplets.begin(), triplets.end());
-    return D;
-  };
-  out.direct.trace = direct(B_gamma);
-  out.direct.normal_derivative = direct(C_gamma);
-  return out;
+void KinkCorrection::add_kinks(const std::vector<double>& lambda, GridVector& u) const {
+  const Grid& grid = state_->gamma.grid();
+  state_->nodes.for_each([&](int i, int j, const Kink& kink) {
+    const double psi = kink.psi();
+    if (psi != 0.0 && grid.has_unknown(i, j)) u[grid.index(i, j)] += lambda[state_->arc_of(kink.t)] * psi;
+  });
+}
+
+Eigen::SparseMatrix<double> KinkCorrection::direct(const SparseRows& rows) const {
+  const State& st = *state_;
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (int r = 0; r < rows.n_rows(); ++r)
+    for (std::size_t k = rows.row_begin[r]; k < rows.row_begin[r + 1]; ++k) {
+      const auto& entry = rows.entries[k];
+      const Kink& kink = st.nodes.at(entry.i, entry.j, st.arcs.t[r]);
+      if (kink.psi() != 0.0) triplets.emplace_back(r, st.arc_of(kink.t), entry.value * kink.psi());
+    }
+  Eigen::SparseMatrix<double> D(rows.n_rows(), st.arcs.m);
+  D.setFromTriplets(triplets.begin(), triplets.end());
+  return D;
 }
 
 }  // namespace fictus

@@ -1,5 +1,6 @@
 #include "fictus/paper_problem.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "fictus/collocation.hpp"
@@ -64,8 +65,15 @@ std::optional<PaperRow> paper_row(Variant variant, int N) {
 
 int paper_multipliers(int N) {
   if (auto row = paper_row(Variant::nonsmooth, N)) return row->m;
-  const Ellipse e({0.5, 0.5}, 0.4, 0.2);
-  return default_multipliers(ArcLengthTable(e).length(), 1.0, 1.0 / N);
+  return std::max(8, int(std::lround(34.0 * std::pow(N / 128.0, 0.85))));  // the paper's growth, m ∝ N^0.85
+}
+
+SolverOptions paper_options(int N, Variant variant) {
+  SolverOptions o;
+  o.variant = variant;
+  o.multipliers = paper_multipliers(N);
+  o.offset = 1.0;
+  return o;
 }
 
 std::array<double, 3> paper_rates(Variant variant) {

@@ -26,9 +26,11 @@ Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_lengt
 /// The phase (among 32 candidates, ½ first) that keeps the points farthest from the curve's corners.
 double phase_off_corners(const Curve& curve, const ArcLengthTable& arc_length, int m);
 
-/// Default number of multipliers: the paper's m ≈ 34·(N/128)^0.85 on its ellipse (length
-/// L_ref = 1.93768… in the unit box), scaled with the curve length relative to the box width:
-///   m = round(34 · (L/W) / L_ref · (W/(128 h))^0.85),  W = x1 − x0.   At least 8.
-int default_multipliers(double curve_length, double box_width, double h);
+/// Default spacing of the multipliers in cells: s = L/m ≈ 8h at every N (docs/math.md, "Number of
+/// multipliers": the contact ends are resolved to s, so s must shrink with h).
+inline constexpr double default_spacing_cells = 8.0;
+
+/// Default number of multipliers: m = max(8, round(L / (8h))).
+int default_multipliers(double curve_length, double h);
 
 }  // namespace fictus

@@ -30,6 +30,22 @@ struct SignoriniCheck {
   double max_complementarity = 0;    // max_i |(C_γ û)_i (B_γ û − g)_i|
 };
 
+/// The Signorini conditions once more with a normal derivative D_γ û from another stencil than the
+/// solve's C_γ (docs/math.md, "Checks"): where C_γ is wrong, D_γ û − C_γ û shows it.
+struct IndependentCheck {
+  std::string rule;                   // the stencil of D_γ
+  double min_normal_derivative = 0;   // min_i (D_γ û)_i
+  double max_complementarity = 0;     // max_i |(D_γ û)_i (B_γ û − g)_i|
+  double max_difference = 0;          // max_i |D_γ û − C_γ û|_i
+  double rms_difference = 0;          // root mean square of the same
+};
+
+/// Errors at the collocation points against an exact solution.
+struct PointErrors {
+  double max_trace = 0;               // max_i |(B_γ û)_i − u(x_i)|
+  double max_normal_derivative = 0;   // max_i |(C_γ û)_i − ∂u/∂n(x_i)|
+};
+
 struct Timings {
   std::vector<std::pair<std::string, double>> phases;  // seconds, in execution order
   double total = 0;
@@ -52,7 +68,9 @@ struct Solution {
   bool reused_curve = false;            // trace rows and Schur blocks came from the previous solve
   std::optional<double> condition_number;
   SignoriniCheck signorini;
+  std::optional<IndependentCheck> check;  // with the field only
   std::optional<ErrorNorms> errors;
+  std::optional<PointErrors> point_errors;
   Timings timings;
   std::size_t peak_memory_bytes = 0;    // of the process so far (VmHWM)
 };
@@ -73,8 +91,9 @@ class FictitiousDomainSolver {
   /// blocks when problem.gamma is the same object and the options that shape them are unchanged.
   Solution solve(const Problem& problem, SolverOptions options, bool compute_field = true);
 
- private:
   struct State;
+
+ private:
   std::unique_ptr<State> state_;
 };
 

@@ -10,6 +10,8 @@
 // the second one being the Galerkin response to the kink that Q1 cannot resolve in the cut cells.
 // So a trace row R of I_h w is  R û_h + (R A⁻¹ Σ_j λ_j r_j) + D λ  with D_ij = Σ_k R_ik ψ_j(x_k):
 // the rows r_j are added to those of B_Γ in the Schur complement, and D is added to its blocks.
+#include <memory>
+
 #include "fictus/collocation.hpp"
 #include "fictus/curve_grid_intersection.hpp"
 #include "fictus/schur_complement.hpp"
@@ -17,15 +19,27 @@
 
 namespace fictus {
 
-struct KinkCorrection {
-  SparseRows galerkin;     // r_j over the grid nodes, one row per arc (m rows)
-  DirectTerms direct;      // D for B_γ and for C_γ (m × m each)
-};
+class KinkCorrection {
+ public:
+  /// The kink model for the arcs of `arcs` on the curve of `gamma`; computes r_j for A = K + cM.
+  KinkCorrection(const CurveGridIntersection& gamma, const Collocation& arcs, double c, int threads = 1);
+  ~KinkCorrection();
+  KinkCorrection(KinkCorrection&&) noexcept;
+  KinkCorrection& operator=(KinkCorrection&&) noexcept;
 
-/// Builds the corrections for the arcs of `arcs` on the curve of `gamma`, for trace rows B_γ and
-/// C_γ built on the same grid. c is the coefficient of A = K + cM.
-KinkCorrection kink_correction(const CurveGridIntersection& gamma, const Collocation& arcs, const SparseRows& B_gamma,
-                               const SparseRows& C_gamma, double c, int threads = 1);
+  /// r_j over the grid nodes, one row per arc (m rows): added to B_Γ in the Schur complement.
+  const SparseRows& galerkin() const;
+  /// D (m × m) for trace rows R built on the same grid, one row per collocation point:
+  /// D_ij = Σ_k R_ik ψ_j(x_k). Not thread-safe (caches the nodes it meets).
+  Eigen::SparseMatrix<double> direct(const SparseRows& rows) const;
+  /// u += Σ_j λ_j ψ_j at the nodes within two cells of the cut cells (the band where the kink
+  /// model holds): turns u₀ + A⁻¹(B_Γ + R)ᵀλ into the kink-corrected field I_h w.
+  void add_kinks(const std::vector<double>& lambda, GridVector& u) const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 /// Row-wise sum a + b of two sets of rows with the same number of rows (entries of a node merged).
 SparseRows add_rows(const SparseRows& a, const SparseRows& b);

@@ -13,9 +13,7 @@ std::vector<fictus::LevelResult> run_levels(fictus::Variant variant, int first, 
   std::vector<fictus::LevelResult> rows;
   for (int level = first; level <= last; ++level) {
     const int N = 1 << level;
-    fictus::SolverOptions o;
-    o.variant = variant;
-    o.multipliers = fictus::paper_multipliers(N);
+    fictus::SolverOptions o = fictus::paper_options(N, variant);
     o.condition_number = false;
     const fictus::Solution s = fictus::solve(fictus::paper_problem(N), o);
     EXPECT_TRUE(s.newton.converged) << "N = " << N << ": " << s.newton.failure;

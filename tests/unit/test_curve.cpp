@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "fictus/collocation.hpp"
+#include "fictus/paper_problem.hpp"
 #include "fictus/curve.hpp"
 
 namespace {
@@ -55,12 +56,19 @@ TEST(Collocation, EquallySpacedInArcLength) {
   }
 }
 
-TEST(Collocation, DefaultRuleFollowsThePaper) {
+TEST(Collocation, DefaultRuleKeepsTheSpacingAtEightCells) {
   const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2);
   const double L = fictus::ArcLengthTable(e).length();
-  const int paper[] = {34, 62, 110, 198, 360};
-  for (int k = 0; k < 5; ++k)
-    EXPECT_NEAR(fictus::default_multipliers(L, 1.0, 1.0 / (128 << k)), paper[k], 2) << "N = " << (128 << k);
+  for (int N = 128; N <= 4096; N *= 2) {
+    const int m = fictus::default_multipliers(L, 1.0 / N);
+    EXPECT_NEAR(L / m * N, fictus::default_spacing_cells, 0.05) << "N = " << N;
+  }
+  EXPECT_EQ(fictus::default_multipliers(0.01, 1.0 / 64), 8);  // never fewer than 8
+}
+
+TEST(Collocation, PaperRuleBeyondItsTable) {
+  EXPECT_EQ(fictus::paper_multipliers(1024), 198);
+  EXPECT_NEAR(fictus::paper_multipliers(8192), 34.0 * std::pow(64.0, 0.85), 1.0);  // 1/8192: m ∝ N^0.85
 }
 
 }  // namespace

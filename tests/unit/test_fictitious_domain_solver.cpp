@@ -9,10 +9,8 @@
 namespace {
 
 fictus::SolverOptions options_for(fictus::Variant variant, fictus::InnerSolver inner, int N) {
-  fictus::SolverOptions o;
-  o.variant = variant;
+  fictus::SolverOptions o = fictus::paper_options(N, variant);
   o.inner = inner;
-  o.multipliers = fictus::paper_multipliers(N);
   return o;
 }
 

@@ -11,11 +11,9 @@
 namespace {
 
 fictus::Solution solve_paper(int N, fictus::Variant variant, fictus::InnerSolver inner, bool all_active = true) {
-  fictus::SolverOptions o;
-  o.variant = variant;
+  fictus::SolverOptions o = fictus::paper_options(N, variant);
   o.inner = inner;
   o.start_all_active = all_active;
-  o.multipliers = fictus::paper_multipliers(N);
   return fictus::solve(fictus::paper_problem(N), o);
 }
 
