@@ -201,6 +201,7 @@ const Grid& FictitiousDomainSolver::grid() const { return state_->grid; }
 Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions options, bool compute_field) {
   options.validate();
   if (!problem.gamma) throw std::invalid_argument("geometry: no curve given");
+  Eigen::setNbThreads(options.threads);  // the dense LU of the Newton steps follows the threads option
   if (!problem.g && !problem.g_along_curve && !problem.g_vectorized) throw std::invalid_argument("data.g: not given");
   State& st = *state_;
   const Grid& grid = st.grid;
