@@ -140,6 +140,10 @@ int run_solve(const fictus::SolverOptions& cli_options, const SolveArguments& ar
         args.N, args.c, args.boundary == "periodic" ? fictus::Boundary::periodic : fictus::Boundary::dirichlet);
     spec.options = cli_options;
     resolve(spec.options, args);
+    // The paper's m and δ unless --m or --offset say otherwise (applied by the overrides below).
+    const fictus::SolverOptions paper = fictus::paper_options(args.N, spec.options.variant);
+    spec.options.multipliers = paper.multipliers;
+    spec.options.offset = paper.offset;
   }
   overrides.apply(spec);
   if (out_option->count() > 0) spec.output.dir = args.out;

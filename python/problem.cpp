@@ -147,7 +147,6 @@ PyProblem PyProblem::paper(int N, double c, const std::string& boundary, py::dic
   if (boundary != "dirichlet" && boundary != "periodic")
     throw std::invalid_argument("domain.boundary: expected \"dirichlet\" or \"periodic\"");
   p.spec.problem = paper_problem(N, c, boundary == "periodic" ? Boundary::periodic : Boundary::dirichlet);
-  p.spec.options.multipliers = 0;
   // Options through the same reader: a minimal file around them.
   if (!options.empty()) {
     py::dict config;
@@ -164,6 +163,10 @@ PyProblem PyProblem::paper(int N, double c, const std::string& boundary, py::dic
     }
     p.spec.options = from_config(config).spec.options;
   }
+  // The paper's m and δ unless given, as `fictus solve` without a file.
+  const SolverOptions paper = paper_options(N, p.spec.options.variant);
+  if (!options.contains("multipliers")) p.spec.options.multipliers = paper.multipliers;
+  if (!options.contains("offset")) p.spec.options.offset = paper.offset;
   return p;
 }
 
