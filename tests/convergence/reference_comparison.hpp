@@ -1,0 +1,112 @@
+#pragma once
+// Fitted-mesh references (tests/references/<name>.json, written by tests/references/generate.sh) and
+// the comparison of a fictus solution with them: errors in ω from the reference's polar Gauss rule,
+// on γ from its trace samples, and the distance of the contact ends. Used by the convergence tests
+// and bench/spacing_study.cpp.
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "fictus/convergence_table.hpp"
+#include "fictus/error_norms.hpp"
+#include "fictus/expression.hpp"
+#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/quadrature.hpp"
+
+namespace reference {
+
+constexpr double two_pi = 2.0 * std::numbers::pi;
+
+struct Reference {
+  std::string name;
+  fictus::Point center;
+  std::function<double(double)> radius;  // r_b(θ), θ the polar angle about the center
+  int n_theta = 0, n_rho = 0;
+  std::vector<double> u, ux, uy;          // interior samples, index j·n_rho + k
+  std::vector<double> trace_u, trace_g;   // on γ at θ_j = 2πj/n
+  std::vector<double> ends;               // θ of the ends of the contact intervals
+  double l2_omega = 0, h1semi_omega = 0, l2_gamma = 0;
+};
+
+/// Reads <folder>/<name>.json.
+inline Reference load(const std::string& folder, const std::string& name) {
+  std::ifstream in(folder + "/" + name + ".json");
+  if (!in) throw std::runtime_error("cannot read " + folder + "/" + name + ".json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  Reference r;
+  r.name = name;
+  r.center = {j["problem"]["center"][0], j["problem"]["center"][1]};
+  const fictus::Expression radius(j["problem"]["boundary_radius"].get<std::string>(), {"t"}, "boundary_radius");
+  r.radius = [radius](double theta) { return radius({theta}); };
+  r.n_theta = j["interior"]["n_theta"];
+  r.n_rho = j["interior"]["n_rho"];
+  r.u = j["interior"]["u"].get<std::vector<double>>();
+  r.ux = j["interior"]["ux"].get<std::vector<double>>();
+  r.uy = j["interior"]["uy"].get<std::vector<double>>();
+  r.trace_u = j["trace"]["u"].get<std::vector<double>>();
+  r.trace_g = j["trace"]["g"].get<std::vector<double>>();
+  r.ends = j["contact"]["ends"].get<std::vector<double>>();
+  r.l2_omega = j["norms"]["l2_omega"];
+  r.h1semi_omega = j["norms"]["h1semi_omega"];
+  r.l2_gamma = j["norms"]["l2_gamma"];
+  return r;
+}
+
+inline fictus::Point boundary_point(const Reference& r, double theta) {
+  return r.center + r.radius(theta) * fictus::Point{std::cos(theta), std::sin(theta)};
+}
+
+struct Comparison {
+  fictus::LevelResult level;       // relative errors against the reference
+  double end_error_spacings = 0;   // largest distance of a reference contact end to fictus's, in s = L/m
+};
+
+inline Comparison compare(const Reference& r, const fictus::Solution& s) {
+  const fictus::Grid& grid = s.grid;
+  // ω: the reference's rule, weights (2π/n_θ)·w_k·ρ_k·r_b(θ_j)².
+  const fictus::GaussRule& rule = fictus::gauss_legendre(r.n_rho);
+  double e0 = 0, e1 = 0;
+  for (int j = 0; j < r.n_theta; ++j) {
+    const double theta = two_pi * (j + 0.5) / r.n_theta, rb = r.radius(theta);
+    for (int k = 0; k < r.n_rho; ++k) {
+      const double rho = rule.nodes[k], w = two_pi / r.n_theta * rule.weights[k] * rho * rb * rb;
+      const fictus::Point x = r.center + rho * rb * fictus::Point{std::cos(theta), std::sin(theta)};
+      const auto q = fictus::sample_q1(grid, s.u, grid.cell_x(x.x), grid.cell_y(x.y), x.x, x.y);
+      const std::size_t n = std::size_t(j) * r.n_rho + k;
+      e0 += w * std::pow(q.value - r.u[n], 2);
+      e1 += w * (std::pow(q.gradient.x - r.ux[n], 2) + std::pow(q.gradient.y - r.uy[n], 2));
+    }
+  }
+  // γ: trapezoid in θ with ds = √(r_b² + r_b′²) dθ.
+  const int n = int(r.trace_u.size());
+  double eg = 0;
+  for (int j = 0; j < n; ++j) {
+    const double theta = two_pi * j / n, d = 1e-6;
+    const double rb = r.radius(theta), drb = (r.radius(theta + d) - r.radius(theta - d)) / (2 * d);
+    eg += two_pi / n * std::hypot(rb, drb) * std::pow(fictus::evaluate_q1(grid, s.u, boundary_point(r, theta)) - r.trace_u[j], 2);
+  }
+  Comparison c;
+  c.level = {grid.nx(), grid.n_nodes(), s.collocation.m, s.newton.iterations, s.fast_solves, s.timings.total,
+             std::sqrt(e0) / r.l2_omega,
+             std::sqrt(e0 + e1) / std::hypot(r.l2_omega, r.h1semi_omega),
+             std::sqrt(eg) / r.l2_gamma};
+  // Contact ends: fictus's lie between two collocation points of different status (the arc boundary).
+  std::vector<fictus::Point> ends;
+  const int m = s.collocation.m;
+  for (int i = 0; i < m; ++i)
+    if (s.newton.active[i] != s.newton.active[(i + 1) % m])
+      ends.push_back(0.5 * (s.collocation.point[i] + s.collocation.point[(i + 1) % m]));
+  for (double theta : r.ends) {
+    double best = 1e300;
+    for (const fictus::Point& e : ends) best = std::min(best, fictus::norm(e - boundary_point(r, theta)));
+    c.end_error_spacings = std::max(c.end_error_spacings, best / s.collocation.spacing);
+  }
+  return c;
+}
+
+}  // namespace reference
