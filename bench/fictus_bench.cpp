@@ -1,6 +1,6 @@
 // fictus benchmark: the paper's problem at h = 1/512 … 1/4096 with both inner solvers, the green
 // path on larger grids, the time of one DST-I of each grid measured in the same run, 1 vs 2
-// threads per phase, and parameter sweeps. Writes a Markdown report (machine, compiler, threads,
+// threads per phase, parameter sweeps, and the trace rules and m rule compared in one run. Writes a Markdown report (machine, compiler, threads,
 // commit beside every figure). Not part of the test suite: `make bench`.
 #include <unistd.h>
 
@@ -65,8 +65,12 @@ struct Run {
   std::unique_ptr<fictus::Solution> solution;
 };
 
-Run run(int N, fictus::Variant variant, fictus::InnerSolver inner, int threads) {
+Run run(int N, fictus::Variant variant, fictus::InnerSolver inner, int threads,
+        fictus::NormalDerivative traces = fictus::NormalDerivative::reconstructed, bool default_m = false) {
+  // The paper's m and δ = L/m, or fictus's defaults (m = L/(8h), δ = 1.5·L/m).
   fictus::SolverOptions o = fictus::paper_options(N, variant);
+  if (default_m) o.multipliers = 0, o.offset = fictus::SolverOptions{}.offset;
+  o.normal_derivative = traces;
   o.inner = inner;
   o.threads = threads;
   o.condition_number = false;
@@ -76,7 +80,7 @@ Run run(int N, fictus::Variant variant, fictus::InnerSolver inner, int threads) 
   return {N, variant, inner, threads, std::move(s)};
 }
 
-const char* phase_names[] = {"load", "u0", "geometry", "green_table", "schur", "newton", "final_solve", "errors"};
+const char* phase_names[] = {"load", "u0", "geometry", "green_table", "schur", "newton", "final_solve", "check", "errors"};
 
 std::string phase_cells(const fictus::Solution& s) {
   std::string out;
@@ -89,6 +93,7 @@ std::string phase_cells(const fictus::Solution& s) {
 int main(int argc, char** argv) {
   std::string out_dir = "bench/results";
   int max_level = 14, krylov_max_level = 12, threads = 2;
+  std::string sections = "all";
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     auto next = [&]() -> std::string {
@@ -99,8 +104,10 @@ int main(int argc, char** argv) {
     else if (a == "--max-level") max_level = std::stoi(next());
     else if (a == "--krylov-max-level") krylov_max_level = std::stoi(next());
     else if (a == "--threads") threads = std::stoi(next());
+    else if (a == "--sections") sections = next();
     else {
-      std::fprintf(stderr, "usage: fictus_bench [--out DIR] [--max-level 14] [--krylov-max-level 12] [--threads 2]\n");
+      std::fprintf(stderr, "usage: fictus_bench [--out DIR] [--max-level 14] [--krylov-max-level 12] [--threads 2] "
+                           "[--sections all|traces]\n");
       return 1;
     }
   }
@@ -117,6 +124,35 @@ int main(int argc, char** argv) {
      << "- commit: " << commit << "\n- threads: " << threads << " unless a table says otherwise\n"
      << "- problem: the paper's (§4 of DESIGN), m as in the paper (default rule above 1/4096); "
         "Krylov tolerance 1e-12; times in seconds, one run each\n\n";
+
+  // 0. Trace rules and m rule in one run: the paper's shifted C_γ against the reconstructed traces
+  //    (same m), and the default m (s = 8h, δ = 1.5s) against the paper's m; median of 3.
+  md << "## Trace rules and m rule (same run, median of 3, " << threads << " threads)\n\n"
+     << "| h | variant | traces | m | total |";
+  for (const char* p : phase_names) md << ' ' << p << " |";
+  md << " rel L2(w) |\n|---|---|---|---|---|";
+  for (std::size_t k = 0; k < std::size(phase_names); ++k) md << "---|";
+  md << "---|\n";
+  for (int N : {1024, 2048, 4096}) {
+    if (N > (1 << max_level)) break;
+    for (fictus::Variant v : {fictus::Variant::nonsmooth, fictus::Variant::smooth})
+      for (int config = 0; config < 3; ++config) {
+        const auto traces = config == 0 ? fictus::NormalDerivative::shifted : fictus::NormalDerivative::reconstructed;
+        std::vector<Run> repeats;
+        for (int r = 0; r < 3; ++r) repeats.push_back(run(N, v, fictus::InnerSolver::green, threads, traces, config == 2));
+        std::sort(repeats.begin(), repeats.end(),
+                  [](const Run& a, const Run& b) { return a.solution->timings.total < b.solution->timings.total; });
+        const fictus::Solution& s = *repeats[1].solution;
+        md << format("| 1/%d | %s | %s | %d%s | %.3f |", N, fictus::to_string(v), fictus::to_string(traces), s.collocation.m,
+                     config == 2 ? " (s = 8h)" : " (paper)", s.timings.total)
+           << phase_cells(s) << format(" %.3e |\n", s.errors->rel_l2_omega);
+      }
+  }
+  md << "\n";
+  if (sections == "traces") {
+    std::printf("%s", md.str().c_str());
+    return 0;
+  }
 
   // 1. Both variants, both inner solvers, with the DST-I reference of each grid.
   md << "## End to end, both inner solvers\n\n"
