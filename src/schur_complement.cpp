@@ -1,6 +1,7 @@
 #include "fictus/schur_complement.hpp"
 
 #include <algorithm>
+#include <unordered_map>
 #include <utility>
 
 namespace fictus {
@@ -51,29 +52,58 @@ LinearSolveReport ImplicitSchur::solve(const ActiveSet& active, const Eigen::Vec
 }
 
 Eigen::MatrixXd green_block(const GreenTable& green, const SparseRows& R, const SparseRows& Q, int threads) {
-  Eigen::MatrixXd S(R.n_rows(), Q.n_rows());
-#pragma omp parallel for num_threads(threads < 1 ? 1 : threads) schedule(dynamic, 4)
-  for (int col = 0; col < Q.n_rows(); ++col) {
-    for (int row = 0; row < R.n_rows(); ++row) {
-      double sum = 0.0;
-      for (std::size_t a = R.row_begin[row]; a < R.row_begin[row + 1]; ++a) {
-        const auto& ra = R.entries[a];
-        double inner = 0.0;
+  return green_blocks(green, {&R}, Q, threads).front();
+}
+
+std::vector<Eigen::MatrixXd> green_blocks(const GreenTable& green, const std::vector<const SparseRows*>& row_sets,
+                                          const SparseRows& Q, int threads) {
+  // The distinct nodes of all row sets, and every entry as (node slot, weight).
+  std::vector<std::size_t> slot_of;  // by entry, over all row sets in order
+  std::vector<std::pair<int, int>> nodes;
+  {
+    std::unordered_map<std::size_t, std::size_t> slots;
+    for (const SparseRows* R : row_sets)
+      for (const auto& e : R->entries) {
+        const auto [it, added] = slots.emplace(e.index, nodes.size());
+        if (added) nodes.emplace_back(e.i, e.j);
+        slot_of.push_back(it->second);
+      }
+  }
+  std::vector<Eigen::MatrixXd> blocks;
+  for (const SparseRows* R : row_sets) blocks.emplace_back(R->n_rows(), Q.n_rows());
+#pragma omp parallel num_threads(threads < 1 ? 1 : threads)
+  {
+    std::vector<double> column(nodes.size());  // (G Qᵀ)(node, col) for the nodes of the rows
+#pragma omp for schedule(dynamic, 4)
+    for (int col = 0; col < Q.n_rows(); ++col) {
+      for (std::size_t u = 0; u < nodes.size(); ++u) {
+        double sum = 0.0;
         for (std::size_t b = Q.row_begin[col]; b < Q.row_begin[col + 1]; ++b) {
           const auto& qb = Q.entries[b];
-          inner += green.G(ra.i, ra.j, qb.i, qb.j) * qb.value;
+          sum += green.G(nodes[u].first, nodes[u].second, qb.i, qb.j) * qb.value;
         }
-        sum += ra.value * inner;
+        column[u] = sum;
       }
-      S(row, col) = sum;
+      std::size_t entry = 0;
+      for (std::size_t set = 0; set < row_sets.size(); ++set) {
+        const SparseRows& R = *row_sets[set];
+        for (int row = 0; row < R.n_rows(); ++row) {
+          double sum = 0.0;
+          for (std::size_t a = R.row_begin[row]; a < R.row_begin[row + 1]; ++a, ++entry)
+            sum += R.entries[a].value * column[slot_of[entry]];
+          blocks[set](row, col) = sum;
+        }
+      }
     }
   }
-  return S;
+  return blocks;
 }
 
 ExplicitSchur::ExplicitSchur(const GreenTable& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
-                             const SparseRows& loads, int threads, const DirectTerms& direct)
-    : S_B_(green_block(green, B_gamma, loads, threads)), S_C_(green_block(green, C_gamma, loads, threads)) {
+                             const SparseRows& loads, int threads, const DirectTerms& direct) {
+  std::vector<Eigen::MatrixXd> blocks = green_blocks(green, {&B_gamma, &C_gamma}, loads, threads);
+  S_B_ = std::move(blocks[0]);
+  S_C_ = std::move(blocks[1]);
   if (!direct.empty()) {
     S_B_ += Eigen::MatrixXd(direct.trace);
     S_C_ += Eigen::MatrixXd(direct.normal_derivative);

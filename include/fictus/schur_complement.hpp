@@ -107,5 +107,9 @@ class ExplicitSchur final : public SchurComplement {
 
 /// Dense (rows × cols) block R G Qᵀ from sparse rows and the Green's table.
 Eigen::MatrixXd green_block(const GreenTable& green, const SparseRows& R, const SparseRows& Q, int threads = 1);
+/// The blocks R_k G Qᵀ of several row sets at once: (G Qᵀ) is evaluated once per distinct node of
+/// the R_k (B_γ's four nodes of x_i lie in C_γ's 3×3), so the cost is (distinct nodes)·nnz(Q) lookups.
+std::vector<Eigen::MatrixXd> green_blocks(const GreenTable& green, const std::vector<const SparseRows*>& row_sets,
+                                          const SparseRows& Q, int threads = 1);
 
 }  // namespace fictus
