@@ -2,7 +2,9 @@
 // relative L²(ω) errors, least-squares rates over N = 256 … 2048, cond(S) at the finest level and the
 // contact-end error (fitted-mesh references) for s/h = 4, 6, 8, 12, the paper's m ∝ N^0.85, and
 // offsets δ/s = 1, 1.5, 2 (smooth variant), on the manufactured problems and the references.
-// Usage: fictus_spacing_study [--out FILE.md] [--levels 8-11]. Accuracy only; no timings.
+// With --before-after: per problem and variant, the full table (N, m, Newton, L²(ω), H¹(ω), L²(γ),
+// contact-end error) for the earlier defaults (shifted C_γ, m ∝ N^0.85, δ = s) and the current ones.
+// Usage: fictus_spacing_study [--out FILE.md] [--levels 8-11] [--before-after]. Accuracy only.
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -44,16 +46,79 @@ int multipliers(double L, int N, double cells) {
 int main(int argc, char** argv) {
   std::string out_path;
   int first = 8, last = 11;
-  for (int k = 1; k + 1 < argc; k += 2) {
+  bool before_after = false;
+  for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
-    if (a == "--out") out_path = argv[k + 1];
-    else if (a == "--levels") std::sscanf(argv[k + 1], "%d-%d", &first, &last);
+    if (a == "--before-after") before_after = true;
+    else if (a == "--out" && k + 1 < argc) out_path = argv[++k];
+    else if (a == "--levels" && k + 1 < argc) std::sscanf(argv[++k], "%d-%d", &first, &last);
   }
   const std::string source = FICTUS_SOURCE_DIR;
   std::vector<reference::Reference> refs;
   for (const char* name : {"ellipse", "star", "peanut"}) refs.push_back(reference::load(source + "/tests/references", name));
 
   std::ostringstream report;
+  if (before_after) {
+    report << "# Before and after: earlier defaults (shifted C_γ, m ∝ N^0.85, δ = s) vs current (reconstructed "
+              "traces, m = L/(8h), δ = 1.5s)\n\nRelative errors; contact ends: largest distance of a reference end "
+              "to fictus's, in spacings s.\n";
+    for (int p = 0; p < 6; ++p)
+      for (const fictus::Variant variant : {fictus::Variant::smooth, fictus::Variant::nonsmooth})
+        for (int after = 0; after < 2; ++after) {
+          std::vector<fictus::LevelResult> rows;
+          std::string name, lines;
+          for (int level = first; level <= last; ++level) {
+            const int N = 1 << level;
+            Case c;
+            if (p < 3) {
+              const auto all = manufactured::all(N);
+              c = {"manufactured " + all[p].name, all[p].problem, nullptr};
+            } else {
+              const reference::Reference& r = refs[p - 3];
+              fictus::ProblemSpec spec = fictus::read_problem_file(source + "/tests/references/" + r.name + ".toml");
+              spec.problem.N = N;
+              c = {"reference " + r.name, spec.problem, &r};
+            }
+            name = c.name;
+            fictus::SolverOptions o;
+            o.variant = variant;
+            o.threads = 2;
+            o.condition_number = false;
+            if (!after) {
+              o.normal_derivative = fictus::NormalDerivative::shifted;
+              o.offset = 1.0;
+              o.multipliers = multipliers(fictus::ArcLengthTable(*c.problem.gamma).length(), N, 0.0);
+            }
+            try {
+              const fictus::Solution s = fictus::solve(c.problem, o);
+              fictus::LevelResult row{N, 0, s.collocation.m, s.newton.iterations, s.fast_solves, 0, 0, 0, 0};
+              double ends = -1;
+              if (c.reference) {
+                const reference::Comparison cmp = reference::compare(*c.reference, s);
+                row.l2_omega = cmp.level.l2_omega, row.h1_omega = cmp.level.h1_omega, row.l2_gamma = cmp.level.l2_gamma;
+                ends = cmp.end_error_spacings;
+              } else {
+                row.l2_omega = s.errors->rel_l2_omega, row.h1_omega = s.errors->rel_h1_omega,
+                row.l2_gamma = s.errors->rel_l2_gamma;
+              }
+              rows.push_back(row);
+              lines += format("| %d | %d | %d%s | %.2e | %.2e | %.2e | %s |\n", N, row.m, row.it0,
+                              s.newton.converged ? "" : " (failed)", row.l2_omega, row.h1_omega, row.l2_gamma,
+                              ends >= 0 ? format("%.2f", ends).c_str() : "");
+            } catch (const std::exception& e) {
+              lines += format("| %d | | fails: %s | | | | |\n", N, e.what());
+            }
+          }
+          const auto fit = rows.size() > 1 ? fictus::fitted_rates(rows) : std::array<double, 3>{};
+          report << "\n### " << name << ", " << fictus::to_string(variant) << ", " << (after ? "current" : "earlier")
+                 << "\n\n| N | m | Newton | L²(ω) | H¹(ω) | L²(γ) | ends/s |\n|---|---|---|---|---|---|---|\n"
+                 << lines << format("| rates | | | %.2f | %.2f | %.2f | |\n", fit[0], fit[1], fit[2]);
+          std::cerr << name << ' ' << fictus::to_string(variant) << (after ? " current" : " earlier") << format(" rates %.2f %.2f %.2f", fit[0], fit[1], fit[2]) << std::endl;
+        }
+    if (out_path.empty()) std::cout << report.str();
+    else std::ofstream(out_path) << report.str();
+    return 0;
+  }
   report << "# Spacing study (bench/spacing_study.cpp)\n\n"
          << "Relative L²(ω) errors at N = 2^" << first << " … 2^" << last
          << ", least-squares rate, cond(S) and the largest contact-end error (in spacings) at the finest level.\n\n";
