@@ -294,7 +294,9 @@ int main(int argc, char** argv) {
   reproduce_cmd->add_option("--normal-shift", reproduce_options.normal_shift, "shifted rule: C_γ shift in cells")
       ->capture_default_str();
 
-  fictus::SolverOptions sweep_options;
+  // The paper's problem: its δ = L/m, and its m unless --m is given (0 is resolved per N in run_sweep).
+  fictus::SolverOptions sweep_options = fictus::paper_options(128, fictus::Variant::smooth);
+  sweep_options.multipliers = 0;
   SolveArguments sweep_solver_args;
   fictus::cli::SweepArguments sweep_args;
   CLI::App* sweep_cmd = app.add_subcommand(

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cctype>
 #include <deque>
+#include <limits>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -46,7 +47,8 @@ std::unique_ptr<Compiled> compile(const std::string& text, const std::vector<std
 bool is_name_char(char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; }
 
 /// A local must be assigned where it first appears ("a = …, … a …"); otherwise it is a misspelt
-/// or unknown variable. Returns the first offending name, or "".
+/// or unknown variable. Returns the first offending name, or "". (A read before the assignment on
+/// some branch, e.g. "a = a + x", passes here and evaluates to NaN: locals start as NaN.)
 std::string unassigned_local(const std::string& text, const std::vector<std::string>& locals) {
   for (const std::string& name : locals) {
     std::size_t at = 0;
@@ -56,7 +58,9 @@ std::string unassigned_local(const std::string& text, const std::vector<std::str
       if (starts && (end == text.size() || !is_name_char(text[end]))) break;
       at = end;
     }
-    std::size_t next = at == std::string::npos ? at : text.find_first_not_of(" \t\n", at + name.size());
+    std::size_t next = at == std::string::npos ? at : at + name.size();
+    while (next < text.size() && static_cast<unsigned char>(text[next]) <= 0x20) ++next;  // muParser's blanks
+    if (next == text.size()) next = std::string::npos;
     const bool assigned = next != std::string::npos && text[next] == '=' && (next + 1 == text.size() || text[next + 1] != '=');
     if (!assigned) return name;
   }
@@ -91,6 +95,9 @@ double Expression::operator()(const double* values) const {
   auto& slot = cache[shared_->id];
   if (!slot) slot = compile(shared_->text, shared_->variables);
   for (std::size_t k = 0; k < slot->values.size(); ++k) slot->values[k] = values[k];
+  // Locals start as NaN on every evaluation: one read before it is assigned (on some branch) gives
+  // NaN, which the callers' finiteness checks report, never a value left from an earlier call.
+  std::fill(slot->locals.begin(), slot->locals.end(), std::numeric_limits<double>::quiet_NaN());
   try {
     return slot->parser.Eval();
   } catch (const mu::Parser::exception_type& e) {

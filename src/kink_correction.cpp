@@ -28,24 +28,75 @@ struct Kink {
   Point grad_q() const { return (1.0 - kappa * d) * normal; }          // ∇q (d small)
 };
 
-Kink project(const Curve& curve, Point x, double t) {
-  for (int it = 0; it < 12; ++it) {
-    const Point p = curve.position(t), d1 = curve.derivative(t), d2 = curve.second_derivative(t);
-    const Point r = p - x;
-    const double f = dot(r, d1), df = dot(d1, d1) + dot(r, d2);
-    const double step = df > 0 ? f / df : f / dot(d1, d1);
-    t -= step;
-    if (std::abs(step) < 1e-14 * two_pi) break;
-  }
+double wrap(double t) {
   t = std::fmod(t, two_pi);
-  if (t < 0) t += two_pi;
-  Kink k;
-  k.t = t;
-  k.normal = curve.outward_normal(t);
-  k.d = dot(x - curve.position(t), k.normal);
-  k.kappa = curve.curvature(t);
-  return k;
+  return t < 0 ? t + two_pi : t;
 }
+
+/// The point of the curve nearest to x, and the kink function there. Smooth curves: Newton on
+/// (p(t) − x)·p′(t) = 0 from t0 (x is within a cell or two of the curve). Curves with corners: the
+/// same on the smooth piece holding t0 and its two neighbours, each clamped to its piece, the
+/// nearest kept; when that is a corner V, d = ±|x − V| along (x − V) and κ = 0.
+class Projector {
+ public:
+  explicit Projector(const Curve& curve) : curve_(curve), corners_(curve.corners()) {
+    std::sort(corners_.begin(), corners_.end());
+  }
+
+  Kink operator()(Point x, double t0) const {
+    if (corners_.empty()) return at(x, wrap(newton(x, t0, -1e300, 1e300)));
+    const int n = int(corners_.size());
+    // The piece [corner k, corner k+1) holding t0; -1: before the first corner (the last piece).
+    const int piece = int(std::upper_bound(corners_.begin(), corners_.end(), wrap(t0)) - corners_.begin()) - 1;
+    double best_t = 0.0, best_distance = 1e300;
+    bool at_corner = false;
+    for (int k = piece - 1; k <= piece + 1; ++k) {
+      const int i = ((k % n) + n) % n;
+      const double a = corners_[i], b = i + 1 < n ? corners_[i + 1] : corners_[0] + two_pi;
+      const double start = std::clamp(wrap(t0) < a ? wrap(t0) + two_pi : wrap(t0), a, b);
+      const double t = newton(x, start, a, b);
+      const double distance = norm(curve_.position(wrap(t)) - x);
+      if (distance < best_distance) best_distance = distance, best_t = t, at_corner = t <= a || t >= b;
+    }
+    if (!at_corner) return at(x, wrap(best_t));
+    // Nearest at the corner V: the side from the mean of the two edge normals there.
+    const double tv = wrap(best_t), e = 1e-9;
+    const Point V = curve_.position(tv);
+    const Point mean = curve_.outward_normal(wrap(tv - e)) + curve_.outward_normal(wrap(tv + e));
+    const double r = norm(x - V);
+    Kink k;
+    k.t = tv;
+    k.d = dot(x - V, mean) >= 0 ? r : -r;
+    k.normal = r > 0 ? (1.0 / k.d) * (x - V) : (1.0 / norm(mean)) * mean;
+    k.kappa = 0.0;
+    return k;
+  }
+
+ private:
+  double newton(Point x, double t, double lo, double hi) const {
+    for (int it = 0; it < 12; ++it) {
+      const double tw = wrap(t);
+      const Point p = curve_.position(tw), d1 = curve_.derivative(tw), d2 = curve_.second_derivative(tw);
+      const Point r = p - x;
+      const double f = dot(r, d1), df = dot(d1, d1) + dot(r, d2);
+      const double step = df > 0 ? f / df : f / dot(d1, d1);
+      const double next = std::clamp(t - step, lo, hi);
+      if (std::abs(next - t) < 1e-14 * two_pi) return next;
+      t = next;
+    }
+    return t;
+  }
+  Kink at(Point x, double t) const {
+    Kink k;
+    k.t = t;
+    k.normal = curve_.outward_normal(t);
+    k.d = dot(x - curve_.position(t), k.normal);
+    k.kappa = curve_.curvature(t);
+    return k;
+  }
+  const Curve& curve_;
+  std::vector<double> corners_;
+};
 
 /// Arc of a curve parameter: arc i covers [arc_begin[i], arc_end[i]) (the last one may wrap past 0).
 class ArcIndex {
@@ -66,7 +117,7 @@ class ArcIndex {
 /// Kink values at grid nodes, computed once per node.
 class NodeKinks {
  public:
-  NodeKinks(const Curve& curve, const Grid& grid) : curve_(curve), grid_(grid) {}
+  NodeKinks(const Curve& curve, const Grid& grid) : project_(curve), grid_(grid) {}
   std::size_t key(int i, int j) const { return std::size_t(j + 2) * std::size_t(grid_.nx() + 5) + std::size_t(i + 2); }
   /// Registers node (i, j) with a starting parameter; returns true if it is new.
   bool add(int i, int j, double t0) { return start_.emplace(key(i, j), t0).second; }
@@ -77,13 +128,13 @@ class NodeKinks {
 #pragma omp parallel for num_threads(threads < 1 ? 1 : threads) schedule(static)
     for (std::size_t n = 0; n < todo.size(); ++n) {
       const int i = int(todo[n].first % width) - 2, j = int(todo[n].first / width) - 2;
-      values[n] = project(curve_, {grid_.x(i), grid_.y(j)}, todo[n].second);
+      values[n] = project_({grid_.x(i), grid_.y(j)}, todo[n].second);
     }
     for (std::size_t n = 0; n < todo.size(); ++n) kinks_[todo[n].first] = values[n];
   }
   const Kink& at(int i, int j, double t0) {
     auto it = kinks_.find(key(i, j));
-    if (it == kinks_.end()) it = kinks_.emplace(key(i, j), project(curve_, {grid_.x(i), grid_.y(j)}, t0)).first;
+    if (it == kinks_.end()) it = kinks_.emplace(key(i, j), project_({grid_.x(i), grid_.y(j)}, t0)).first;
     return it->second;
   }
   const Kink& at(int i, int j) const { return kinks_.at(key(i, j)); }
@@ -95,7 +146,7 @@ class NodeKinks {
   }
 
  private:
-  const Curve& curve_;
+  Projector project_;
   const Grid& grid_;
   std::unordered_map<std::size_t, double> start_;
   std::unordered_map<std::size_t, Kink> kinks_;
@@ -157,7 +208,7 @@ const SparseRows& KinkCorrection::galerkin() const { return state_->galerkin; }
 KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Collocation& arcs, double c, int threads)
     : state_(std::make_unique<State>(gamma, arcs)) {
   const Grid& grid = gamma.grid();
-  const Curve& curve = gamma.curve();
+  const Projector project(gamma.curve());
   const double h = grid.h();
   const int m = arcs.m;
   const ArcIndex& arc_of = state_->arc_of;
@@ -183,17 +234,17 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
   // Element matrix of −Δ + c on a square Q1 cell (local nodes as in Q1Basis).
   const double K[4][4] = {{4, -1, -1, -2}, {-1, 4, -2, -1}, {-1, -2, 4, -1}, {-2, -1, -1, 4}};
   const double M[4][4] = {{4, 2, 2, 1}, {2, 4, 1, 2}, {2, 1, 4, 2}, {1, 2, 2, 4}};
-  std::vector<RowEntry> entries;
+  std::vector<std::vector<RowEntry>> by_cell(cells.size());  // summed in cell order: the same for any thread count
 #pragma omp parallel num_threads(threads < 1 ? 1 : threads)
   {
-    std::vector<RowEntry> local;
     std::vector<QuadraturePoint> inside;
 #pragma omp for schedule(dynamic, 16)
     for (std::size_t n = 0; n < cells.size(); ++n) {
       const CutCell& cell = cells[n];
+      std::vector<RowEntry>& local = by_cell[n];
       const double t0 = cell_parameter(cell), x0 = grid.x(cell.ix), y0 = grid.y(cell.iy);
       auto add_point = [&](double x, double y, double w) {
-        const Kink kink = project(curve, {x, y}, t0);
+        const Kink kink = project({x, y}, t0);
         const Q1Basis basis((x - x0) / h, (y - y0) / h, h);
         const int arc = arc_of(kink.t);
         const double q = kink.q();
@@ -217,12 +268,12 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
           local.push_back({arc, cell.ix + (k & 1), cell.iy + (k >> 1), -psi * (K[l][k] / 6.0 + c * h * h * M[l][k] / 36.0)});
       }
     }
-#pragma omp critical
-    entries.insert(entries.end(), local.begin(), local.end());
   }
 
   // Rows r_j: entries merged per (arc, node), boundary nodes of the box dropped.
-  std::sort(entries.begin(), entries.end(), [&](const RowEntry& a, const RowEntry& b) {
+  std::vector<RowEntry> entries;
+  for (const auto& cell_entries : by_cell) entries.insert(entries.end(), cell_entries.begin(), cell_entries.end());
+  std::stable_sort(entries.begin(), entries.end(), [&](const RowEntry& a, const RowEntry& b) {
     return std::tie(a.arc, a.j, a.i) < std::tie(b.arc, b.j, b.i);
   });
   SparseRows& rows = state_->galerkin;

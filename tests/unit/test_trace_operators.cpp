@@ -9,6 +9,7 @@
 
 #include "fictus/collocation.hpp"
 #include "fictus/kink_correction.hpp"
+#include "fictus/shapes.hpp"
 #include "fictus/trace_operators.hpp"
 
 namespace {
@@ -210,6 +211,41 @@ TEST(KinkCorrection, GalerkinRowsLiveOnTheCutCellsAndCarryNoMassWhenCIsZero) {
   for (const auto& cell : geometry.cut_cells())
     for (int k = 0; k < 4; ++k) cut_nodes.insert({cell.ix + (k & 1), cell.iy + (k >> 1)});
   for (const auto& e : R.entries) EXPECT_TRUE(cut_nodes.count({e.i, e.j}));
+}
+
+TEST(KinkCorrection, KinkValuesOfAPolygonFollowTheDistanceToEdgesAndCorners) {
+  // ψ = q(d)⁺ with q(d) = d on straight edges: outside a convex corner d is the distance to the
+  // vertex, beside an edge the distance to its line (the projection must not flip between edges).
+  const fictus::Grid grid(fictus::Box{}, 64);
+  const auto square = std::make_shared<fictus::PolygonCurve>(
+      std::vector<fictus::Point>{{0.3, 0.3}, {0.7, 0.32}, {0.68, 0.7}, {0.31, 0.69}});
+  const fictus::ArcLengthTable arc(*square);
+  const fictus::Collocation points = fictus::make_collocation(*square, arc, 24, fictus::phase_off_corners(*square, arc, 24));
+  const fictus::CurveGridIntersection geometry(*square, grid);
+  const fictus::KinkCorrection kink(geometry, points, 1.0);
+  fictus::GridVector psi(grid.n_unknowns(), 0.0);
+  kink.add_kinks(std::vector<double>(points.m, 1.0), psi);
+  const auto& v = square->vertices();
+  auto segment_distance = [](fictus::Point p, fictus::Point a, fictus::Point b) {
+    const fictus::Point e = b - a;
+    const double t = std::clamp(fictus::dot(p - a, e) / fictus::dot(e, e), 0.0, 1.0);
+    return fictus::norm(p - (a + t * e));
+  };
+  int checked = 0;
+  for (int j = 1; j < grid.ny(); ++j)
+    for (int i = 1; i < grid.nx(); ++i) {
+      const fictus::Point x{grid.x(i), grid.y(j)};
+      if (geometry.node_inside(i, j)) {
+        EXPECT_EQ(psi[grid.index(i, j)], 0.0);
+        continue;
+      }
+      double d = 1e300;
+      for (std::size_t k = 0; k < v.size(); ++k) d = std::min(d, segment_distance(x, v[k], v[(k + 1) % v.size()]));
+      if (d > 2.5 * grid.h()) continue;  // outside the band
+      EXPECT_NEAR(psi[grid.index(i, j)], d, 1e-12) << "node (" << i << ", " << j << ")";
+      ++checked;
+    }
+  EXPECT_GT(checked, 100);
 }
 
 }  // namespace
