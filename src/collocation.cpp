@@ -56,8 +56,8 @@ double phase_off_corners(const Curve& curve, const ArcLengthTable& arc_length, i
   return best_phase;
 }
 
-int default_multipliers(double curve_length, double h) {
-  return std::max(8, int(std::lround(curve_length / (default_spacing_cells * h))));
+int default_multipliers(double curve_length, double h, double spacing_cells) {
+  return std::max(8, int(std::lround(curve_length / (spacing_cells * h))));
 }
 
 }  // namespace fictus

@@ -26,11 +26,13 @@ Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_lengt
 /// The phase (among 32 candidates, ½ first) that keeps the points farthest from the curve's corners.
 double phase_off_corners(const Curve& curve, const ArcLengthTable& arc_length, int m);
 
-/// Default spacing of the multipliers in cells: s = L/m ≈ 8h at every N (docs/math.md, "Number of
-/// multipliers": the contact ends are resolved to s, so s must shrink with h).
-inline constexpr double default_spacing_cells = 8.0;
+/// Default spacing of the multipliers in cells, s = L/m ≈ c·h at every N (docs/math.md, "Number of
+/// multipliers and offset": the contact ends are resolved to s, so s must shrink with h): 8 cells in
+/// the smooth variant, 12 in the non-smooth one (measured on fitted-mesh references).
+inline constexpr double default_spacing_cells_smooth = 8.0;
+inline constexpr double default_spacing_cells_nonsmooth = 12.0;
 
-/// Default number of multipliers: m = max(8, round(L / (8h))).
-int default_multipliers(double curve_length, double h);
+/// Default number of multipliers: m = max(8, round(L / (spacing_cells·h))).
+int default_multipliers(double curve_length, double h, double spacing_cells = default_spacing_cells_smooth);
 
 }  // namespace fictus
