@@ -1,6 +1,7 @@
 #include "fictus/kink_correction.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <tuple>
@@ -23,6 +24,7 @@ struct Kink {
   double d = 0.0;      // signed distance, > 0 outside ω
   double kappa = 0.0;  // curvature there
   Point normal;        // outward unit normal there
+  Point foot;          // the nearest point itself
   double q() const { return d - 0.5 * kappa * d * d; }                // ψ outside ω, extended smoothly inside
   double psi() const { return d > 0 ? q() : 0.0; }                    // q(d)⁺
   Point grad_q() const { return (1.0 - kappa * d) * normal; }          // ∇q (d small)
@@ -41,6 +43,29 @@ class Projector {
  public:
   explicit Projector(const Curve& curve) : curve_(curve), corners_(curve.corners()) {
     std::sort(corners_.begin(), corners_.end());
+  }
+
+  /// The nearest point of a point y near x (within a few cells) from x's nearest point: on a curve
+  /// without corners by its osculating circle there (d, n, t to O(κ′|y − x|³)), otherwise exactly.
+  Kink near(const Kink& at_x, Point y, double speed) const {
+    if (!corners_.empty()) return (*this)(y, at_x.t);
+    Kink k = at_x;
+    const Point p = at_x.foot;
+    if (std::abs(at_x.kappa) * norm(y - p) < 1e-12) {
+      const Point tangent{-at_x.normal.y, at_x.normal.x};
+      k.d = dot(y - p, at_x.normal);
+      k.t = wrap(at_x.t + dot(y - p, tangent) / speed);
+      return k;
+    }
+    const double rho = 1.0 / at_x.kappa;
+    const Point centre = p - rho * at_x.normal, v = y - centre, u = p - centre;
+    const double r = norm(v);
+    k.d = rho > 0 ? r - rho : -rho - r;
+    k.normal = (rho > 0 ? 1.0 / r : -1.0 / r) * v;
+    const double angle = std::atan2(u.x * v.y - u.y * v.x, dot(u, v));
+    k.t = wrap(at_x.t + rho * angle / speed);
+    k.foot = centre + (std::abs(rho) / r) * v;
+    return k;
   }
 
   Kink operator()(Point x, double t0) const {
@@ -66,6 +91,7 @@ class Projector {
     const double r = norm(x - V);
     Kink k;
     k.t = tv;
+    k.foot = V;
     k.d = dot(x - V, mean) >= 0 ? r : -r;
     k.normal = r > 0 ? (1.0 / k.d) * (x - V) : (1.0 / norm(mean)) * mean;
     k.kappa = 0.0;
@@ -90,7 +116,8 @@ class Projector {
     Kink k;
     k.t = t;
     k.normal = curve_.outward_normal(t);
-    k.d = dot(x - curve_.position(t), k.normal);
+    k.foot = curve_.position(t);
+    k.d = dot(x - k.foot, k.normal);
     k.kappa = curve_.curvature(t);
     return k;
   }
@@ -114,42 +141,55 @@ class ArcIndex {
   std::vector<std::pair<double, int>> begins_;
 };
 
-/// Kink values at grid nodes, computed once per node.
+/// Kink values at the grid nodes of a band around γ, each from the osculating circle at the centre
+/// of a cut cell next to it (computed once); nodes met later are projected exactly.
 class NodeKinks {
  public:
   NodeKinks(const Curve& curve, const Grid& grid) : project_(curve), grid_(grid) {}
   std::size_t key(int i, int j) const { return std::size_t(j + 2) * std::size_t(grid_.nx() + 5) + std::size_t(i + 2); }
-  /// Registers node (i, j) with a starting parameter; returns true if it is new.
-  bool add(int i, int j, double t0) { return start_.emplace(key(i, j), t0).second; }
-  void compute(int threads) {
-    std::vector<std::pair<std::size_t, double>> todo(start_.begin(), start_.end());
-    std::vector<Kink> values(todo.size());
+  /// The band: every node of `nodes` with the index of a cut cell near it (the first one wins).
+  void build(std::vector<std::pair<std::size_t, int>> nodes, const std::vector<Kink>& centres,
+             const std::vector<double>& speeds, int threads) {
+    std::stable_sort(nodes.begin(), nodes.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    nodes.erase(std::unique(nodes.begin(), nodes.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
+                nodes.end());
+    keys_.resize(nodes.size());
+    kinks_.resize(nodes.size());
     const std::size_t width = std::size_t(grid_.nx() + 5);
 #pragma omp parallel for num_threads(threads < 1 ? 1 : threads) schedule(static)
-    for (std::size_t n = 0; n < todo.size(); ++n) {
-      const int i = int(todo[n].first % width) - 2, j = int(todo[n].first / width) - 2;
-      values[n] = project_({grid_.x(i), grid_.y(j)}, todo[n].second);
+    for (std::size_t n = 0; n < nodes.size(); ++n) {
+      const auto [k, cell] = nodes[n];
+      const int i = int(k % width) - 2, j = int(k / width) - 2;
+      keys_[n] = k;
+      kinks_[n] = project_.near(centres[cell], {grid_.x(i), grid_.y(j)}, speeds[cell]);
     }
-    for (std::size_t n = 0; n < todo.size(); ++n) kinks_[todo[n].first] = values[n];
   }
+  /// A node of the band, or (projected from t0 and kept) another one.
   const Kink& at(int i, int j, double t0) {
-    auto it = kinks_.find(key(i, j));
-    if (it == kinks_.end()) it = kinks_.emplace(key(i, j), project_({grid_.x(i), grid_.y(j)}, t0)).first;
+    if (const Kink* k = find(i, j)) return *k;
+    auto it = extra_.find(key(i, j));
+    if (it == extra_.end()) it = extra_.emplace(key(i, j), project_({grid_.x(i), grid_.y(j)}, t0)).first;
     return it->second;
   }
-  const Kink& at(int i, int j) const { return kinks_.at(key(i, j)); }
-  /// f(i, j, kink) for every node registered before compute() (not those met later by at()).
+  /// A node of the band (precondition: it is one).
+  const Kink& at(int i, int j) const { return *find(i, j); }
+  /// f(i, j, kink) for every node of the band.
   template <class F>
   void for_each(F&& f) const {
     const std::size_t width = std::size_t(grid_.nx() + 5);
-    for (const auto& [key, t0] : start_) f(int(key % width) - 2, int(key / width) - 2, kinks_.at(key));
+    for (std::size_t n = 0; n < keys_.size(); ++n) f(int(keys_[n] % width) - 2, int(keys_[n] / width) - 2, kinks_[n]);
   }
 
  private:
+  const Kink* find(int i, int j) const {
+    const auto it = std::lower_bound(keys_.begin(), keys_.end(), key(i, j));
+    return it != keys_.end() && *it == key(i, j) ? &kinks_[std::size_t(it - keys_.begin())] : nullptr;
+  }
   Projector project_;
   const Grid& grid_;
-  std::unordered_map<std::size_t, double> start_;
-  std::unordered_map<std::size_t, Kink> kinks_;
+  std::vector<std::size_t> keys_;  // sorted
+  std::vector<Kink> kinks_;
+  std::unordered_map<std::size_t, Kink> extra_;
 };
 
 /// Q1 on a square cell, local nodes (0,0), (1,0), (0,1), (1,1): value and gradient at (ξ, η).
@@ -219,17 +259,28 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
     return 0.5 * (piece.t0 + piece.t1);
   };
 
-  // 1. Kink values at the nodes of the cut cells and of the two rings of cells around them (the band
-  //    that trace stencils reach).
-  for (const CutCell& cell : cells)
-    for (int j = cell.iy - 2; j <= cell.iy + 3; ++j)
-      for (int i = cell.ix - 2; i <= cell.ix + 3; ++i)
-        if (i >= 0 && j >= 0 && i <= grid.nx() && j <= grid.ny()) nodes.add(i, j, cell_parameter(cell));
-  nodes.compute(threads);
+  // 1. The nearest point of every cut cell's centre (exact), then the kink values at the nodes of the
+  //    cut cells and of the two rings of cells around them (the band that trace stencils reach).
+  std::vector<Kink> centres(cells.size());
+  std::vector<double> speeds(cells.size());
+#pragma omp parallel for num_threads(threads < 1 ? 1 : threads) schedule(static)
+  for (std::size_t n = 0; n < cells.size(); ++n) {
+    centres[n] = project({grid.x(cells[n].ix) + 0.5 * h, grid.y(cells[n].iy) + 0.5 * h}, cell_parameter(cells[n]));
+    speeds[n] = gamma.curve().speed(centres[n].t);
+  }
+  {
+    std::vector<std::pair<std::size_t, int>> band;
+    band.reserve(36 * cells.size());
+    for (std::size_t n = 0; n < cells.size(); ++n)
+      for (int j = cells[n].iy - 2; j <= cells[n].iy + 3; ++j)
+        for (int i = cells[n].ix - 2; i <= cells[n].ix + 3; ++i)
+          if (i >= 0 && j >= 0 && i <= grid.nx() && j <= grid.ny()) band.emplace_back(nodes.key(i, j), int(n));
+    nodes.build(std::move(band), centres, speeds, threads);
+  }
   // 2. r_j,k = a(ψ_j − I_hψ_j, φ_k) on every cut cell: the part outside ω is the whole cell minus
   //    its part in ω (ψ_j's smooth extension q(d) on both), and I_hψ_j takes the element matrix.
   //    Each quadrature point goes to the arc its nearest curve point lies on.
-  const GaussRule& rule = gauss_legendre(4);
+  const GaussRule& rule = gauss_legendre(3);  // q(d) is smooth on the cell: degree-5 exactness suffices
   constexpr int cut_q = 3;
   // Element matrix of −Δ + c on a square Q1 cell (local nodes as in Q1Basis).
   const double K[4][4] = {{4, -1, -1, -2}, {-1, 4, -2, -1}, {-1, -2, 4, -1}, {-2, -1, -1, 4}};
@@ -241,17 +292,22 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
 #pragma omp for schedule(dynamic, 16)
     for (std::size_t n = 0; n < cells.size(); ++n) {
       const CutCell& cell = cells[n];
-      std::vector<RowEntry>& local = by_cell[n];
-      const double t0 = cell_parameter(cell), x0 = grid.x(cell.ix), y0 = grid.y(cell.iy);
+      // Sums per arc met in this cell (rarely more than two) for the cell's four nodes.
+      std::vector<std::pair<int, std::array<double, 4>>> sums;
+      auto sums_of = [&](int arc) -> std::array<double, 4>& {
+        for (auto& [a, v] : sums)
+          if (a == arc) return v;
+        return sums.emplace_back(arc, std::array<double, 4>{}).second;
+      };
+      // Nearest points of the quadrature points from the cell centre's (its osculating circle).
+      const double x0 = grid.x(cell.ix), y0 = grid.y(cell.iy);
       auto add_point = [&](double x, double y, double w) {
-        const Kink kink = project({x, y}, t0);
+        const Kink kink = project.near(centres[n], {x, y}, speeds[n]);
         const Q1Basis basis((x - x0) / h, (y - y0) / h, h);
-        const int arc = arc_of(kink.t);
         const double q = kink.q();
         const Point grad = kink.grad_q();
-        for (int k = 0; k < 4; ++k)
-          local.push_back({arc, cell.ix + (k & 1), cell.iy + (k >> 1),
-                           w * (dot(grad, basis.gradient[k]) + c * q * basis.value[k])});
+        std::array<double, 4>& v = sums_of(arc_of(kink.t));
+        for (int k = 0; k < 4; ++k) v[k] += w * (dot(grad, basis.gradient[k]) + c * q * basis.value[k]);
       };
       for (std::size_t b = 0; b < rule.nodes.size(); ++b)
         for (std::size_t a = 0; a < rule.nodes.size(); ++a)
@@ -263,10 +319,11 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
         const Kink& kink = nodes.at(cell.ix + (l & 1), cell.iy + (l >> 1));
         const double psi = kink.psi();
         if (psi == 0.0) continue;
-        const int arc = arc_of(kink.t);
-        for (int k = 0; k < 4; ++k)
-          local.push_back({arc, cell.ix + (k & 1), cell.iy + (k >> 1), -psi * (K[l][k] / 6.0 + c * h * h * M[l][k] / 36.0)});
+        std::array<double, 4>& v = sums_of(arc_of(kink.t));
+        for (int k = 0; k < 4; ++k) v[k] -= psi * (K[l][k] / 6.0 + c * h * h * M[l][k] / 36.0);
       }
+      for (const auto& [arc, v] : sums)
+        for (int k = 0; k < 4; ++k) by_cell[n].push_back({arc, cell.ix + (k & 1), cell.iy + (k >> 1), v[k]});
     }
   }
 
