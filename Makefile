@@ -9,7 +9,7 @@ DEBIAN_PACKAGES = cmake g++ make pkg-config libfftw3-dev libeigen3-dev libcli11-
                   libmuparser-dev libtomlplusplus-dev python3 python3-dev python3-numpy python3-matplotlib \
                   python3-vtk9 python3-pytest pybind11-dev
 
-.PHONY: deps configure build run test bench clean
+.PHONY: deps configure build run test bench references manufactured clean
 
 deps:
 	@missing=""; for p in $(DEBIAN_PACKAGES); do \
@@ -34,6 +34,16 @@ test: build
 
 bench: build
 	$(BUILD_DIR)/bench/fictus_bench --out bench/results $(BENCH_ARGS)
+
+# Regenerate the fitted-mesh references (FreeFEM, about an hour on one core) and the manufactured
+# solutions (sympy); both outputs are committed, so neither is needed to build or test.
+references:
+	tests/references/generate.sh
+
+manufactured:
+	@dpkg -s python3-sympy >/dev/null 2>&1 || { SUDO=""; [ "$$(id -u)" -eq 0 ] || SUDO=sudo; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq python3-sympy; }
+	/usr/bin/python3 tests/convergence/manufactured.py
 
 clean:
 	rm -rf $(BUILD_DIR)
