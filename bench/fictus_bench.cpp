@@ -219,7 +219,7 @@ int main(int argc, char** argv) {
     const int count = obstacles ? 100 : 20;
     const fictus::Problem base = fictus::paper_problem(1024);
     fictus::FictitiousDomainSolver solver(base, threads);
-    fictus::SolverOptions o;
+    fictus::SolverOptions o = fictus::paper_options(1024, fictus::Variant::smooth);  // as `fictus sweep`
     o.threads = threads;
     o.condition_number = false;
     double first = 0, rest = 0;
