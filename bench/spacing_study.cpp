@@ -34,6 +34,18 @@ std::string format(const char* f, auto... args) {
   return buffer;
 }
 
+/// Problem p at N: 0–2 the manufactured circle, ellipse, star; 3–5 the references.
+Case make_case(int p, int N, const std::vector<reference::Reference>& refs, const std::string& source) {
+  if (p < 3) {
+    const auto all = manufactured::all(N);
+    return {"manufactured " + all[p].name, all[p].problem, nullptr};
+  }
+  const reference::Reference& r = refs[p - 3];
+  fictus::ProblemSpec spec = fictus::read_problem_file(source + "/tests/references/" + r.name + ".toml");
+  spec.problem.N = N;
+  return {"reference " + r.name, spec.problem, &r};
+}
+
 /// m for a spacing of `cells` cells (0: the paper's growth m = 34·(N/128)^0.85 scaled by L).
 int multipliers(double L, int N, double cells) {
   if (cells > 0) return std::max(8, int(std::lround(L * N / cells)));
@@ -69,16 +81,7 @@ int main(int argc, char** argv) {
           std::string name, lines;
           for (int level = first; level <= last; ++level) {
             const int N = 1 << level;
-            Case c;
-            if (p < 3) {
-              const auto all = manufactured::all(N);
-              c = {"manufactured " + all[p].name, all[p].problem, nullptr};
-            } else {
-              const reference::Reference& r = refs[p - 3];
-              fictus::ProblemSpec spec = fictus::read_problem_file(source + "/tests/references/" + r.name + ".toml");
-              spec.problem.N = N;
-              c = {"reference " + r.name, spec.problem, &r};
-            }
+            const Case c = make_case(p, N, refs, source);
             name = c.name;
             fictus::SolverOptions o;
             o.variant = variant;
@@ -137,16 +140,7 @@ int main(int argc, char** argv) {
           std::string name;
           for (int level = first; level <= last && failure.empty(); ++level) {
             const int N = 1 << level;
-            Case c;
-            if (p < 3) {
-              const auto all = manufactured::all(N);
-              c = {"manufactured " + all[p].name, all[p].problem, nullptr};
-            } else {
-              const reference::Reference& r = refs[p - 3];
-              fictus::ProblemSpec spec = fictus::read_problem_file(source + "/tests/references/" + r.name + ".toml");
-              spec.problem.N = N;
-              c = {"reference " + r.name, spec.problem, &r};
-            }
+            const Case c = make_case(p, N, refs, source);
             name = c.name;
             fictus::SolverOptions o;
             o.variant = variant;

@@ -248,8 +248,9 @@ Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions opt
     const ArcLengthTable arc_length(gamma);
     const double L = arc_length.length();
     const SolverOptions requested = options;
-    if (options.multipliers == 0) options.multipliers = default_multipliers(L, h, options.variant == Variant::smooth ? default_spacing_cells_smooth
-                                                                                     : default_spacing_cells_nonsmooth);
+    const double spacing_cells =
+        options.variant == Variant::smooth ? default_spacing_cells_smooth : default_spacing_cells_nonsmooth;
+    if (options.multipliers == 0) options.multipliers = default_multipliers(L, h, spacing_cells);
     const int m = options.multipliers;
     const double spacing = L / m;
     if (spacing < 2 * h)
