@@ -36,11 +36,6 @@ class RowBuilder {
     add(ix, iy + 1, w * (1 - xi) * eta);
     add(ix + 1, iy + 1, w * xi * eta);
   }
-  /// w times the entries of row r of `other` (built on the same grid).
-  void add_row(const SparseRows& other, int r, double w) {
-    for (std::size_t k = other.row_begin[r]; k < other.row_begin[r + 1]; ++k)
-      add(other.entries[k].i, other.entries[k].j, w * other.entries[k].value);
-  }
   void end_row() { rows_.row_begin.push_back(rows_.entries.size()); }
 
  private:
