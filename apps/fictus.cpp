@@ -8,6 +8,9 @@
 #include <filesystem>
 #include <iostream>
 #include <regex>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <cerrno>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -15,7 +18,9 @@
 #include "fictus/convergence_table.hpp"
 #include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/paper_problem.hpp"
+#include "fictus/options.hpp"
 #include "fictus/problem_file.hpp"
+#include "option_flags.hpp"
 #include "results_io.hpp"
 #include "vtk_io.hpp"
 #include "sweep.hpp"
@@ -25,66 +30,7 @@ using nlohmann::json;
 
 namespace {
 
-struct SolveArguments {
-  std::string problem_path;
-  int N = 256;
-  double c = 1.0;
-  std::string boundary = "dirichlet";
-  std::string variant = "smooth";
-  std::string schur = "green";
-  std::string start = "all";
-  std::string normal_derivative = "reconstructed";
-  std::string out;
-  std::vector<std::string> files;
-};
-
-/// Flags that override a problem file: applied only when given on the command line.
-struct Overrides {
-  std::vector<std::pair<CLI::Option*, std::function<void(fictus::ProblemSpec&)>>> items;
-  void apply(fictus::ProblemSpec& spec) const {
-    for (const auto& [option, set] : items)
-      if (option->count() > 0) set(spec);
-  }
-};
-
-void add_solver_options(CLI::App& cmd, fictus::SolverOptions& o, SolveArguments& a, Overrides* overrides = nullptr) {
-  auto add = [&](CLI::Option* option, std::function<void(fictus::ProblemSpec&)> set) {
-    option->capture_default_str();
-    if (overrides) overrides->items.emplace_back(option, std::move(set));
-  };
-  add(cmd.add_option("--variant", a.variant, "smooth (controls on Γ outside ω) or nonsmooth (Γ = γ)"),
-      [&](fictus::ProblemSpec& s) { s.options.variant = fictus::parse_variant(a.variant); });
-  add(cmd.add_option("--m,--multipliers", o.multipliers, "number of multipliers m (0: default rule)"),
-      [&](fictus::ProblemSpec& s) { s.options.multipliers = o.multipliers; });
-  add(cmd.add_option("--offset", o.offset, "smooth variant: distance of Γ from γ in units of the spacing L/m"),
-      [&](fictus::ProblemSpec& s) { s.options.offset = o.offset; });
-  add(cmd.add_option("--rho", o.rho, "ρ > 0 of the projection"), [&](fictus::ProblemSpec& s) { s.options.rho = o.rho; });
-  add(cmd.add_option("--normal-derivative", a.normal_derivative,
-                     "traces: reconstructed (consistent at x_i) or shifted (cell gradient normal_shift·h inside ω)"),
-      [&](fictus::ProblemSpec& s) { s.options.normal_derivative = fictus::parse_normal_derivative(a.normal_derivative); });
-  add(cmd.add_option("--normal-shift", o.normal_shift, "shifted rule: C_γ is taken this many cells h inside ω"),
-      [&](fictus::ProblemSpec& s) { s.options.normal_shift = o.normal_shift; });
-  add(cmd.add_option("--start", a.start, "Newton start: all (every point active) or zero (λ = 0)"),
-      [&](fictus::ProblemSpec& s) { s.options.start_all_active = a.start == "all"; });
-  add(cmd.add_option("--schur", a.schur, "inner solver: green (explicit Schur complement) or krylov (GMRES, paper)"),
-      [&](fictus::ProblemSpec& s) { s.options.inner = fictus::parse_inner_solver(a.schur); });
-  add(cmd.add_option("--krylov-tol", o.krylov_tolerance, "relative GMRES tolerance"),
-      [&](fictus::ProblemSpec& s) { s.options.krylov_tolerance = o.krylov_tolerance; });
-  add(cmd.add_option("--krylov-max-iterations", o.krylov_max_iterations, "GMRES operator applications per solve"),
-      [&](fictus::ProblemSpec& s) { s.options.krylov_max_iterations = o.krylov_max_iterations; });
-  add(cmd.add_option("--load-quadrature", o.load_quadrature, "Gauss points per direction for the load"),
-      [&](fictus::ProblemSpec& s) { s.options.load_quadrature = o.load_quadrature; });
-  add(cmd.add_option("--error-quadrature", o.error_quadrature, "Gauss points per direction for the errors"),
-      [&](fictus::ProblemSpec& s) { s.options.error_quadrature = o.error_quadrature; });
-  add(cmd.add_option("--newton-tol", o.newton_tolerance, "relative Newton residual tolerance"),
-      [&](fictus::ProblemSpec& s) { s.options.newton_tolerance = o.newton_tolerance; });
-  add(cmd.add_option("--max-newton", o.max_newton, "maximum Newton steps"),
-      [&](fictus::ProblemSpec& s) { s.options.max_newton = o.max_newton; });
-  add(cmd.add_option("--threads", o.threads, "threads for transforms and loops"),
-      [&](fictus::ProblemSpec& s) { s.options.threads = o.threads; });
-  CLI::Option* no_condition = cmd.add_flag("!--no-condition", o.condition_number, "skip the condition number of the Newton matrix");
-  if (overrides) overrides->items.emplace_back(no_condition, [&](fictus::ProblemSpec& s) { s.options.condition_number = false; });
-}
+bool formulation_or_solver(const fictus::OptionSpec& s) { return s.section == "formulation" || s.section == "solver"; }
 
 void print_summary(const fictus::Solution& s) {
   std::printf("N = %d (h = %.3g), n = %zu nodes, m = %d, variant %s, inner solver %s\n", s.grid.nx(), s.grid.h(),
@@ -110,15 +56,6 @@ void print_summary(const fictus::Solution& s) {
   std::printf("), peak memory %.1f MiB\n", s.peak_memory_bytes / 1048576.0);
 }
 
-void resolve(fictus::SolverOptions& o, const SolveArguments& a) {
-  o.variant = fictus::parse_variant(a.variant);
-  o.inner = fictus::parse_inner_solver(a.schur);
-  o.normal_derivative = fictus::parse_normal_derivative(a.normal_derivative);
-  if (a.start != "all" && a.start != "zero")
-    throw std::invalid_argument("solver.start: expected \"all\" or \"zero\", got \"" + a.start + "\"");
-  o.start_all_active = a.start == "all";
-}
-
 std::pair<int, int> parse_levels(const std::string& text) {
   static const std::regex pattern(R"((\d+)(?:-(\d+))?)");
   std::smatch match;
@@ -128,26 +65,29 @@ std::pair<int, int> parse_levels(const std::string& text) {
   return {a, b};
 }
 
-int run_solve(const fictus::SolverOptions& cli_options, const SolveArguments& args, const Overrides& overrides,
-              CLI::Option* out_option) {
+int run_solve(const std::string& problem_path, const fictus::cli::OptionFlags& flags, CLI::Option* out_option,
+              const std::string& out, const std::vector<std::string>& files, CLI::Option* files_option) {
   fictus::ProblemSpec spec;
-  if (!args.problem_path.empty()) {
-    spec = fictus::read_problem_file(args.problem_path);
+  if (!problem_path.empty()) {
+    spec = fictus::read_problem_file(problem_path);
   } else {
-    if (args.boundary != "dirichlet" && args.boundary != "periodic")
-      throw std::invalid_argument("domain.boundary: expected \"dirichlet\" or \"periodic\", got \"" + args.boundary + "\"");
-    spec.problem = fictus::paper_problem(
-        args.N, args.c, args.boundary == "periodic" ? fictus::Boundary::periodic : fictus::Boundary::dirichlet);
-    spec.options = cli_options;
-    resolve(spec.options, args);
-    // The paper's m and δ unless --m or --offset say otherwise (applied by the overrides below).
-    const fictus::SolverOptions paper = fictus::paper_options(args.N, spec.options.variant);
-    spec.options.multipliers = paper.multipliers;
-    spec.options.offset = paper.offset;
+    // The paper's problem, with its m and δ unless the flags say otherwise.
+    fictus::Problem given;
+    fictus::SolverOptions options;
+    flags.apply(given, options);
+    spec.problem = fictus::paper_problem(given.N, given.c, given.boundary);
+    spec.options = fictus::paper_options(given.N, options.variant);
   }
-  overrides.apply(spec);
-  if (out_option->count() > 0) spec.output.dir = args.out;
-  spec.options.validate();
+  flags.apply(spec.problem, spec.options);
+  fictus::validate_options(spec.problem, spec.options);
+  if (out_option->count() > 0) spec.output.dir = out;
+  if (files_option->count() > 0) {
+    for (const std::string& f : files)
+      if (std::find(fictus::output_file_names().begin(), fictus::output_file_names().end(), f) ==
+          fictus::output_file_names().end())
+        throw std::invalid_argument("output.files: unknown file \"" + f + "\" (results.json, points.csv, solution.vti, curves.vtp)");
+    spec.output.files = files;
+  }
   for (const std::string& w : spec.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
 
   const fictus::Problem& problem = spec.problem;
@@ -172,21 +112,30 @@ int run_solve(const fictus::SolverOptions& cli_options, const SolveArguments& ar
   return 0;
 }
 
+/// Runs the plot script with an argument vector (no shell: any folder name is safe).
 int run_plot(const std::string& folder) {
   if (!fs::is_directory(folder)) throw std::invalid_argument("plot: " + folder + " is not a folder");
-  const std::string command = std::string("'") + FICTUS_PYTHON + "' '" + FICTUS_PLOT_SCRIPT + "' '" + folder + "'";
-  const int status = std::system(command.c_str());
-  return status == 0 ? 0 : 1;
+  const pid_t child = fork();
+  if (child < 0) throw std::runtime_error("plot: cannot start " FICTUS_PYTHON);
+  if (child == 0) {
+    const char* argv[] = {FICTUS_PYTHON, FICTUS_PLOT_SCRIPT, folder.c_str(), nullptr};
+    execv(FICTUS_PYTHON, const_cast<char* const*>(argv));
+    std::fprintf(stderr, "fictus: error: plot: cannot run %s\n", FICTUS_PYTHON);
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(child, &status, 0) < 0)
+    if (errno != EINTR) return 2;
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? 0 : 1;
 }
 
-int run_reproduce(fictus::SolverOptions base, const SolveArguments& args, const std::string& table,
+int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out, const std::string& table,
                   const std::string& levels_text) {
   const auto [first, last] = parse_levels(levels_text);
   std::vector<fictus::Variant> variants;
   if (table == "1" || table == "both") variants.push_back(fictus::Variant::nonsmooth);
   if (table == "2" || table == "both") variants.push_back(fictus::Variant::smooth);
   if (variants.empty()) throw std::invalid_argument("--table: expected 1, 2 or both");
-  SolveArguments a = args;
   int status = 0;
   json summary;
   std::vector<std::pair<std::string, std::string>> files;
@@ -196,11 +145,9 @@ int run_reproduce(fictus::SolverOptions base, const SolveArguments& args, const 
     json levels = json::array();
     for (int level = first; level <= last; ++level) {
       const int N = 1 << level;
-      fictus::SolverOptions options = base;
-      a.variant = fictus::to_string(variant);
-      resolve(options, a);
-      options.multipliers = fictus::paper_multipliers(N);
-      const fictus::Problem problem = fictus::paper_problem(N);
+      fictus::Problem problem = fictus::paper_problem(N);
+      fictus::SolverOptions options = fictus::paper_options(N, variant);  // the paper's m and δ
+      flags.apply(problem, options);
       const fictus::Solution s = fictus::solve(problem, options);
       if (!s.newton.converged) {
         std::fprintf(stderr, "fictus: error: Newton did not converge at h = 1/%d: %s\n", N, s.newton.failure.c_str());
@@ -221,10 +168,10 @@ int run_reproduce(fictus::SolverOptions base, const SolveArguments& args, const 
     files.emplace_back("table" + std::to_string(number) + ".json", out.dump(2) + "\n");
     files.emplace_back("table" + std::to_string(number) + ".csv", fictus::cli::levels_csv(rows));
   }
-  if (!args.out.empty()) {
-    fs::create_directories(args.out);
-    for (const auto& [name, text] : files) fictus::cli::write_atomically(fs::path(args.out) / name, text);
-    std::printf("wrote %zu files to %s/\n", files.size(), args.out.c_str());
+  if (!out.empty()) {
+    fs::create_directories(out);
+    for (const auto& [name, text] : files) fictus::cli::write_atomically(fs::path(out) / name, text);
+    std::printf("wrote %zu files to %s/\n", files.size(), out.c_str());
   }
   return status;
 }
@@ -236,92 +183,95 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string(FICTUS_VERSION));
 
-  fictus::SolverOptions solve_options;
-  SolveArguments solve_args;
-  Overrides overrides;
+  // solve: every option of options.hpp as --key; without a file the paper's problem.
+  std::string problem_path, out = "results/solve";
+  std::vector<std::string> files;
+  fictus::cli::OptionFlags solve_flags;
   CLI::App* solve_cmd = app.add_subcommand("solve", "solve a problem file, or the paper's problem without one");
-  solve_cmd->add_option("problem", solve_args.problem_path, "problem file (TOML, see docs/problem_files.md)")
-      ->check(CLI::ExistingFile);
-  solve_args.out = "results/solve";
+  solve_cmd->add_option("problem", problem_path, "problem file (TOML, see docs/problem_files.md)")->check(CLI::ExistingFile);
   CLI::Option* out_option =
-      solve_cmd->add_option("--out", solve_args.out, "folder for the output files (\"\": none; default: output.dir)")
-          ->capture_default_str();
-  overrides.items.emplace_back(
-      solve_cmd->add_option("--N", solve_args.N, "cells along x (h = (x1 - x0)/N)")->capture_default_str(),
-      [&](fictus::ProblemSpec& s) { s.problem.N = solve_args.N; });
-  overrides.items.emplace_back(
-      solve_cmd->add_option("--c", solve_args.c, "reaction coefficient c >= 0 (paper's problem: f = -Δu_ex + c·u_ex follows)")
-          ->capture_default_str(),
-      [&](fictus::ProblemSpec& s) { s.problem.c = solve_args.c; });
-  overrides.items.emplace_back(
-      solve_cmd->add_option("--boundary", solve_args.boundary,
-                            "box conditions: dirichlet, or periodic (c = 0 allowed: singular A, bordered Newton)")
-          ->capture_default_str(),
-      [&](fictus::ProblemSpec& s) {
-        if (solve_args.boundary != "dirichlet" && solve_args.boundary != "periodic")
-          throw std::invalid_argument("domain.boundary: expected \"dirichlet\" or \"periodic\"");
-        s.problem.boundary = solve_args.boundary == "periodic" ? fictus::Boundary::periodic : fictus::Boundary::dirichlet;
-      });
-  add_solver_options(*solve_cmd, solve_options, solve_args, &overrides);
-  overrides.items.emplace_back(
-      solve_cmd->add_option("--files", solve_args.files, "output files, comma-separated (results.json,points.csv,solution.vti,curves.vtp)")
-          ->delimiter(','),
-      [&](fictus::ProblemSpec& s) {
-        for (const std::string& f : solve_args.files)
-          if (std::find(fictus::output_file_names().begin(), fictus::output_file_names().end(), f) ==
-              fictus::output_file_names().end())
-            throw std::invalid_argument("output.files: unknown file \"" + f + "\"");
-        s.output.files = solve_args.files;
-      });
+      solve_cmd->add_option("--out", out, "output.dir: folder for the output files (\"\": none)")->capture_default_str();
+  solve_cmd->add_option("--dir", out, "alias of --out")->group("");
+  CLI::Option* files_option =
+      solve_cmd->add_option("--files", files, "output.files, comma-separated: results.json,points.csv,solution.vti,curves.vtp")
+          ->delimiter(',')
+          ->allow_extra_args(false);
+  const std::map<std::string, std::string> paper_note = {
+      {"multipliers", "without a problem file: the paper's m"}, {"offset", "without a problem file: 1 (the paper's δ = L/m)"}};
+  solve_flags.add(*solve_cmd, [](const fictus::OptionSpec&) { return true; }, paper_note);
 
   std::string plot_dir;
   CLI::App* plot_cmd = app.add_subcommand("plot", "PNG plots of the results in a folder (matplotlib)");
   plot_cmd->add_option("dir", plot_dir, "folder written by solve or reproduce")->required();
 
-  fictus::SolverOptions reproduce_options = fictus::paper_options(128, fictus::Variant::smooth);  // the paper's δ = L/m
-  SolveArguments reproduce_args;
-  std::string table = "both", levels = "7-12";
+  // reproduce: the paper's problem at each level, its m and δ; the other options as flags.
+  std::string table = "both", levels = "7-12", reproduce_out;
+  fictus::cli::OptionFlags reproduce_flags;
   CLI::App* reproduce_cmd = app.add_subcommand("reproduce", "reproduce the paper's Table 1 and/or Table 2");
   reproduce_cmd->add_option("--table", table, "1 (non-smooth), 2 (smooth) or both")->capture_default_str();
   reproduce_cmd->add_option("--levels", levels, "levels A-B, h = 2^-level")->capture_default_str();
-  reproduce_cmd->add_option("--out", reproduce_args.out, "write table<k>.json and table<k>.csv here");
-  reproduce_cmd->add_option("--schur", reproduce_args.schur, "inner solver: green or krylov")->capture_default_str();
-  reproduce_cmd->add_option("--threads", reproduce_options.threads, "threads")->capture_default_str();
-  reproduce_cmd->add_option("--offset", reproduce_options.offset, "smooth variant: δ in units of L/m")
-      ->capture_default_str();
-  reproduce_cmd->add_option("--normal-derivative", reproduce_args.normal_derivative, "reconstructed or shifted")
-      ->capture_default_str();
-  reproduce_cmd->add_option("--normal-shift", reproduce_options.normal_shift, "shifted rule: C_γ shift in cells")
-      ->capture_default_str();
+  reproduce_cmd->add_option("--out", reproduce_out, "write table<k>.json and table<k>.csv here");
+  reproduce_flags.add(*reproduce_cmd, [](const fictus::OptionSpec& s) {
+    return formulation_or_solver(s) && s.key != "variant" && s.key != "multipliers";
+  }, {{"offset", "here: 1 (the paper's δ = L/m)"}});
 
-  // The paper's problem: its δ = L/m, and its m unless --m is given (0 is resolved per N in run_sweep).
-  fictus::SolverOptions sweep_options = fictus::paper_options(128, fictus::Variant::smooth);
-  sweep_options.multipliers = 0;
-  SolveArguments sweep_solver_args;
+  // sweep: the paper's problem on one grid; its m unless --multipliers is given.
+  fictus::cli::OptionFlags sweep_flags;
   fictus::cli::SweepArguments sweep_args;
   CLI::App* sweep_cmd = app.add_subcommand(
       "sweep", "solve a family of problems on one grid (paper's problem; g scaled, or the curve rotated or moved)");
-  sweep_cmd->add_option("--N", sweep_args.N, "cells per side")->capture_default_str();
   sweep_cmd->add_option("--g-scale", sweep_args.g_scale, "obstacle factors: a,b,c or start:stop:count");
   sweep_cmd->add_option("--rotate", sweep_args.rotate, "rotations of γ about its center [rad]: a,b,c or start:stop:count");
   sweep_cmd->add_option("--move", sweep_args.move, "shifts of γ along x: a,b,c or start:stop:count");
   sweep_cmd->add_flag("--field", sweep_args.field, "also compute the grid field û for every problem");
   sweep_cmd->add_option("--out", sweep_args.out, "write sweep.csv here (\"\": none)")->capture_default_str();
-  add_solver_options(*sweep_cmd, sweep_options, sweep_solver_args);
-  sweep_options.condition_number = false;
+  sweep_flags.add(*sweep_cmd, [](const fictus::OptionSpec& s) { return s.section != "data" && s.key != "box"; },
+                  {{"multipliers", "here: the paper's m"}, {"offset", "here: 1 (the paper's δ = L/m)"},
+                   {"condition_number", "here: false"}});
+
+  CLI::App* options_cmd = app.add_subcommand("options", "list every option: key, default, allowed values, meaning");
+  bool markdown = false, as_json = false;
+  options_cmd->add_flag("--markdown", markdown, "as the Markdown table of docs/problem_files.md");
+  options_cmd->add_flag("--json", as_json, "as JSON: section, key, type, default, allowed values, meaning, aliases");
 
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --version
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "fictus: error: %s (see fictus --help)\n", e.what());
+    return 1;
   }
   try {
-    if (*solve_cmd) return run_solve(solve_options, solve_args, overrides, out_option);
+    if (*solve_cmd) return run_solve(problem_path, solve_flags, out_option, out, files, files_option);
     if (*plot_cmd) return run_plot(plot_dir);
-    if (*reproduce_cmd) return run_reproduce(reproduce_options, reproduce_args, table, levels);
+    if (*reproduce_cmd) return run_reproduce(reproduce_flags, reproduce_out, table, levels);
     if (*sweep_cmd) {
-      resolve(sweep_options, sweep_solver_args);
-      return fictus::cli::run_sweep(sweep_args, sweep_options);
+      fictus::Problem problem;
+      fictus::SolverOptions options = fictus::paper_options(problem.N, fictus::Variant::smooth);
+      options.multipliers = 0;  // the paper's m at the sweep's N (run_sweep)
+      options.condition_number = false;
+      sweep_flags.apply(problem, options);
+      sweep_args.N = problem.N;
+      sweep_args.c = problem.c;
+      sweep_args.boundary = problem.boundary;
+      return fictus::cli::run_sweep(sweep_args, options);
+    }
+    if (*options_cmd) {
+      if (markdown) {
+        std::printf("%s", fictus::options_markdown().c_str());
+      } else if (as_json) {
+        std::printf("%s\n", fictus::cli::options_schema_json().dump(1).c_str());
+      } else {
+        for (const fictus::OptionSpec& s : fictus::option_specs())
+          std::printf("%-34s %-18s %s\n    %s\n", s.name().c_str(), fictus::option_text(s, s.default_value()).c_str(),
+                      s.rule.c_str(), s.meaning.c_str());
+      }
+      return 0;
     }
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "fictus: error: %s\n", e.what());

@@ -5,39 +5,39 @@
 #include <sstream>
 #include <stdexcept>
 #include <unistd.h>
+#include <variant>
+
+#include "fictus/options.hpp"
 
 namespace fictus::cli {
 
 using nlohmann::json;
 
-json options_to_json(const SolverOptions& o) {
-  return json{{"variant", to_string(o.variant)},
-              {"multipliers", o.multipliers},
-              {"offset", o.offset},
-              {"rho", o.rho},
-              {"normal_derivative", to_string(o.normal_derivative)},
-              {"normal_shift", o.normal_shift},
-              {"start", o.start_all_active ? "all" : "zero"},
-              {"schur", to_string(o.inner)},
-              {"krylov_tolerance", o.krylov_tolerance},
-              {"krylov_max_iterations", o.krylov_max_iterations},
-              {"newton_tolerance", o.newton_tolerance},
-              {"max_newton", o.max_newton},
-              {"load_quadrature", o.load_quadrature},
-              {"error_quadrature", o.error_quadrature},
-              {"condition_number", o.condition_number},
-              {"threads", o.threads}};
+json options_to_json(const Problem& problem, const SolverOptions& options) {
+  json j = json::object();
+  for (const OptionSpec& spec : option_specs())
+    std::visit([&](const auto& v) { j[spec.key] = v; }, spec.get(problem, options));
+  return j;
+}
+
+json options_schema_json() {
+  static const char* const types[] = {"boolean", "integer", "number", "choice", "numbers"};
+  json list = json::array();
+  for (const OptionSpec& spec : option_specs()) {
+    json j{{"section", spec.section}, {"key", spec.key},     {"type", types[int(spec.type)]},
+           {"rule", spec.rule},       {"meaning", spec.meaning}, {"aliases", spec.aliases}};
+    std::visit([&](const auto& v) { j["default"] = v; }, spec.default_value());
+    if (spec.type == OptionType::choice) j["choices"] = spec.choices;
+    list.push_back(j);
+  }
+  return list;
 }
 
 json solution_to_json(const Problem& problem, const Solution& s) {
   json j;
   j["version"] = FICTUS_VERSION;
   j["problem"] = problem.name;
-  j["options"] = options_to_json(s.options);
-  j["options"]["N"] = problem.N;
-  j["options"]["c"] = problem.c;
-  j["options"]["box"] = {problem.box.x0, problem.box.x1, problem.box.y0, problem.box.y1};
-  j["options"]["boundary"] = problem.boundary == Boundary::periodic ? "periodic" : "dirichlet";
+  j["options"] = options_to_json(problem, s.options);
   j["alpha"] = s.alpha;
   j["grid"] = {{"N", s.grid.nx()}, {"Ny", s.grid.ny()}, {"h", s.grid.h()}, {"n_nodes", s.grid.n_nodes()},
                {"n_unknowns", s.grid.n_unknowns()}};

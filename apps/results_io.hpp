@@ -13,7 +13,10 @@
 
 namespace fictus::cli {
 
-nlohmann::json options_to_json(const SolverOptions& options);
+/// Every option of options.hpp in effect, by key (results.json's `options`).
+nlohmann::json options_to_json(const Problem& problem, const SolverOptions& options);
+/// The option descriptions (`fictus options --json`).
+nlohmann::json options_schema_json();
 nlohmann::json solution_to_json(const Problem& problem, const Solution& solution);
 LevelResult level_result(const Solution& solution);
 

@@ -49,7 +49,7 @@ int run_sweep(const SweepArguments& args, SolverOptions options) {
   const std::vector<double> values = parse_values(
       !args.g_scale.empty() ? args.g_scale : !args.rotate.empty() ? args.rotate : args.move, "--" + parameter);
 
-  const Problem base = paper_problem(args.N);
+  const Problem base = paper_problem(args.N, args.c, args.boundary);
   if (options.multipliers == 0) options.multipliers = paper_multipliers(args.N);
   FictitiousDomainSolver solver(base, options.threads, options.load_quadrature);
   std::ostringstream csv;

@@ -7,7 +7,9 @@
 namespace fictus::cli {
 
 struct SweepArguments {
-  int N = 1024;
+  int N = 256;
+  double c = 1.0;
+  Boundary boundary = Boundary::dirichlet;
   std::string g_scale, rotate, move;  // lists "a,b,c" or "start:stop:count"
   bool field = false;                 // also compute û (one fast solve per problem)
   std::string out = "results/sweep";

@@ -15,6 +15,7 @@
 
 #include "bindings.hpp"
 #include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/options.hpp"
 #include "fictus/paper_problem.hpp"
 #include "fictus/problem_file.hpp"
 #include "python_problem.hpp"
@@ -25,18 +26,11 @@ namespace fictus::python {
 
 namespace {
 
-/// Where each flat keyword goes.
+/// Where each flat keyword goes: the section of its option (options.hpp), or [data] for the data.
 const char* section_of(const std::string& key) {
-  static const std::map<std::string, const char*> sections = {
-      {"N", "domain"}, {"box", "domain"}, {"boundary", "domain"},
-      {"variant", "formulation"}, {"multipliers", "formulation"}, {"offset", "formulation"}, {"rho", "formulation"},
-      {"normal_derivative", "formulation"}, {"normal_shift", "formulation"},
-      {"c", "data"}, {"f", "data"}, {"g", "data"}, {"exact", "data"},
-      {"schur", "solver"}, {"krylov_tolerance", "solver"}, {"krylov_max_iterations", "solver"},
-      {"newton_tolerance", "solver"}, {"max_newton", "solver"}, {"start", "solver"}, {"threads", "solver"},
-      {"load_quadrature", "solver"}, {"error_quadrature", "solver"}, {"condition_number", "solver"}};
-  const auto it = sections.find(key);
-  return it == sections.end() ? nullptr : it->second;
+  if (key == "f" || key == "g" || key == "exact") return "data";
+  const OptionSpec* spec = find_option(key);
+  return spec ? spec->section.c_str() : nullptr;
 }
 
 void insert(toml::table& table, const std::string& key, py::handle value, const std::string& where);
@@ -144,9 +138,11 @@ PyProblem PyProblem::from_config(py::dict config) {
 
 PyProblem PyProblem::paper(int N, double c, const std::string& boundary, py::dict options) {
   PyProblem p;
-  if (boundary != "dirichlet" && boundary != "periodic")
-    throw std::invalid_argument("domain.boundary: expected \"dirichlet\" or \"periodic\"");
-  p.spec.problem = paper_problem(N, c, boundary == "periodic" ? Boundary::periodic : Boundary::dirichlet);
+  Problem given;  // N, c and the box conditions through the options' checks
+  set_option(*find_option("N"), given, p.spec.options, std::int64_t(N));
+  set_option(*find_option("c"), given, p.spec.options, c);
+  set_option(*find_option("boundary"), given, p.spec.options, boundary);
+  p.spec.problem = paper_problem(given.N, given.c, given.boundary);
   // Options through the same reader: a minimal file around them.
   if (!options.empty()) {
     py::dict config;
@@ -193,7 +189,8 @@ void bind_problem(py::module_& m) {
                   [](int N, double c, const std::string& boundary, py::kwargs options) {
                     return PyProblem::paper(N, c, boundary, options);
                   },
-                  py::arg("N") = 256, py::arg("c") = 1.0, py::arg("boundary") = "dirichlet")
+                  py::arg("N") = Problem{}.N, py::arg("c") = Problem{}.c,
+                  py::arg("boundary") = std::string(to_string(Problem{}.boundary)))
       .def_property_readonly("N", [](const PyProblem& p) { return p.spec.problem.N; })
       .def_property_readonly("warnings", [](const PyProblem& p) { return p.spec.warnings; })
       .def("solve", &PyProblem::solve, py::arg("field") = true,

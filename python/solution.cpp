@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "bindings.hpp"
+#include "fictus/options.hpp"
 #include "fictus/fictitious_domain_solver.hpp"
 #include "python_problem.hpp"
 
@@ -53,24 +54,11 @@ py::array_t<double> pairs_view(const std::vector<double>& v, py::handle owner) {
                              {py::ssize_t(2 * sizeof(double)), py::ssize_t(sizeof(double))}, v.data(), owner);
 }
 
-py::dict options_dict(const SolverOptions& o) {
+/// Every option of options.hpp in effect, by key (as results.json's `options`).
+py::dict options_dict(const Problem& problem, const SolverOptions& o) {
   py::dict d;
-  d["variant"] = to_string(o.variant);
-  d["multipliers"] = o.multipliers;
-  d["offset"] = o.offset;
-  d["rho"] = o.rho;
-  d["normal_derivative"] = to_string(o.normal_derivative);
-  d["normal_shift"] = o.normal_shift;
-  d["start"] = o.start_all_active ? "all" : "zero";
-  d["schur"] = to_string(o.inner);
-  d["krylov_tolerance"] = o.krylov_tolerance;
-  d["krylov_max_iterations"] = o.krylov_max_iterations;
-  d["newton_tolerance"] = o.newton_tolerance;
-  d["max_newton"] = o.max_newton;
-  d["load_quadrature"] = o.load_quadrature;
-  d["error_quadrature"] = o.error_quadrature;
-  d["condition_number"] = o.condition_number;
-  d["threads"] = o.threads;
+  for (const OptionSpec& spec : option_specs())
+    std::visit([&](const auto& v) { d[py::str(spec.key)] = py::cast(v); }, spec.get(problem, o));
   return d;
 }
 
@@ -185,7 +173,7 @@ void bind_solution(py::module_& m) {
                              })
       .def_property_readonly("options",
                              [](const PySolution& p) {
-                               py::dict d = options_dict(p.s().options);
+                               py::dict d = options_dict(p.problem(), p.s().options);
                                d["N"] = p.problem().N;
                                d["c"] = p.problem().c;
                                d["boundary"] = p.problem().boundary == Boundary::periodic ? "periodic" : "dirichlet";

@@ -15,49 +15,11 @@
 #include "fictus/green_table.hpp"
 #include "fictus/kink_correction.hpp"
 #include "fictus/load_vector.hpp"
+#include "fictus/options.hpp"
 #include "fictus/trace_operators.hpp"
 
 namespace fictus {
 
-const char* to_string(Variant v) { return v == Variant::smooth ? "smooth" : "nonsmooth"; }
-const char* to_string(InnerSolver s) { return s == InnerSolver::green ? "green" : "krylov"; }
-const char* to_string(NormalDerivative d) { return d == NormalDerivative::shifted ? "shifted" : "reconstructed"; }
-
-Variant parse_variant(const std::string& text) {
-  if (text == "smooth") return Variant::smooth;
-  if (text == "nonsmooth" || text == "non-smooth") return Variant::nonsmooth;
-  throw std::invalid_argument("formulation.variant: expected \"smooth\" or \"nonsmooth\", got \"" + text + "\"");
-}
-
-NormalDerivative parse_normal_derivative(const std::string& text) {
-  if (text == "reconstructed") return NormalDerivative::reconstructed;
-  if (text == "shifted") return NormalDerivative::shifted;
-  throw std::invalid_argument("formulation.normal_derivative: expected \"reconstructed\" or \"shifted\", got \"" + text +
-                              "\"");
-}
-
-InnerSolver parse_inner_solver(const std::string& text) {
-  if (text == "green") return InnerSolver::green;
-  if (text == "krylov") return InnerSolver::krylov;
-  throw std::invalid_argument("solver.schur: expected \"green\" or \"krylov\", got \"" + text + "\"");
-}
-
-void SolverOptions::validate() const {
-  auto require = [](bool ok, const std::string& message) {
-    if (!ok) throw std::invalid_argument(message);
-  };
-  require(multipliers >= 0, "formulation.multipliers: must be >= 0 (0 = default rule)");
-  require(std::isfinite(offset) && offset > 0, "formulation.offset: must be > 0");
-  require(std::isfinite(rho) && rho > 0, "formulation.rho: must be > 0");
-  require(std::isfinite(normal_shift) && normal_shift >= 0, "formulation.normal_shift: must be >= 0");
-  require(krylov_tolerance > 0 && krylov_tolerance < 1, "solver.krylov_tolerance: must be in (0, 1)");
-  require(krylov_max_iterations >= 1, "solver.krylov_max_iterations: must be >= 1");
-  require(newton_tolerance > 0 && newton_tolerance < 1, "solver.newton_tolerance: must be in (0, 1)");
-  require(max_newton >= 1, "solver.max_newton: must be >= 1");
-  require(load_quadrature >= 1 && load_quadrature <= 8, "solver.load_quadrature: must be in 1..8");
-  require(error_quadrature >= 1 && error_quadrature <= 12, "solver.error_quadrature: must be in 1..12");
-  require(threads >= 1, "solver.threads: must be >= 1");
-}
 
 double Timings::operator[](const std::string& name) const {
   for (const auto& [phase, seconds] : phases)
@@ -189,8 +151,7 @@ std::optional<IndependentCheck> independent_check(const CurveSetup& setup, const
 }  // namespace
 
 FictitiousDomainSolver::FictitiousDomainSolver(const Problem& problem, int threads, int load_quadrature) {
-  if (problem.N < 8) throw std::invalid_argument("domain.N: need N >= 8, got " + std::to_string(problem.N));
-  if (!(problem.c >= 0) || !std::isfinite(problem.c)) throw std::invalid_argument("data.c: must be finite and >= 0");
+  validate_options(problem, SolverOptions{});
   if (!problem.f && !problem.f_vectorized) throw std::invalid_argument("data.f: not given");
   if (threads < 1) throw std::invalid_argument("solver.threads: must be >= 1");
   Grid grid(problem.box, problem.N, problem.boundary);

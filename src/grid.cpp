@@ -6,6 +6,8 @@
 
 namespace fictus {
 
+const char* to_string(Boundary b) { return b == Boundary::periodic ? "periodic" : "dirichlet"; }
+
 Grid::Grid(const Box& box, int nx, Boundary boundary) : box_(box), boundary_(boundary), nx_(nx) {
   if (!(box.x1 > box.x0) || !(box.y1 > box.y0))
     throw std::invalid_argument("domain.box: need x0 < x1 and y0 < y1");

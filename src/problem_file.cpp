@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "fictus/expression.hpp"
+#include "fictus/options.hpp"
 #include "fictus/shapes.hpp"
 
 namespace fictus {
@@ -82,6 +83,12 @@ class TableReader {
     if (!n->is_array()) fail(key(k), std::string("expected an array, got ") + type_name(*n));
     return n->as_array();
   }
+  /// The schema's options of this section that the table gives, set into (problem, options).
+  void read_options(Problem& problem, SolverOptions& options) {
+    for (const OptionSpec& spec : option_specs())
+      if (spec.section == name_)
+        if (const toml::node* n = node(spec.key)) set_option(spec, problem, options, value_of(spec, *n));
+  }
   /// Throws for the first key that was never read.
   void finish() const {
     if (!table_) return;
@@ -93,6 +100,21 @@ class TableReader {
   const toml::node* node(const std::string& k) {
     used_.insert(k);
     return table_ ? table_->get(k) : nullptr;
+  }
+  static OptionValue value_of(const OptionSpec& spec, const toml::node& n) {
+    if (n.is_boolean()) return *n.value<bool>();
+    if (n.is_integer()) return std::int64_t(*n.value<int64_t>());
+    if (n.is_floating_point()) return *n.value<double>();
+    if (n.is_string()) return *n.value<std::string>();
+    if (const toml::array* a = n.as_array()) {
+      std::vector<double> list;
+      for (const toml::node& e : *a) {
+        if (!e.is_number()) fail(spec.name(), std::string("expected an array of numbers, got ") + type_name(e) + " in it");
+        list.push_back(*e.value<double>());
+      }
+      return list;
+    }
+    fail(spec.name(), std::string("unsupported value: ") + type_name(n));
   }
   static const char* type_name(const toml::node& n) {
     switch (n.type()) {
@@ -195,13 +217,7 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
   SolverOptions& o = spec.options;
 
   TableReader domain(subtable(root, "domain"), "domain");
-  const auto box = domain.numbers("box", 4, {0.0, 1.0, 0.0, 1.0});
-  p.box = Box{box[0], box[1], box[2], box[3]};
-  if (!(p.box.x1 > p.box.x0 && p.box.y1 > p.box.y0)) fail("domain.box", "need x0 < x1 and y0 < y1");
-  p.N = domain.integer("N", 256);
-  const std::string boundary = domain.string("boundary", "dirichlet");
-  if (boundary != "dirichlet" && boundary != "periodic") fail("domain.boundary", "expected \"dirichlet\" or \"periodic\"");
-  p.boundary = boundary == "periodic" ? Boundary::periodic : Boundary::dirichlet;
+  domain.read_options(p, o);
   domain.finish();
 
   const toml::table* geometry_table = subtable(root, "geometry");
@@ -211,17 +227,11 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
   geometry.finish();
 
   TableReader formulation(subtable(root, "formulation"), "formulation");
-  o.variant = parse_variant(formulation.string("variant", "smooth"));
-  o.multipliers = formulation.integer("multipliers", 0);
-  o.offset = formulation.number("offset", o.offset);
-  o.rho = formulation.number("rho", o.rho);
-  o.normal_derivative = parse_normal_derivative(formulation.string("normal_derivative", to_string(o.normal_derivative)));
-  o.normal_shift = formulation.number("normal_shift", o.normal_shift);
+  formulation.read_options(p, o);
   formulation.finish();
 
   TableReader data(subtable(root, "data"), "data");
-  p.c = data.number("c", 1.0);
-  if (p.c < 0) fail("data.c", "must be >= 0");
+  data.read_options(p, o);
   const Expression f(data.required_string("f"), {"x", "y"}, "data.f");
   p.f = [f](double x, double y) { return f({x, y}); };
   const Expression g(data.required_string("g"), {"x", "y", "phi", "s"}, "data.g");
@@ -236,20 +246,9 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
   data.finish();
 
   TableReader solver(subtable(root, "solver"), "solver");
-  o.inner = parse_inner_solver(solver.string("schur", "green"));
-  o.krylov_tolerance = solver.number("krylov_tolerance", o.krylov_tolerance);
-  o.krylov_max_iterations = solver.integer("krylov_max_iterations", o.krylov_max_iterations);
-  o.newton_tolerance = solver.number("newton_tolerance", o.newton_tolerance);
-  o.max_newton = solver.integer("max_newton", o.max_newton);
-  const std::string start = solver.string("start", "all");
-  if (start != "all" && start != "zero") fail("solver.start", "expected \"all\" or \"zero\"");
-  o.start_all_active = start == "all";
-  o.threads = solver.integer("threads", o.threads);
-  o.load_quadrature = solver.integer("load_quadrature", o.load_quadrature);
-  o.error_quadrature = solver.integer("error_quadrature", o.error_quadrature);
-  o.condition_number = solver.boolean("condition_number", o.condition_number);
+  solver.read_options(p, o);
   solver.finish();
-  o.validate();
+  validate_options(p, o);
 
   TableReader output(subtable(root, "output"), "output");
   spec.output.dir = output.string("dir", spec.output.dir);

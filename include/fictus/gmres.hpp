@@ -7,11 +7,13 @@
 
 #include <Eigen/Dense>
 
+#include "fictus/solver_options.hpp"
+
 namespace fictus {
 
 struct GmresOptions {
-  double relative_tolerance = 1e-10;  // ‖b − Ax‖ ≤ tol·‖b‖
-  int max_iterations = 2000;          // operator applications
+  double relative_tolerance = SolverOptions{}.krylov_tolerance;  // ‖b − Ax‖ ≤ tol·‖b‖
+  int max_iterations = SolverOptions{}.krylov_max_iterations;    // operator applications
   int restart = 400;
 };
 

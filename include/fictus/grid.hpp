@@ -29,6 +29,7 @@ struct Box {
 };
 
 enum class Boundary { dirichlet, periodic };
+const char* to_string(Boundary b);
 
 class Grid {
  public:

@@ -17,14 +17,16 @@
 #include <Eigen/Dense>
 
 #include "fictus/schur_complement.hpp"
+#include "fictus/solver_options.hpp"
 
 namespace fictus {
 
+/// The Newton part of SolverOptions (its defaults).
 struct NewtonOptions {
-  double rho = 1.0;            // ρ > 0 of the projection
-  int max_iterations = 50;     // linear solves
-  bool start_all_active = true;
-  double tolerance = 1e-9;     // ‖F‖∞ ≤ tolerance · max(‖b‖∞, ‖c‖∞, ‖g‖∞)
+  double rho = SolverOptions{}.rho;                       // ρ > 0 of the projection
+  int max_iterations = SolverOptions{}.max_newton;        // linear solves
+  bool start_all_active = SolverOptions{}.start_all_active;
+  double tolerance = SolverOptions{}.newton_tolerance;    // ‖F‖∞ ≤ tolerance · max(‖b‖∞, ‖c‖∞, ‖g‖∞)
 };
 
 struct NewtonStep {

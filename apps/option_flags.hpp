@@ -1,0 +1,37 @@
+#pragma once
+// The options of options.hpp as command-line flags: `--key VALUE` for every key (the problem file's
+// name), with `--key-with-dashes` and older names as hidden aliases. Values are kept as text and
+// applied through the same checks as the problem file's.
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "fictus/options.hpp"
+
+namespace fictus::cli {
+
+class OptionFlags {
+ public:
+  /// Adds a flag for every option that `include` accepts. `note` is appended to the help of the keys
+  /// it names (e.g. the defaults that differ without a problem file).
+  void add(CLI::App& command, const std::function<bool(const OptionSpec&)>& include,
+           const std::map<std::string, std::string>& note = {});
+  /// Sets every option given on the command line into (problem, options); throws naming the key.
+  void apply(Problem& problem, SolverOptions& options) const;
+  bool given(const std::string& key) const;
+
+ private:
+  struct Flag {
+    const OptionSpec* spec;
+    std::vector<CLI::Option*> options;  // the flag and its aliases
+  };
+  std::vector<Flag> flags_;
+  std::map<std::string, std::string> text_;  // key → value as typed
+  bool no_condition_ = false;
+  CLI::Option* no_condition_flag_ = nullptr;
+};
+
+}  // namespace fictus::cli

@@ -1,0 +1,393 @@
+#include "fictus/options.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+namespace fictus {
+
+namespace {
+
+/// The shortest text that reads back as v ("1e-10", "1e12", "0.75"), marked as a number ("1.0").
+std::string format_number(double v) {
+  char buffer[32];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buffer, sizeof buffer, "%.*g", digits, v);
+    if (std::strtod(buffer, nullptr) == v) break;
+  }
+  if (v == std::floor(v) && std::abs(v) < 1e6) std::snprintf(buffer, sizeof buffer, "%.0f", v);  // 100, not 1e+02
+  std::string text = buffer;
+  if (const auto e = text.find("e+"); e != std::string::npos) text.erase(e + 1, 1);
+  if (text.find_first_of(".en") == std::string::npos) text += ".0";  // a number, not an integer
+  return text;
+}
+
+std::string quoted_list(const std::vector<std::string>& names) {
+  std::string text;
+  for (std::size_t k = 0; k < names.size(); ++k) text += (k ? (k + 1 == names.size() ? " or " : ", ") : "") + ("\"" + names[k] + "\"");
+  return text;
+}
+
+/// A member of SolverOptions or Problem, read and written through the value's alternative.
+template <class T, class Owner>
+OptionSpec member(std::string section, std::string key, OptionType type, T Owner::*field, std::string meaning) {
+  OptionSpec spec;
+  spec.section = std::move(section);
+  spec.key = std::move(key);
+  spec.type = type;
+  spec.meaning = std::move(meaning);
+  spec.get = [field](const Problem& p, const SolverOptions& o) -> OptionValue {
+    const Owner* owner;
+    if constexpr (std::is_same_v<Owner, Problem>) owner = &p, (void)o;
+    else owner = &o, (void)p;
+    if constexpr (std::is_same_v<T, int>) return std::int64_t(owner->*field);
+    else return owner->*field;
+  };
+  spec.set = [field](Problem& p, SolverOptions& o, const OptionValue& v) {
+    Owner* owner;
+    if constexpr (std::is_same_v<Owner, Problem>) owner = &p, (void)o;
+    else owner = &o, (void)p;
+    if constexpr (std::is_same_v<T, int>) owner->*field = int(std::get<std::int64_t>(v));
+    else owner->*field = std::get<T>(v);
+  };
+  return spec;
+}
+
+OptionSpec integer(std::string section, std::string key, int SolverOptions::*field, std::int64_t lo, std::int64_t hi,
+                   std::string meaning) {
+  OptionSpec s = member(std::move(section), std::move(key), OptionType::integer, field, std::move(meaning));
+  s.rule = "in " + std::to_string(lo) + " … " + std::to_string(hi);
+  s.violation = [lo, hi](const OptionValue& v) {
+    const std::int64_t i = std::get<std::int64_t>(v);
+    return i < lo || i > hi ? "must be in " + std::to_string(lo) + " … " + std::to_string(hi) + ", got " + std::to_string(i)
+                            : std::string();
+  };
+  return s;
+}
+
+/// A number in an interval; `open_low`/`open_high` exclude the end.
+template <class Owner>
+OptionSpec number(std::string section, std::string key, double Owner::*field, double lo, bool open_low, double hi,
+                  bool open_high, std::string meaning) {
+  OptionSpec s = member(std::move(section), std::move(key), OptionType::number, field, std::move(meaning));
+  const std::string lo_text = format_number(lo), hi_text = std::isinf(hi) ? "∞" : format_number(hi);
+  if (std::isinf(hi)) s.rule = open_low ? "> " + lo_text : ">= " + lo_text;
+  else s.rule = std::string("in ") + (open_low ? "(" : "[") + lo_text + ", " + hi_text + (open_high ? ")" : "]");
+  const std::string rule = s.rule;
+  s.violation = [=](const OptionValue& v) {
+    const double x = std::get<double>(v);
+    const bool ok = std::isfinite(x) && (open_low ? x > lo : x >= lo) && (open_high ? x < hi : x <= hi);
+    return ok ? std::string() : "must be " + rule + ", got " + format_number(x);
+  };
+  return s;
+}
+
+/// A choice stored as an enum: names[k] ↔ values[k] (later names are accepted spellings).
+template <class Enum, class Owner>
+OptionSpec choice(std::string section, std::string key, Enum Owner::*field, std::vector<std::string> names,
+                  std::vector<Enum> values, std::string meaning) {
+  OptionSpec s;
+  s.section = std::move(section);
+  s.key = std::move(key);
+  s.type = OptionType::choice;
+  s.meaning = std::move(meaning);
+  s.choices = names;
+  s.get = [=](const Problem& p, const SolverOptions& o) -> OptionValue {
+    Enum e;
+    if constexpr (std::is_same_v<Owner, Problem>) e = p.*field, (void)o;
+    else e = o.*field, (void)p;
+    for (std::size_t k = 0; k < values.size(); ++k)
+      if (values[k] == e) return names[k];
+    return std::string("?");
+  };
+  s.set = [=](Problem& p, SolverOptions& o, const OptionValue& v) {
+    const auto k = std::size_t(std::find(names.begin(), names.end(), std::get<std::string>(v)) - names.begin());
+    if constexpr (std::is_same_v<Owner, Problem>) p.*field = values[k], (void)o;
+    else o.*field = values[k], (void)p;
+  };
+  s.violation = [](const OptionValue&) { return std::string(); };  // the names are checked by checked()
+  std::vector<std::string> canonical;  // the first name of each value; later ones are other spellings
+  for (std::size_t k = 0; k < names.size(); ++k)
+    if (std::find(values.begin(), values.begin() + k, values[k]) == values.begin() + k) canonical.push_back(names[k]);
+  s.rule = quoted_list(canonical);
+  return s;
+}
+
+std::vector<OptionSpec> make_specs() {
+  std::vector<OptionSpec> specs;
+  // [domain]
+  {
+    OptionSpec box;
+    box.section = "domain", box.key = "box", box.type = OptionType::numbers, box.count = 4;
+    box.meaning = "Ω = [x0, x1] × [y0, y1]";
+    box.rule = "finite, x0 < x1, y0 < y1";
+    box.get = [](const Problem& p, const SolverOptions&) -> OptionValue {
+      return std::vector<double>{p.box.x0, p.box.x1, p.box.y0, p.box.y1};
+    };
+    box.set = [](Problem& p, SolverOptions&, const OptionValue& v) {
+      const auto& b = std::get<std::vector<double>>(v);
+      p.box = Box{b[0], b[1], b[2], b[3]};
+    };
+    box.violation = [](const OptionValue& v) {
+      const auto& b = std::get<std::vector<double>>(v);
+      for (double x : b)
+        if (!std::isfinite(x) || std::abs(x) > 1e12) return std::string("must be finite numbers of magnitude <= 1e12");
+      return b[0] < b[1] && b[2] < b[3] ? std::string() : std::string("need x0 < x1 and y0 < y1");
+    };
+    specs.push_back(box);
+  }
+  {
+    OptionSpec N = member(std::string("domain"), std::string("N"), OptionType::integer, &Problem::N,
+                          "cells along x; h = (x1 − x0)/N, and (y1 − y0)/h must be whole");
+    N.rule = "in 8 … 1048576; even for a periodic box";
+    N.violation = [](const OptionValue& v) {
+      const std::int64_t n = std::get<std::int64_t>(v);
+      return n < 8 || n > 1048576 ? "need 8 <= N <= 1048576, got " + std::to_string(n) : std::string();
+    };
+    specs.push_back(N);
+  }
+  specs.push_back(choice(std::string("domain"), std::string("boundary"), &Problem::boundary,
+                         {to_string(Boundary::dirichlet), to_string(Boundary::periodic)},
+                         {Boundary::dirichlet, Boundary::periodic},
+                         "conditions on ∂Ω: u = 0, or periodic (even cell counts; c = 0 allowed)"));
+  // [formulation]
+  specs.push_back(choice(std::string("formulation"), std::string("variant"), &SolverOptions::variant,
+                         {to_string(Variant::smooth), to_string(Variant::nonsmooth), "non-smooth"}, {Variant::smooth, Variant::nonsmooth, Variant::nonsmooth},
+                         "smooth: controls λ on the offset curve Γ outside ω; nonsmooth: multipliers on γ"));
+  {
+    OptionSpec m = integer("formulation", "multipliers", &SolverOptions::multipliers, 0, 1000000,
+                           "m; 0 = the default rule m = max(8, round(L/(c·h))), c = 8 (smooth) or 12 (non-smooth); "
+                           "a given m needs 8 <= m <= L/(2h)");
+    m.aliases = {"m"};
+    specs.push_back(m);
+  }
+  specs.push_back(number("formulation", "offset", &SolverOptions::offset, 0.0, true, 100.0, false,
+                         "smooth variant: δ/s, the distance of Γ from γ in units of the point spacing s = L/m; "
+                         "Γ must stay >= 4h from γ"));
+  specs.push_back(number("formulation", "rho", &SolverOptions::rho, 0.0, true, 1e12, false,
+                         "ρ of the projection max{0, ∂u/∂n − ρ(u − g)}"));
+  specs.push_back(choice(std::string("formulation"), std::string("normal_derivative"),
+                         &SolverOptions::normal_derivative,
+                         {to_string(NormalDerivative::reconstructed), to_string(NormalDerivative::shifted)},
+                         {NormalDerivative::reconstructed, NormalDerivative::shifted},
+                         "traces B_γ, C_γ: reconstructed (consistent at x_i) or shifted (the cell gradient "
+                         "normal_shift cells inside ω; first order at best)"));
+  specs.push_back(number("formulation", "normal_shift", &SolverOptions::normal_shift, 0.0, false, 8.0, false,
+                         "shifted rule only: C_γ is taken this many cells h inside ω"));
+  // [data]
+  specs.push_back(number("data", "c", &Problem::c, 0.0, false, 1e12, false, "reaction coefficient of −Δu + c·u = f"));
+  // [solver]
+  specs.push_back(choice(std::string("solver"), std::string("schur"), &SolverOptions::inner,
+                         {to_string(InnerSolver::green), to_string(InnerSolver::krylov)},
+                         {InnerSolver::green, InnerSolver::krylov},
+                         "green: explicit Schur complement, dense LU; krylov: GMRES on the implicit one (the paper's)"));
+  {
+    OptionSpec s = number("solver", "krylov_tolerance", &SolverOptions::krylov_tolerance, 0.0, true, 1.0, true,
+                          "relative GMRES residual");
+    s.aliases = {"krylov-tol"};
+    specs.push_back(s);
+  }
+  specs.push_back(integer("solver", "krylov_max_iterations", &SolverOptions::krylov_max_iterations, 1, 1000000,
+                          "GMRES operator applications per solve"));
+  {
+    OptionSpec s = number("solver", "newton_tolerance", &SolverOptions::newton_tolerance, 0.0, true, 1.0, true,
+                          "relative Newton residual ‖F‖∞");
+    s.aliases = {"newton-tol"};
+    specs.push_back(s);
+  }
+  specs.push_back(integer("solver", "max_newton", &SolverOptions::max_newton, 1, 10000,
+                          "Newton steps; when exceeded the run fails with the iteration history"));
+  {
+    OptionSpec start;
+    start.section = "solver", start.key = "start", start.type = OptionType::choice, start.choices = {"all", "zero"};
+    start.meaning = "Newton start: all (every point active) or zero (λ = 0)";
+    start.get = [](const Problem&, const SolverOptions& o) -> OptionValue {
+      return std::string(o.start_all_active ? "all" : "zero");
+    };
+    start.set = [](Problem&, SolverOptions& o, const OptionValue& v) { o.start_all_active = std::get<std::string>(v) == "all"; };
+    start.violation = [](const OptionValue&) { return std::string(); };
+    specs.push_back(start);
+  }
+  {
+    OptionSpec t = member(std::string("solver"), std::string("threads"), OptionType::integer, &SolverOptions::threads,
+                          "threads for the transforms, loops and dense algebra");
+    t.rule = "in 1 … 4 × the hardware threads";
+    t.violation = [](const OptionValue& v) {
+      const std::int64_t n = std::get<std::int64_t>(v);
+      return n < 1 || n > max_threads()
+                 ? "must be in 1 … " + std::to_string(max_threads()) + " (4 × the hardware threads), got " + std::to_string(n)
+                 : std::string();
+    };
+    specs.push_back(t);
+  }
+  specs.push_back(integer("solver", "load_quadrature", &SolverOptions::load_quadrature, 1, 8,
+                          "Gauss points per direction per cell for the load"));
+  specs.push_back(integer("solver", "error_quadrature", &SolverOptions::error_quadrature, 1, 12,
+                          "Gauss points per direction for the error integrals"));
+  {
+    OptionSpec c = member(std::string("solver"), std::string("condition_number"), OptionType::boolean,
+                          &SolverOptions::condition_number, "compute cond(S) of the final Newton matrix (green only)");
+    c.rule = "true or false";
+    c.violation = [](const OptionValue&) { return std::string(); };
+    specs.push_back(c);
+  }
+  for (OptionSpec& s : specs)
+    if (s.type == OptionType::choice && s.rule.empty()) s.rule = quoted_list(s.choices);
+  return specs;
+}
+
+[[noreturn]] void fail(const OptionSpec& spec, const std::string& reason) {
+  throw std::invalid_argument(spec.name() + ": " + reason);
+}
+
+const char* type_words(OptionType t) {
+  switch (t) {
+    case OptionType::boolean: return "true or false";
+    case OptionType::integer: return "an integer";
+    case OptionType::number: return "a number";
+    case OptionType::choice: return "a string";
+    case OptionType::numbers: return "an array of numbers";
+  }
+  return "";
+}
+
+}  // namespace
+
+const char* to_string(Variant v) { return v == Variant::smooth ? "smooth" : "nonsmooth"; }
+const char* to_string(InnerSolver s) { return s == InnerSolver::green ? "green" : "krylov"; }
+const char* to_string(NormalDerivative d) { return d == NormalDerivative::shifted ? "shifted" : "reconstructed"; }
+
+int max_threads() {
+  static const int n = std::max(4, 4 * int(std::thread::hardware_concurrency()));
+  return n;
+}
+
+const std::vector<OptionSpec>& option_specs() {
+  static const std::vector<OptionSpec> specs = make_specs();
+  return specs;
+}
+
+const OptionSpec* find_option(std::string_view key) {
+  for (const OptionSpec& s : option_specs())
+    if (s.key == key || s.name() == key) return &s;
+  return nullptr;
+}
+
+OptionValue OptionSpec::default_value() const { return get(Problem{}, SolverOptions{}); }
+
+OptionValue checked(const OptionSpec& spec, OptionValue value) {
+  if (spec.type == OptionType::number && std::holds_alternative<std::int64_t>(value))
+    value = double(std::get<std::int64_t>(value));
+  const bool right_type = (spec.type == OptionType::boolean && std::holds_alternative<bool>(value)) ||
+                          (spec.type == OptionType::integer && std::holds_alternative<std::int64_t>(value)) ||
+                          (spec.type == OptionType::number && std::holds_alternative<double>(value)) ||
+                          (spec.type == OptionType::choice && std::holds_alternative<std::string>(value)) ||
+                          (spec.type == OptionType::numbers && std::holds_alternative<std::vector<double>>(value));
+  if (!right_type) fail(spec, std::string("expected ") + type_words(spec.type));
+  if (spec.type == OptionType::number && !std::isfinite(std::get<double>(value))) fail(spec, "must be finite (NaN or Inf given)");
+  if (spec.type == OptionType::choice) {
+    const std::string& text = std::get<std::string>(value);
+    if (std::find(spec.choices.begin(), spec.choices.end(), text) == spec.choices.end())
+      fail(spec, "expected " + spec.rule + ", got \"" + text.substr(0, 40) + (text.size() > 40 ? "…" : "") + "\"");
+  }
+  if (spec.type == OptionType::numbers) {
+    const auto& list = std::get<std::vector<double>>(value);
+    if (list.size() != spec.count) fail(spec, "expected an array of " + std::to_string(spec.count) + " numbers");
+    for (double x : list)
+      if (!std::isfinite(x)) fail(spec, "must be finite (NaN or Inf given)");
+  }
+  if (const std::string reason = spec.violation(value); !reason.empty()) fail(spec, reason);
+  return value;
+}
+
+OptionValue parse_option_text(const OptionSpec& spec, const std::string& text) {
+  auto as_number = [&](const std::string& t) {
+    std::size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(t, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != t.size()) fail(spec, "expected a number, got \"" + t.substr(0, 40) + "\"");
+    return v;
+  };
+  switch (spec.type) {
+    case OptionType::boolean:
+      if (text == "true" || text == "1" || text == "yes") return checked(spec, true);
+      if (text == "false" || text == "0" || text == "no") return checked(spec, false);
+      fail(spec, "expected true or false, got \"" + text.substr(0, 40) + "\"");
+    case OptionType::integer: {
+      std::size_t used = 0;
+      long long v = 0;
+      try {
+        v = std::stoll(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != text.size()) fail(spec, "expected an integer, got \"" + text.substr(0, 40) + "\"");
+      return checked(spec, std::int64_t(v));
+    }
+    case OptionType::number: return checked(spec, as_number(text));
+    case OptionType::choice: return checked(spec, text);
+    case OptionType::numbers: {
+      std::vector<double> list;
+      std::stringstream in(text);
+      for (std::string part; std::getline(in, part, ',');) list.push_back(as_number(part));
+      return checked(spec, list);
+    }
+  }
+  fail(spec, "unknown type");
+}
+
+void set_option(const OptionSpec& spec, Problem& problem, SolverOptions& options, OptionValue value) {
+  spec.set(problem, options, checked(spec, std::move(value)));
+}
+
+std::string option_text(const OptionSpec& spec, const OptionValue& value) {
+  (void)spec;
+  return std::visit(
+      [](const auto& v) -> std::string {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, bool>) return v ? "true" : "false";
+        else if constexpr (std::is_same_v<T, std::int64_t>) return std::to_string(v);
+        else if constexpr (std::is_same_v<T, double>) return format_number(v);
+        else if constexpr (std::is_same_v<T, std::string>) return "\"" + v + "\"";
+        else {
+          std::string text = "[";
+          for (std::size_t k = 0; k < v.size(); ++k) text += (k ? ", " : "") + format_number(v[k]);
+          return text + "]";
+        }
+      },
+      value);
+}
+
+void SolverOptions::validate() const {
+  for (const OptionSpec& spec : option_specs())
+    if (spec.section == "formulation" || spec.section == "solver") checked(spec, spec.get(Problem{}, *this));
+}
+
+void validate_options(const Problem& problem, const SolverOptions& options) {
+  for (const OptionSpec& spec : option_specs()) checked(spec, spec.get(problem, options));
+  if (problem.boundary == Boundary::periodic && problem.N % 2 != 0)
+    throw std::invalid_argument("domain.N: a periodic box needs an even N, got " + std::to_string(problem.N));
+}
+
+std::string options_markdown() {
+  std::string text;
+  std::string section;
+  for (const OptionSpec& s : option_specs()) {
+    if (s.section != section) {
+      section = s.section;
+      text += (text.empty() ? "" : "\n") + std::string("[") + section + "]\n\n| key | default | allowed | meaning |\n|---|---|---|---|\n";
+    }
+    text += "| `" + s.key + "` | `" + option_text(s, s.default_value()) + "` | " + s.rule + " | " + s.meaning + " |\n";
+  }
+  return text;
+}
+
+}  // namespace fictus
