@@ -18,8 +18,9 @@
 #include "fictus/convergence_table.hpp"
 #include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/paper_problem.hpp"
+#include "fictus/io/process.hpp"
 #include "fictus/options.hpp"
-#include "fictus/problem_file.hpp"
+#include "fictus/io/problem_file.hpp"
 #include "option_flags.hpp"
 #include "results_io.hpp"
 #include "vtk_io.hpp"
@@ -91,7 +92,8 @@ int run_solve(const std::string& problem_path, const fictus::cli::OptionFlags& f
   for (const std::string& w : spec.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
 
   const fictus::Problem& problem = spec.problem;
-  const fictus::Solution solution = fictus::solve(problem, spec.options);
+  fictus::Solution solution = fictus::solve(problem, spec.options);
+  solution.peak_memory_bytes = fictus::peak_memory_bytes();
   if (!solution.newton.converged) throw std::runtime_error(fictus::describe_newton_failure(solution));
   print_summary(solution);
   if (!spec.output.dir.empty()) {
@@ -148,7 +150,8 @@ int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out,
       fictus::Problem problem = fictus::paper_problem(N);
       fictus::SolverOptions options = fictus::paper_options(N, variant);  // the paper's m and δ
       flags.apply(problem, options);
-      const fictus::Solution s = fictus::solve(problem, options);
+      fictus::Solution s = fictus::solve(problem, options);
+      s.peak_memory_bytes = fictus::peak_memory_bytes();
       if (!s.newton.converged) {
         std::fprintf(stderr, "fictus: error: Newton did not converge at h = 1/%d: %s\n", N, s.newton.failure.c_str());
         status = 2;

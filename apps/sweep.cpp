@@ -51,7 +51,7 @@ int run_sweep(const SweepArguments& args, SolverOptions options) {
 
   const Problem base = paper_problem(args.N, args.c, args.boundary);
   if (options.multipliers == 0) options.multipliers = paper_multipliers(args.N);
-  FictitiousDomainSolver solver(base, options.threads, options.load_quadrature);
+  FictitiousDomainSolver solver(base, options);
   std::ostringstream csv;
   csv.precision(12);
   csv << parameter << ",iterations,converged,n_active,min_gap,min_normal_derivative,max_complementarity,seconds\n";

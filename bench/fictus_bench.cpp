@@ -19,6 +19,7 @@
 
 #include "fictus/dst_solver.hpp"
 #include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/io/process.hpp"
 #include "fictus/paper_problem.hpp"
 
 namespace {
@@ -77,6 +78,7 @@ Run run(int N, fictus::Variant variant, fictus::InnerSolver inner, int threads,
   o.krylov_tolerance = 1e-12;  // so that both paths give λ to ~1e-9 (cond S up to 1e4)
   std::fprintf(stderr, "  N = %d, %s, %s, %d thread(s)...\n", N, fictus::to_string(variant), fictus::to_string(inner), threads);
   auto s = std::make_unique<fictus::Solution>(fictus::solve(fictus::paper_problem(N), o));
+  s->peak_memory_bytes = fictus::peak_memory_bytes();
   return {N, variant, inner, threads, std::move(s)};
 }
 
@@ -218,10 +220,10 @@ int main(int argc, char** argv) {
     const bool obstacles = kind[0] == '1';
     const int count = obstacles ? 100 : 20;
     const fictus::Problem base = fictus::paper_problem(1024);
-    fictus::FictitiousDomainSolver solver(base, threads);
     fictus::SolverOptions o = fictus::paper_options(1024, fictus::Variant::smooth);  // as `fictus sweep`
     o.threads = threads;
     o.condition_number = false;
+    fictus::FictitiousDomainSolver solver(base, o);
     double first = 0, rest = 0;
     for (int k = 0; k < count; ++k) {
       fictus::Problem p = base;

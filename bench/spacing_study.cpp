@@ -16,7 +16,7 @@
 #include "fictus/collocation.hpp"
 #include "fictus/convergence_table.hpp"
 #include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/problem_file.hpp"
+#include "fictus/io/problem_file.hpp"
 #include "manufactured_solutions.hpp"
 #include "reference_comparison.hpp"
 

@@ -17,7 +17,7 @@
 #include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/options.hpp"
 #include "fictus/paper_problem.hpp"
-#include "fictus/problem_file.hpp"
+#include "fictus/io/problem_file.hpp"
 #include "python_problem.hpp"
 
 namespace py = pybind11;

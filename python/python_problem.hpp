@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/problem_file.hpp"
+#include "fictus/io/problem_file.hpp"
 
 namespace fictus::python {
 

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "bindings.hpp"
+#include "fictus/io/process.hpp"
 #include "fictus/options.hpp"
 #include "fictus/fictitious_domain_solver.hpp"
 #include "python_problem.hpp"
@@ -28,7 +29,7 @@ PySolution PyProblem::solve(bool field) {
     if (field) {
       solution = std::make_shared<const Solution>(fictus::solve(spec.problem, spec.options));
     } else {
-      FictitiousDomainSolver solver(spec.problem, spec.options.threads, spec.options.load_quadrature);
+      FictitiousDomainSolver solver(spec.problem, spec.options);
       solution = std::make_shared<const Solution>(solver.solve(spec.problem, spec.options, false));
     }
   } catch (const std::invalid_argument&) {
@@ -37,6 +38,7 @@ PySolution PyProblem::solve(bool field) {
     throw;
   }
   if (!errors_->message.empty()) throw std::invalid_argument(errors_->message);
+  std::const_pointer_cast<Solution>(solution)->peak_memory_bytes = peak_memory_bytes();
   if (!solution->newton.converged) throw std::runtime_error(describe_newton_failure(*solution));
   return PySolution(solution, spec.problem);
 }

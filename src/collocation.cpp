@@ -9,7 +9,7 @@
 namespace fictus {
 
 Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase) {
-  if (m < 4) throw std::invalid_argument("formulation.multipliers: need m >= 4, got " + std::to_string(m));
+  if (m < 1) throw std::invalid_argument("make_collocation: need m >= 1, got " + std::to_string(m));
   Collocation c;
   c.m = m;
   c.length = arc_length.length();
@@ -57,7 +57,7 @@ double phase_off_corners(const Curve& curve, const ArcLengthTable& arc_length, i
 }
 
 int default_multipliers(double curve_length, double h, double spacing_cells) {
-  return std::max(8, int(std::lround(curve_length / (spacing_cells * h))));
+  return std::max(minimum_multipliers, int(std::lround(curve_length / (spacing_cells * h))));
 }
 
 }  // namespace fictus

@@ -2,37 +2,25 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <cmath>
-#include <fstream>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
-#include "fictus/curve_grid_intersection.hpp"
+#include "fictus/curve_discretization.hpp"
+#include "fictus/execution.hpp"
 #include "fictus/fast_solver.hpp"
-#include "fictus/schur_complement.hpp"
-#include "fictus/shapes.hpp"
 #include "fictus/green_table.hpp"
-#include "fictus/kink_correction.hpp"
 #include "fictus/load_vector.hpp"
 #include "fictus/options.hpp"
-#include "fictus/trace_operators.hpp"
+#include "fictus/schur_complement.hpp"
 
 namespace fictus {
-
 
 double Timings::operator[](const std::string& name) const {
   for (const auto& [phase, seconds] : phases)
     if (phase == name) return seconds;
   return 0.0;
-}
-
-std::size_t peak_memory_bytes() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line))
-    if (line.rfind("VmHWM:", 0) == 0) return std::size_t(std::stoull(line.substr(6))) * 1024;
-  return 0;
 }
 
 namespace {
@@ -50,9 +38,7 @@ class PhaseClock {
  private:
   using Clock = std::chrono::steady_clock;
   static Clock::time_point now() { return Clock::now(); }
-  static double seconds(Clock::time_point a, Clock::time_point b) {
-    return std::chrono::duration<double>(b - a).count();
-  }
+  static double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
   Timings& timings_;
   Clock::time_point start_, last_;
 };
@@ -60,10 +46,6 @@ class PhaseClock {
 Eigen::VectorXd to_eigen(const std::vector<double>& v) {
   return Eigen::Map<const Eigen::VectorXd>(v.data(), Eigen::Index(v.size()));
 }
-
-}  // namespace
-
-namespace {
 
 /// R·1: the sum of each row's entries.
 Eigen::VectorXd row_sums(const SparseRows& rows) {
@@ -73,38 +55,38 @@ Eigen::VectorXd row_sums(const SparseRows& rows) {
   return sums;
 }
 
+/// The options that shape steps 1–3: a change in any of them rebuilds the curve's rows and blocks.
+bool same_curve_options(const SolverOptions& a, const SolverOptions& b) {
+  return a.variant == b.variant && a.multipliers == b.multipliers && a.offset == b.offset &&
+         a.normal_derivative == b.normal_derivative && a.normal_shift == b.normal_shift && a.inner == b.inner &&
+         a.krylov_tolerance == b.krylov_tolerance && a.krylov_max_iterations == b.krylov_max_iterations;
+}
+
+std::string format_point(Point p) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "(%.6g, %.6g)", p.x, p.y);
+  return buffer;
+}
+
 }  // namespace
 
-/// Everything that depends on the curve and the options that shape the trace rows.
+/// Steps 1–3 for one curve: kept while the curve and its options stay.
 struct CurveSetup {
-  std::shared_ptr<const Curve> gamma, Gamma;
-  SolverOptions options;  // the options it was built with
-  Collocation collocation;
-  double delta = 0;
-  std::unique_ptr<CurveGridIntersection> gamma_geometry, offset_geometry;
-  SparseRows B_gamma, C_gamma, B_Gamma;
-  SparseRows loads;      // rows carrying λ in the Schur complement: B_Γ, or B_Γ + R (kink correction)
-  DirectTerms direct;    // D_B, D_C of the kink correction (non-smooth variant, reconstructed traces)
-  std::unique_ptr<KinkCorrection> kink;
+  std::shared_ptr<const Curve> gamma;
+  SolverOptions options;  // as asked (m = 0 stays 0), so the next request compares equal
+  std::unique_ptr<CurveDiscretization> boundary;
   std::unique_ptr<SchurComplement> schur;
-  Eigen::VectorXd b0, c0;
-  std::optional<ConstantMode> mode;
-
-  const CurveGridIntersection& Gamma_geometry() const { return offset_geometry ? *offset_geometry : *gamma_geometry; }
-  bool matches(const Problem& problem, const SolverOptions& o) const {
-    const SolverOptions& s = options;
-    return problem.gamma == gamma && o.variant == s.variant && o.multipliers == s.multipliers &&
-           o.offset == s.offset && o.normal_derivative == s.normal_derivative && o.normal_shift == s.normal_shift &&
-           o.inner == s.inner &&
-           o.krylov_tolerance == s.krylov_tolerance && o.krylov_max_iterations == s.krylov_max_iterations;
-  }
+  Eigen::VectorXd b0, c0;             // B_γu₀, C_γu₀
+  std::optional<ConstantMode> mode;   // singular A only
 };
 
 struct FictitiousDomainSolver::State {
-  Problem problem;  // grid-level data only: box, N, boundary, c, f
   Grid grid;
-  int threads;
+  double c;
+  Execution execution;
   int load_quadrature;
+  ScalarField f;
+  VectorizedField f_vectorized;
   std::unique_ptr<FastSolver> fast;
   std::unique_ptr<GreenTable> green;
   GridVector u0;
@@ -113,49 +95,13 @@ struct FictitiousDomainSolver::State {
   std::unique_ptr<CurveSetup> setup;
 };
 
-namespace {
-
-/// The Signorini conditions with a normal derivative D_γ from another stencil than C_γ:
-///   smooth variant (or shifted C_γ): the one-sided quadratic least-squares fit through the nodes of ω;
-///   non-smooth variant, reconstructed traces: the bicubic interpolant of the kink-corrected field.
-std::optional<IndependentCheck> independent_check(const CurveSetup& setup, const Solution& sol) {
-  const Collocation& points = setup.collocation;
-  const int m = points.m;
-  IndependentCheck check;
-  std::vector<double> d;
-  if (setup.kink) {
-    check.rule = "bicubic interpolant of the kink-corrected field";
-    normal_derivative_rows_centered(sol.grid, points.point, points.normal, 3).multiply(sol.u, d);
-  } else {
-    check.rule = "one-sided quadratic least-squares fit through the nodes of omega";
-    try {
-      one_sided_rows(*setup.gamma_geometry, points.point, points.normal, OneSidedTrace::normal_derivative, 2, 2.5)
-          .multiply(sol.u, d);
-    } catch (const std::runtime_error&) {  // ω too thin for the fit: no check, not a failed solve
-      return std::nullopt;
-    }
-  }
-  check.min_normal_derivative = 1e300;
-  double sum = 0.0;
-  for (int i = 0; i < m; ++i) {
-    const double gap = sol.trace[i] - sol.g[i], difference = d[i] - sol.normal_derivative[i];
-    check.min_normal_derivative = std::min(check.min_normal_derivative, d[i]);
-    check.max_complementarity = std::max(check.max_complementarity, std::abs(gap * d[i]));
-    check.max_difference = std::max(check.max_difference, std::abs(difference));
-    sum += difference * difference;
-  }
-  check.rms_difference = std::sqrt(sum / m);
-  return check;
-}
-
-}  // namespace
-
-FictitiousDomainSolver::FictitiousDomainSolver(const Problem& problem, int threads, int load_quadrature) {
-  validate_options(problem, SolverOptions{});
+FictitiousDomainSolver::FictitiousDomainSolver(const Problem& problem, const SolverOptions& options) {
+  validate_options(problem, options);
   if (!problem.f && !problem.f_vectorized) throw std::invalid_argument("data.f: not given");
-  if (threads < 1) throw std::invalid_argument("solver.threads: must be >= 1");
-  Grid grid(problem.box, problem.N, problem.boundary);
-  state_ = std::make_unique<State>(State{problem, grid, threads, load_quadrature, make_fast_solver(grid, problem.c, threads),
+  const Grid grid(problem.box, problem.N, problem.boundary);
+  const Execution execution(options.threads);
+  state_ = std::make_unique<State>(State{grid, problem.c, execution, options.load_quadrature, problem.f,
+                                         problem.f_vectorized, make_fast_solver(grid, problem.c, execution.threads()),
                                          nullptr, {}, false, 0.0, nullptr});
 }
 
@@ -163,236 +109,227 @@ FictitiousDomainSolver::~FictitiousDomainSolver() = default;
 
 const Grid& FictitiousDomainSolver::grid() const { return state_->grid; }
 
-Solution FictitiousDomainSolver::solve(const Problem& problem, SolverOptions options, bool compute_field) {
-  options.validate();
-  if (!problem.gamma) throw std::invalid_argument("geometry: no curve given");
-  Eigen::setNbThreads(options.threads);  // the dense LU of the Newton steps follows the threads option
-  if (!problem.g && !problem.g_along_curve && !problem.g_vectorized) throw std::invalid_argument("data.g: not given");
-  State& st = *state_;
-  const Grid& grid = st.grid;
-  const double h = grid.h();
-  Solution sol(grid);
-  PhaseClock clock(sol.timings);
-  std::size_t fast_solves = 0;
+namespace {
 
-  // Load and u₀ = A⁻¹f (A⁺f for a singular A), once per solver.
-  if (!st.have_u0) {
-    st.u0 = st.problem.f_vectorized ? assemble_load(grid, st.problem.f_vectorized, st.load_quadrature, st.threads)
-                                    : assemble_load(grid, st.problem.f, st.load_quadrature, st.threads);
-    st.load_total = 0;
-    for (double v : st.u0) {
-      if (!std::isfinite(v)) throw std::invalid_argument("data.f: not finite somewhere in the box");
-      st.load_total += v;
-    }
-    clock.mark("load");
-    st.fast->solve_in_place(st.u0);
-    ++fast_solves;
-    st.have_u0 = true;
-    clock.mark("u0");
+using State = FictitiousDomainSolver::State;
+
+/// Step 0: the load vector and u₀ = A⁻¹f (A⁺f for a singular A), once per solver.
+void load_and_u0(State& st, PhaseClock& clock, std::size_t& fast_solves) {
+  if (st.have_u0) return;
+  const int threads = st.execution.threads();
+  st.u0 = st.f_vectorized ? assemble_load(st.grid, st.f_vectorized, st.load_quadrature, threads)
+                          : assemble_load(st.grid, st.f, st.load_quadrature, threads);
+  st.load_total = 0;
+  for (double v : st.u0) {
+    if (!std::isfinite(v)) throw std::invalid_argument("data.f: not finite somewhere in the box");
+    st.load_total += v;
   }
+  clock.mark("load");
+  st.fast->solve_in_place(st.u0);
+  ++fast_solves;
+  st.have_u0 = true;
+  clock.mark("u0");
+}
 
-  // Curve, collocation, trace rows, Schur complement: reused while the curve and its options stay.
-  if (st.setup && st.setup->matches(problem, options)) {
-    options.multipliers = st.setup->collocation.m;
-    sol.reused_curve = true;
-  } else {
-    st.setup.reset();
-    auto setup = std::make_unique<CurveSetup>();
-    setup->gamma = problem.gamma;
-    const Curve& gamma = *problem.gamma;
-    // A curve must be simple, counter-clockwise and a few cells inside the box.
-    if (signed_area(gamma) <= 0)
-      throw std::invalid_argument("geometry: the curve must be counter-clockwise (ω on its left)");
-    check_simple(gamma, "geometry");
-    check_inside_box(gamma, grid.box(), 2 * h, "geometry");
-    setup->gamma_geometry = std::make_unique<CurveGridIntersection>(gamma, grid, "geometry");
-    const ArcLengthTable arc_length(gamma);
-    const double L = arc_length.length();
-    const SolverOptions requested = options;
-    const double spacing_cells =
-        options.variant == Variant::smooth ? default_spacing_cells_smooth : default_spacing_cells_nonsmooth;
-    if (options.multipliers == 0) options.multipliers = default_multipliers(L, h, spacing_cells);
-    const int m = options.multipliers;
-    const double spacing = L / m;
-    if (spacing < 2 * h)
-      throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) +
-                                  " is too large for the grid (spacing L/m = " + std::to_string(spacing) +
-                                  " < 2h; use m <= " + std::to_string(int(L / (2 * h))) + ")");
-    if (m < 8) throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) + " is too small (need m >= 8)");
-    setup->collocation = make_collocation(gamma, arc_length, m, phase_off_corners(gamma, arc_length, m));
-    if (options.variant == Variant::smooth) {
-      if (!gamma.smooth())
-        throw std::invalid_argument("formulation.variant: the smooth variant needs a curve with a continuous normal "
-                                    "(use \"nonsmooth\" for polygons)");
-      setup->delta = options.offset * spacing;
-      // The biquadratic stencil of C_γ reaches 1.5·√2·h ≈ 2.1h from x_i; its nodes must stay out of
-      // the cells cut by Γ (which reach 1.4h from Γ), where the kink of û pollutes the nodal values.
-      if (options.normal_derivative == NormalDerivative::reconstructed && setup->delta < 4 * h)
-        throw std::invalid_argument("formulation.offset: Γ at δ = offset·L/m = " + std::to_string(setup->delta / h) +
-                                    " h is within reach of the C_γ stencil (need δ >= 4h: a larger offset or a smaller m)");
-      setup->Gamma = std::make_shared<OffsetCurve>(problem.gamma, setup->delta);
-      check_simple(*setup->Gamma, "formulation.offset");
-      check_inside_box(*setup->Gamma, grid.box(), 2 * h, "formulation.offset");
-      setup->offset_geometry = std::make_unique<CurveGridIntersection>(*setup->Gamma, grid, "formulation.offset");
-    } else {
-      setup->Gamma = problem.gamma;
-    }
-    const Collocation& points = setup->collocation;
-    setup->B_gamma = point_value_rows(grid, points.point);
-    setup->B_Gamma = arc_integral_rows(setup->Gamma_geometry(), points.arc_begin, points.arc_end);
-    if (options.normal_derivative == NormalDerivative::shifted) {
-      setup->C_gamma = normal_derivative_rows(grid, points.point, points.normal, options.normal_shift * h);
-      setup->loads = setup->B_Gamma;
-    } else {
-      setup->C_gamma = normal_derivative_rows_centered(grid, points.point, points.normal, 2);
-      if (options.variant == Variant::nonsmooth) {
-        setup->kink = std::make_unique<KinkCorrection>(*setup->gamma_geometry, setup->collocation, st.problem.c,
-                                                       st.threads);
-        setup->loads = add_rows(setup->B_Gamma, setup->kink->galerkin());
-        setup->direct.trace = setup->kink->direct(setup->B_gamma);
-        setup->direct.normal_derivative = setup->kink->direct(setup->C_gamma);
-      } else {
-        setup->loads = setup->B_Gamma;
-      }
-    }
-    std::vector<double> b0, c0;
-    setup->B_gamma.multiply(st.u0, b0);
-    setup->C_gamma.multiply(st.u0, c0);
-    setup->b0 = to_eigen(b0);
-    setup->c0 = to_eigen(c0);
-    if (st.fast->singular())
-      setup->mode = ConstantMode{row_sums(setup->B_gamma), row_sums(setup->C_gamma), row_sums(setup->B_Gamma),
-                                 st.load_total};
-    clock.mark("geometry");
-
-    if (options.inner == InnerSolver::green) {
-      if (!st.green) {
-        st.green = std::make_unique<GreenTable>(grid, st.problem.c, st.threads);
-        clock.mark("green_table");
-      }
-      setup->schur = std::make_unique<ExplicitSchur>(*st.green, setup->B_gamma, setup->C_gamma, setup->loads, st.threads,
-                                                     setup->direct);
-      clock.mark("schur");
-    } else {
-      GmresOptions gmres_options;
-      gmres_options.relative_tolerance = options.krylov_tolerance;
-      gmres_options.max_iterations = options.krylov_max_iterations;
-      gmres_options.restart = m + 1;
-      setup->schur = std::make_unique<ImplicitSchur>(*st.fast, setup->B_gamma, setup->C_gamma, setup->loads, gmres_options,
-                                                     setup->direct);
-    }
-    setup->options = requested;  // as asked (m = 0 stays 0), so the next request compares equal
-    st.setup = std::move(setup);
+/// Step 3: the Schur blocks of the curve's rows, explicit from the Green's table or implicit.
+std::unique_ptr<SchurComplement> schur_blocks(State& st, const BoundaryDiscretization& boundary,
+                                              const SolverOptions& options, PhaseClock& clock) {
+  if (options.inner == InnerSolver::krylov) {
+    GmresOptions gmres;
+    gmres.relative_tolerance = options.krylov_tolerance;
+    gmres.max_iterations = options.krylov_max_iterations;
+    gmres.restart = boundary.n_points() + 1;
+    return std::make_unique<ImplicitSchur>(*st.fast, boundary.B_gamma(), boundary.C_gamma(), boundary.loads(), gmres,
+                                           boundary.direct());
   }
-  const CurveSetup& setup = *st.setup;
-  const int m = setup.collocation.m;
-  sol.collocation = setup.collocation;
-  sol.Gamma = setup.Gamma;
-  sol.delta = setup.delta;
+  if (!st.green) {
+    st.green = std::make_unique<GreenTable>(st.grid, st.c, st.execution.threads());
+    clock.mark("green_table");
+  }
+  auto schur = std::make_unique<ExplicitSchur>(*st.green, boundary.B_gamma(), boundary.C_gamma(), boundary.loads(),
+                                               st.execution.threads(), boundary.direct());
+  clock.mark("schur");
+  return schur;
+}
 
-  // Obstacle at the collocation points, then semismooth Newton.
-  sol.g.resize(m);
-  if (problem.g_vectorized && !problem.g_along_curve) {
+/// Steps 1–3 for data.gamma, or the previous ones when the curve and its options are unchanged.
+const CurveSetup& curve_setup(State& st, const ContactData& data, const SolverOptions& options, PhaseClock& clock,
+                              bool& reused) {
+  reused = st.setup && st.setup->gamma == data.gamma && same_curve_options(st.setup->options, options);
+  if (reused) return *st.setup;
+  st.setup.reset();
+  auto setup = std::make_unique<CurveSetup>();
+  setup->gamma = data.gamma;
+  setup->options = options;
+  setup->boundary = std::make_unique<CurveDiscretization>(data.gamma, st.grid, options, st.c, st.execution);
+  const BoundaryDiscretization& boundary = *setup->boundary;
+  std::vector<double> b0, c0;
+  boundary.B_gamma().multiply(st.u0, b0);
+  boundary.C_gamma().multiply(st.u0, c0);
+  setup->b0 = to_eigen(b0);
+  setup->c0 = to_eigen(c0);
+  if (st.fast->singular())
+    setup->mode = ConstantMode{row_sums(boundary.B_gamma()), row_sums(boundary.C_gamma()),
+                               row_sums(boundary.B_Gamma()), st.load_total};
+  clock.mark("geometry");
+  setup->schur = schur_blocks(st, boundary, options, clock);
+  st.setup = std::move(setup);
+  return *st.setup;
+}
+
+/// Step 4: g at the collocation points (a batch callable, g(x, y, s) along γ, or g(x, y)).
+std::vector<double> obstacle(const ContactData& data, const BoundaryDiscretization& boundary) {
+  const int m = boundary.n_points();
+  const std::vector<Point>& p = boundary.points();
+  std::vector<double> g(m);
+  if (data.g_vectorized && !data.g_along_curve) {
     std::vector<double> x(m), y(m);
-    for (int i = 0; i < m; ++i) x[i] = setup.collocation.point[i].x, y[i] = setup.collocation.point[i].y;
-    problem.g_vectorized(m, x.data(), y.data(), sol.g.data());
+    for (int i = 0; i < m; ++i) x[i] = p[i].x, y[i] = p[i].y;
+    data.g_vectorized(m, x.data(), y.data(), g.data());
   }
   for (int i = 0; i < m; ++i) {
-    const Point p = setup.collocation.point[i];
-    if (problem.g_along_curve) sol.g[i] = problem.g_along_curve(p.x, p.y, setup.collocation.s[i]);
-    else if (!problem.g_vectorized) sol.g[i] = problem.g(p.x, p.y);
-    if (!std::isfinite(sol.g[i]))
-      throw std::invalid_argument("data.g: not finite at the collocation point (" + std::to_string(p.x) + ", " +
-                                  std::to_string(p.y) + ")");
+    if (data.g_along_curve) g[i] = data.g_along_curve(p[i].x, p[i].y, boundary.arc_positions()[i]);
+    else if (!data.g_vectorized) g[i] = data.g(p[i].x, p[i].y);
+    if (!std::isfinite(g[i])) throw std::invalid_argument("data.g: not finite at the collocation point " + format_point(p[i]));
   }
+  return g;
+}
+
+/// Step 5: semismooth Newton on λ with the Schur blocks.
+void newton(const CurveSetup& setup, const SolverOptions& options, Solution& sol, std::size_t& fast_solves) {
   NewtonOptions newton_options;
   newton_options.rho = options.rho;
   newton_options.max_iterations = options.max_newton;
   newton_options.start_all_active = options.start_all_active;
   newton_options.tolerance = options.newton_tolerance;
-  const std::size_t schur_solves_before = setup.schur->fast_solves();
+  const std::size_t before = setup.schur->fast_solves();
   sol.newton = solve_semismooth_newton(*setup.schur, setup.b0, setup.c0, to_eigen(sol.g), newton_options,
                                        setup.mode ? &*setup.mode : nullptr);
-  fast_solves += setup.schur->fast_solves() - schur_solves_before;
+  fast_solves += setup.schur->fast_solves() - before;
   for (const NewtonStep& step : sol.newton.history) sol.inner_iterations += step.inner_iterations;
   if (options.condition_number) sol.condition_number = setup.schur->condition_number(sol.newton.active);
-  sol.lambda.assign(sol.newton.lambda.data(), sol.newton.lambda.data() + m);
+  sol.lambda.assign(sol.newton.lambda.data(), sol.newton.lambda.data() + sol.newton.lambda.size());
   sol.alpha = sol.newton.alpha;
-  clock.mark("newton");
+}
 
-  if (compute_field) {
-    // û = u₀ + A⁻¹B_Γᵀλ (+ α for a singular A); with the kink correction the field is
-    // I_h w = u₀ + A⁻¹(B_Γ + R)ᵀλ + Σ_j λ_j ψ_j, whose traces are those of the Newton system.
-    GridVector u(grid.n_unknowns(), 0.0);
-    setup.loads.add_transposed(sol.lambda, u);
-    st.fast->solve_in_place(u);
-    ++fast_solves;
-    for (std::size_t k = 0; k < u.size(); ++k) u[k] += st.u0[k] + sol.alpha;
-    if (setup.kink) setup.kink->add_kinks(sol.lambda, u);
-    sol.u = std::move(u);
-    setup.B_gamma.multiply(sol.u, sol.trace);
-    setup.C_gamma.multiply(sol.u, sol.normal_derivative);
-    clock.mark("final_solve");
-  } else {
-    sol.trace.assign(sol.newton.trace.data(), sol.newton.trace.data() + m);
-    sol.normal_derivative.assign(sol.newton.normal_derivative.data(), sol.newton.normal_derivative.data() + m);
-  }
-  sol.fast_solves = fast_solves;
+/// Step 6: û = u₀ + A⁻¹ loadsᵀλ + α, finished by the boundary (the kink-corrected field I_h w in the
+/// non-smooth variant, whose traces are those of the Newton system); its traces at the points.
+void field(const State& st, const BoundaryDiscretization& boundary, Solution& sol, std::size_t& fast_solves) {
+  GridVector u(st.grid.n_unknowns(), 0.0);
+  boundary.loads().add_transposed(sol.lambda, u);
+  st.fast->solve_in_place(u);
+  ++fast_solves;
+  for (std::size_t k = 0; k < u.size(); ++k) u[k] += st.u0[k] + sol.alpha;
+  boundary.finish_field(sol.lambda, u);
+  sol.u = std::move(u);
+  boundary.B_gamma().multiply(sol.u, sol.trace);
+  boundary.C_gamma().multiply(sol.u, sol.normal_derivative);
+}
 
-  // Signorini conditions at the collocation points.
-  sol.signorini.min_gap = 1e300;
-  sol.signorini.min_normal_derivative = 1e300;
+/// Step 7: the Signorini conditions at the points, and again with an independent ∂u/∂n.
+void signorini_checks(const BoundaryDiscretization& boundary, Solution& sol) {
+  const int m = boundary.n_points();
+  SignoriniCheck& s = sol.signorini;
+  s.min_gap = s.min_normal_derivative = std::numeric_limits<double>::infinity();
   for (int i = 0; i < m; ++i) {
     const double gap = sol.trace[i] - sol.g[i], dn = sol.normal_derivative[i];
-    sol.signorini.min_gap = std::min(sol.signorini.min_gap, gap);
-    sol.signorini.min_normal_derivative = std::min(sol.signorini.min_normal_derivative, dn);
-    sol.signorini.max_complementarity = std::max(sol.signorini.max_complementarity, std::abs(gap * dn));
+    s.min_gap = std::min(s.min_gap, gap);
+    s.min_normal_derivative = std::min(s.min_normal_derivative, dn);
+    s.max_complementarity = std::max(s.max_complementarity, std::abs(gap * dn));
   }
-
-  if (compute_field) {
-    sol.check = independent_check(setup, sol);
-    clock.mark("check");
+  if (sol.u.empty()) return;
+  IndependentCheck check;
+  const std::optional<std::vector<double>> d = boundary.independent_normal_derivative(sol.u, check.rule);
+  if (!d) return;
+  check.min_normal_derivative = std::numeric_limits<double>::infinity();
+  double sum = 0.0;
+  for (int i = 0; i < m; ++i) {
+    const double gap = sol.trace[i] - sol.g[i], difference = (*d)[i] - sol.normal_derivative[i];
+    check.min_normal_derivative = std::min(check.min_normal_derivative, (*d)[i]);
+    check.max_complementarity = std::max(check.max_complementarity, std::abs(gap * (*d)[i]));
+    check.max_difference = std::max(check.max_difference, std::abs(difference));
+    sum += difference * difference;
   }
+  check.rms_difference = std::sqrt(sum / m);
+  sol.check = check;
+}
 
-  if ((problem.exact || problem.exact_vectorized) && compute_field) {
-    const VectorizedField exact = problem.exact_vectorized ? problem.exact_vectorized : vectorize(problem.exact);
-    std::vector<double> x(m), y(m), values(m);
-    for (int i = 0; i < m; ++i) x[i] = setup.collocation.point[i].x, y[i] = setup.collocation.point[i].y;
-    exact(m, x.data(), y.data(), values.data());
-    for (int i = 0; i < m; ++i)
-      if (!std::isfinite(values[i]))
-        throw std::invalid_argument("data.exact: not finite at (" + std::to_string(x[i]) + ", " + std::to_string(y[i]) + ")");
-    // ∂u/∂n at the points: the given gradient, else a one-sided second-order difference into ω
-    // (u may be defined in ω only): (3u(x) − 4u(x − εn) + u(x − 2εn))/(2ε), ε = 1e-5·box width.
-    const double step = 1e-5 * (grid.box().x1 - grid.box().x0);
-    std::vector<double> xs(2 * std::size_t(m)), ys(2 * std::size_t(m)), inner(2 * std::size_t(m));
-    for (int i = 0; i < m; ++i)
-      for (int k = 0; k < 2; ++k) {
-        const Point p = setup.collocation.point[i] - (k + 1) * step * setup.collocation.normal[i];
-        xs[2 * i + k] = p.x, ys[2 * i + k] = p.y;
-      }
-    if (!problem.exact_gradient) exact(2 * std::size_t(m), xs.data(), ys.data(), inner.data());
-    PointErrors pe;
-    for (int i = 0; i < m; ++i) {
-      const double dudn = problem.exact_gradient
-                              ? dot(setup.collocation.normal[i], problem.exact_gradient(x[i], y[i]))
-                              : (3 * values[i] - 4 * inner[2 * i] + inner[2 * i + 1]) / (2 * step);
-      if (!std::isfinite(dudn))
-        throw std::invalid_argument("data.exact: its normal derivative is not finite near (" + std::to_string(x[i]) +
-                                    ", " + std::to_string(y[i]) + ")");
-      pe.max_trace = std::max(pe.max_trace, std::abs(sol.trace[i] - values[i]));
-      pe.max_normal_derivative = std::max(pe.max_normal_derivative, std::abs(sol.normal_derivative[i] - dudn));
+/// Step 8a: the errors of the traces at the points. ∂u/∂n of the exact solution: its gradient when
+/// given, else a one-sided second-order difference into ω (u may be defined in ω only):
+/// (3u(x) − 4u(x − εn) + u(x − 2εn))/(2ε), ε = 1e-5·box width.
+PointErrors point_errors(const ContactData& data, const BoundaryDiscretization& boundary, const Grid& grid,
+                         const Solution& sol) {
+  const VectorizedField exact = data.exact_vectorized ? data.exact_vectorized : vectorize(data.exact);
+  const std::vector<Point>& p = boundary.points();
+  const std::vector<Point>& n = boundary.normals();
+  const std::size_t m = p.size();
+  std::vector<double> x(m), y(m), values(m);
+  for (std::size_t i = 0; i < m; ++i) x[i] = p[i].x, y[i] = p[i].y;
+  exact(m, x.data(), y.data(), values.data());
+  const double step = 1e-5 * (grid.box().x1 - grid.box().x0);
+  std::vector<double> xs(2 * m), ys(2 * m), inner(2 * m);
+  for (std::size_t i = 0; i < m; ++i)
+    for (int k = 0; k < 2; ++k) {
+      const Point q = p[i] - (k + 1) * step * n[i];
+      xs[2 * i + k] = q.x, ys[2 * i + k] = q.y;
     }
-    sol.point_errors = pe;
-    if (problem.exact_vectorized)
-      sol.errors = compute_errors(sol.u, *setup.gamma_geometry, problem.exact_vectorized, {}, options.error_quadrature, st.threads);
-    else
-      sol.errors = compute_errors(sol.u, *setup.gamma_geometry, problem.exact, problem.exact_gradient,
-                                  options.error_quadrature, st.threads);
+  if (!data.exact_gradient) exact(2 * m, xs.data(), ys.data(), inner.data());
+  PointErrors pe;
+  for (std::size_t i = 0; i < m; ++i) {
+    if (!std::isfinite(values[i])) throw std::invalid_argument("data.exact: not finite at " + format_point(p[i]));
+    const double dudn = data.exact_gradient ? dot(n[i], data.exact_gradient(x[i], y[i]))
+                                            : (3 * values[i] - 4 * inner[2 * i] + inner[2 * i + 1]) / (2 * step);
+    if (!std::isfinite(dudn))
+      throw std::invalid_argument("data.exact: its normal derivative is not finite near " + format_point(p[i]));
+    pe.max_trace = std::max(pe.max_trace, std::abs(sol.trace[i] - values[i]));
+    pe.max_normal_derivative = std::max(pe.max_normal_derivative, std::abs(sol.normal_derivative[i] - dudn));
+  }
+  return pe;
+}
+
+}  // namespace
+
+Solution FictitiousDomainSolver::solve(const ContactData& data, SolverOptions options, bool compute_field) {
+  State& st = *state_;
+  options.validate();
+  if (options.threads != st.execution.threads() || options.load_quadrature != st.load_quadrature)
+    throw std::invalid_argument("solver.threads: threads and load_quadrature are the solver's (" +
+                                std::to_string(st.execution.threads()) + ", " + std::to_string(st.load_quadrature) +
+                                "); make a new FictitiousDomainSolver to change them");
+  if (!data.gamma) throw std::invalid_argument("geometry: no curve given");
+  if (!data.g && !data.g_along_curve && !data.g_vectorized) throw std::invalid_argument("data.g: not given");
+  Eigen::setNbThreads(options.threads);  // the dense LU of the Newton steps follows the threads option
+  Solution sol(st.grid);
+  PhaseClock clock(sol.timings);
+  std::size_t fast_solves = 0;
+
+  load_and_u0(st, clock, fast_solves);                                                       // 0
+  const CurveSetup& setup = curve_setup(st, data, options, clock, sol.reused_curve);        // 1–3
+  const CurveDiscretization& boundary = *setup.boundary;
+  sol.collocation = boundary.collocation();
+  sol.Gamma = boundary.Gamma();
+  sol.delta = boundary.delta();
+  sol.g = obstacle(data, boundary);                                                          // 4
+  newton(setup, options, sol, fast_solves);                                                  // 5
+  clock.mark("newton");
+  if (compute_field) {                                                                       // 6
+    field(st, boundary, sol, fast_solves);
+    clock.mark("final_solve");
+  } else {
+    sol.trace.assign(sol.newton.trace.data(), sol.newton.trace.data() + sol.newton.trace.size());
+    sol.normal_derivative.assign(sol.newton.normal_derivative.data(),
+                                 sol.newton.normal_derivative.data() + sol.newton.normal_derivative.size());
+  }
+  sol.fast_solves = fast_solves;
+  signorini_checks(boundary, sol);                                                           // 7
+  if (compute_field) clock.mark("check");
+  if ((data.exact || data.exact_vectorized) && compute_field) {                              // 8
+    sol.point_errors = point_errors(data, boundary, st.grid, sol);
+    sol.errors = boundary.errors(sol.u, data, options.error_quadrature, st.execution);
     clock.mark("errors");
   }
   sol.options = options;
-  sol.peak_memory_bytes = peak_memory_bytes();
+  sol.options.multipliers = boundary.collocation().m;
   return sol;
 }
 
@@ -407,8 +344,7 @@ std::string describe_newton_failure(const Solution& s) {
 }
 
 Solution solve(const Problem& problem, SolverOptions options) {
-  options.validate();
-  FictitiousDomainSolver solver(problem, options.threads, options.load_quadrature);
+  FictitiousDomainSolver solver(problem, options);
   return solver.solve(problem, options);
 }
 

@@ -83,15 +83,15 @@ Point ExpressionCurve::second_derivative(double t) const {
   return (1.0 / (e * e)) * (position(t + e) - 2.0 * position(t) + position(t - e));
 }
 
-ParametricCurve::ParametricCurve(Expression x, Expression y) : x_(std::move(x)), y_(std::move(y)) {
+ParametricCurve::ParametricCurve(std::function<double(double)> x, std::function<double(double)> y) : x_(std::move(x)), y_(std::move(y)) {
   center_ = centroid(*this);
 }
 
-Point ParametricCurve::position(double t) const { return {x_({t}), y_({t})}; }
+Point ParametricCurve::position(double t) const { return {x_(t), y_(t)}; }
 
-StarCurve::StarCurve(Point center, Expression r) : center_(center), r_(std::move(r)) {
+StarCurve::StarCurve(Point center, std::function<double(double)> r) : center_(center), r_(std::move(r)) {
   for (int k = 0; k < 1024; ++k) {
-    const double t = two_pi * k / 1024, r = r_({t});
+    const double t = two_pi * k / 1024, r = r_(t);
     if (!(r > 0) || !std::isfinite(r))
       throw std::invalid_argument("geometry.r: must be positive and finite for all t (r(" + std::to_string(t) +
                                   ") = " + std::to_string(r) + ")");
@@ -99,7 +99,7 @@ StarCurve::StarCurve(Point center, Expression r) : center_(center), r_(std::move
 }
 
 Point StarCurve::position(double t) const {
-  const double r = r_({t});
+  const double r = r_(t);
   return center_ + Point{r * std::cos(t), r * std::sin(t)};
 }
 

@@ -32,7 +32,10 @@ double phase_off_corners(const Curve& curve, const ArcLengthTable& arc_length, i
 inline constexpr double default_spacing_cells_smooth = 8.0;
 inline constexpr double default_spacing_cells_nonsmooth = 12.0;
 
-/// Default number of multipliers: m = max(8, round(L / (spacing_cells·h))).
+/// The fewest multipliers a solve accepts (and the default rule gives).
+inline constexpr int minimum_multipliers = 8;
+
+/// Default number of multipliers: m = max(minimum_multipliers, round(L / (spacing_cells·h))).
 int default_multipliers(double curve_length, double h, double spacing_cells = default_spacing_cells_smooth);
 
 }  // namespace fictus

@@ -1,13 +1,18 @@
 #pragma once
-// The whole method: curves and collocation → trace rows → load → u₀ = A⁻¹f → Schur complement
-// (implicit, or explicit from the Green's table) → semismooth Newton on λ → û = u₀ + A⁻¹B_Γᵀλ →
-// Signorini checks and errors.
-//
-// FictitiousDomainSolver keeps what does not depend on the curve or the obstacle: the fast solver,
-// the Green's table T (grid, boundary and c only) and u₀ (the load f). A new obstacle g or ρ costs
-// only the m×m Newton; a new curve its trace rows, Schur blocks and Newton; the grid field û one
-// more fast solve (skip it with compute_field = false: boundary values then come from the Schur
-// blocks).
+// The whole method, as the steps of FictitiousDomainSolver::solve (docs/math.md):
+//   once per solver (grid, boundary conditions, c, f):
+//     0. load and u₀ = A⁻¹f; the Green's table T on the first explicit Schur complement;
+//   once per curve and the options that shape its rows (reused while they stay):
+//     1. geometry: γ checked, m, collocation points, δ and Γ;
+//     2. trace rows: B_γ, C_γ, B_Γ (and the kink correction);
+//     3. Schur blocks: S_B, S_C (explicit from T, or implicit with GMRES);
+//   every solve:
+//     4. obstacle g at the points;
+//     5. semismooth Newton on λ;
+//     6. field û = u₀ + A⁻¹B_Γᵀλ (+ α; kink-corrected in the non-smooth variant), or the boundary
+//        values from the Schur blocks without it;
+//     7. Signorini checks, with an independent ∂u/∂n;
+//     8. errors against an exact solution.
 #include <cstddef>
 #include <memory>
 #include <optional>
@@ -72,24 +77,26 @@ struct Solution {
   std::optional<ErrorNorms> errors;
   std::optional<PointErrors> point_errors;
   Timings timings;
-  std::size_t peak_memory_bytes = 0;    // of the process so far (VmHWM)
+  std::size_t peak_memory_bytes = 0;    // of the process so far (VmHWM; set by the caller, 0 if unknown)
 };
 
 class FictitiousDomainSolver {
  public:
-  /// Takes the grid-level data of `problem` (box, N, boundary, c, f); throws std::invalid_argument
-  /// naming the field on bad input. u₀ and T are computed on the first solve that needs them.
-  explicit FictitiousDomainSolver(const Problem& problem, int threads = 1, int load_quadrature = 2);
+  /// The grid-level data of `problem` (box, N, boundary, c, f) and the options that shape the
+  /// grid-level work (threads, load_quadrature); throws std::invalid_argument naming the field on bad
+  /// input. u₀ and T are computed on the first solve that needs them.
+  explicit FictitiousDomainSolver(const Problem& problem, const SolverOptions& options = {});
   ~FictitiousDomainSolver();
   FictitiousDomainSolver(const FictitiousDomainSolver&) = delete;
   FictitiousDomainSolver& operator=(const FictitiousDomainSolver&) = delete;
 
   const Grid& grid() const;
 
-  /// Solves with the curve, obstacle and exact solution of `problem` (its box, N, boundary, c and f
-  /// must be those given to the constructor). Reuses the previous curve's trace rows and Schur
-  /// blocks when problem.gamma is the same object and the options that shape them are unchanged.
-  Solution solve(const Problem& problem, SolverOptions options, bool compute_field = true);
+  /// Solves with the curve, obstacle and exact solution of `data` and the per-solve options
+  /// (options.threads and options.load_quadrature must be the constructor's: they shaped the
+  /// grid-level work). Reuses the previous curve's trace rows and Schur blocks when data.gamma is the
+  /// same object and the options that shape them are unchanged.
+  Solution solve(const ContactData& data, SolverOptions options, bool compute_field = true);
 
   struct State;
 
@@ -103,7 +110,5 @@ std::string describe_newton_failure(const Solution& solution);
 /// One problem, one call (a thin wrapper over FictitiousDomainSolver).
 Solution solve(const Problem& problem, SolverOptions options);
 
-/// Peak resident memory of this process in bytes (0 where unknown).
-std::size_t peak_memory_bytes();
 
 }  // namespace fictus

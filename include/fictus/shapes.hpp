@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "fictus/curve.hpp"
-#include "fictus/expression.hpp"
+#include <functional>
 
 namespace fictus {
 
@@ -42,24 +42,25 @@ class ExpressionCurve : public Curve {
 
 class ParametricCurve final : public ExpressionCurve {
  public:
-  ParametricCurve(Expression x, Expression y);
+  ParametricCurve(std::function<double(double)> x, std::function<double(double)> y);
   Point position(double t) const override;
   Point center() const override { return center_; }
 
  private:
-  Expression x_, y_;
+  std::function<double(double)> x_, y_;
   Point center_;
 };
 
 class StarCurve final : public ExpressionCurve {
  public:
-  StarCurve(Point center, Expression r);
+  /// r(t) > 0 and finite (checked on samples; throws naming geometry.r).
+  StarCurve(Point center, std::function<double(double)> r);
   Point position(double t) const override;
   Point center() const override { return center_; }
 
  private:
   Point center_;
-  Expression r_;
+  std::function<double(double)> r_;
 };
 
 class ReversedCurve final : public Curve {

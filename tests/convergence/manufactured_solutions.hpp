@@ -7,6 +7,7 @@
 #include <string>
 
 #include "fictus/problem.hpp"
+#include "fictus/io/expression.hpp"
 #include "fictus/shapes.hpp"
 
 namespace manufactured {
@@ -457,7 +458,7 @@ inline std::vector<Problem> all(int N) {
     p.name = "manufactured_star";
     p.N = N;
     p.c = 1.0;
-    p.gamma = std::make_shared<fictus::StarCurve>(fictus::Point{0.5, 0.5}, fictus::Expression("0.3 * (1 - 0.6 * cos(6 * t))^(-1/6)", {"t"}, "geometry.r"));
+    p.gamma = std::make_shared<fictus::StarCurve>(fictus::Point{0.5, 0.5}, [r = fictus::Expression("0.3 * (1 - 0.6 * cos(6 * t))^(-1/6)", {"t"}, "geometry.r")](double t) { return r({t}); });
     p.f = star::f;
     p.g = star::g;
     p.exact = star::u;

@@ -14,7 +14,7 @@
 
 #include "fictus/convergence_table.hpp"
 #include "fictus/error_norms.hpp"
-#include "fictus/expression.hpp"
+#include "fictus/io/expression.hpp"
 #include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/quadrature.hpp"
 

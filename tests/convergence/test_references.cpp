@@ -7,7 +7,7 @@
 
 #include <iostream>
 
-#include "fictus/problem_file.hpp"
+#include "fictus/io/problem_file.hpp"
 #include "reference_comparison.hpp"
 
 namespace {

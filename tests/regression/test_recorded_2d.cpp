@@ -17,7 +17,7 @@
 
 #include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/paper_problem.hpp"
-#include "fictus/problem_file.hpp"
+#include "fictus/io/problem_file.hpp"
 
 namespace {
 

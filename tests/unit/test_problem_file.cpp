@@ -5,8 +5,8 @@
 #include <cmath>
 #include <string>
 
-#include "fictus/expression.hpp"
-#include "fictus/problem_file.hpp"
+#include "fictus/io/expression.hpp"
+#include "fictus/io/problem_file.hpp"
 #include "manufactured_solutions.hpp"
 
 namespace {

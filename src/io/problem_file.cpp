@@ -1,4 +1,4 @@
-#include "fictus/problem_file.hpp"
+#include "fictus/io/problem_file.hpp"
 
 #include <toml++/toml.h>
 
@@ -9,7 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "fictus/expression.hpp"
+#include "fictus/io/expression.hpp"
 #include "fictus/options.hpp"
 #include "fictus/shapes.hpp"
 
@@ -173,11 +173,12 @@ std::shared_ptr<const Curve> read_geometry(TableReader& g, std::vector<std::stri
     }
     curve = polygon;
   } else if (shape == "parametric") {
-    curve = std::make_shared<ParametricCurve>(Expression(g.required_string("x"), {"t"}, "geometry.x"),
-                                              Expression(g.required_string("y"), {"t"}, "geometry.y"));
+    const Expression x(g.required_string("x"), {"t"}, "geometry.x"), y(g.required_string("y"), {"t"}, "geometry.y");
+    curve = std::make_shared<ParametricCurve>([x](double t) { return x({t}); }, [y](double t) { return y({t}); });
   } else if (shape == "star") {
     const auto c = g.required_numbers("center", 2);
-    curve = std::make_shared<StarCurve>(Point{c[0], c[1]}, Expression(g.required_string("r"), {"t"}, "geometry.r"));
+    const Expression r(g.required_string("r"), {"t"}, "geometry.r");
+    curve = std::make_shared<StarCurve>(Point{c[0], c[1]}, [r](double t) { return r({t}); });
   } else {
     fail("geometry.shape", "unknown shape \"" + shape + "\" (ellipse, circle, polygon, parametric, star)");
   }

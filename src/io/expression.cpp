@@ -1,4 +1,4 @@
-#include "fictus/expression.hpp"
+#include "fictus/io/expression.hpp"
 
 #include <muParser.h>
 

@@ -1,0 +1,57 @@
+#pragma once
+// The boundary of a 2-D problem: a closed curve γ, its collocation points and the curve Γ that
+// carries λ (γ itself in the non-smooth variant, the offset curve at δ outside ω in the smooth one),
+// with the trace rows of the chosen rule (docs/math.md, "Trace matrices").
+#include <memory>
+
+#include "fictus/boundary_discretization.hpp"
+#include "fictus/collocation.hpp"
+#include "fictus/curve_grid_intersection.hpp"
+#include "fictus/kink_correction.hpp"
+
+namespace fictus {
+
+class CurveDiscretization final : public BoundaryDiscretization {
+ public:
+  /// Steps 1–2 of the solve for curve γ on `grid` (c: the reaction coefficient the kink rows use):
+  ///   1. geometry: γ checked (counter-clockwise, simple, 2h inside the box), m from the default rule
+  ///      when options.multipliers = 0 and checked (8 ≤ m ≤ L/(2h)), the collocation points, δ and Γ
+  ///      (smooth variant: simple, inside the box, ≥ 4h from γ with reconstructed traces);
+  ///   2. trace rows: B_γ, C_γ, B_Γ, and the kink correction's rows and direct terms.
+  /// Throws std::invalid_argument naming the option or "geometry" on bad input.
+  CurveDiscretization(std::shared_ptr<const Curve> gamma, const Grid& grid, const SolverOptions& options, double c,
+                      const Execution& execution);
+
+  const std::vector<Point>& points() const override { return collocation_.point; }
+  const std::vector<Point>& normals() const override { return collocation_.normal; }
+  const std::vector<double>& arc_positions() const override { return collocation_.s; }
+  const SparseRows& B_gamma() const override { return B_gamma_; }
+  const SparseRows& C_gamma() const override { return C_gamma_; }
+  const SparseRows& B_Gamma() const override { return B_Gamma_; }
+  const SparseRows& loads() const override { return loads_; }
+  const DirectTerms& direct() const override { return direct_; }
+  void finish_field(const std::vector<double>& lambda, GridVector& u) const override;
+  std::optional<std::vector<double>> independent_normal_derivative(const GridVector& u,
+                                                                   std::string& rule) const override;
+  ErrorNorms errors(const GridVector& u, const ContactData& data, int quadrature,
+                    const Execution& execution) const override;
+
+  const Collocation& collocation() const { return collocation_; }
+  const std::shared_ptr<const Curve>& gamma() const { return gamma_; }
+  const std::shared_ptr<const Curve>& Gamma() const { return Gamma_; }
+  double delta() const { return delta_; }
+
+ private:
+  void make_geometry(const Grid& grid, SolverOptions options);
+  void make_trace_rows(const Grid& grid, const SolverOptions& options, double c, const Execution& execution);
+
+  std::shared_ptr<const Curve> gamma_, Gamma_;
+  Collocation collocation_;
+  double delta_ = 0;
+  std::unique_ptr<CurveGridIntersection> gamma_geometry_, Gamma_geometry_;
+  SparseRows B_gamma_, C_gamma_, B_Gamma_, loads_;
+  DirectTerms direct_;
+  std::unique_ptr<KinkCorrection> kink_;
+};
+
+}  // namespace fictus
