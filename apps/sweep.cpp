@@ -62,8 +62,8 @@ int run_sweep(const SweepArguments& args, SolverOptions options) {
     Problem problem = base;
     const double v = values[k];
     if (parameter == "g_scale") problem.g = [g = base.g, v](double x, double y) { return v * g(x, y); };
-    if (parameter == "rotate") problem.gamma = std::make_shared<TransformedCurve>(base.gamma, v, Point{0, 0});
-    if (parameter == "move") problem.gamma = std::make_shared<TransformedCurve>(base.gamma, 0.0, Point{v, 0});
+    if (parameter == "rotate") problem.gamma = std::make_shared<TransformedCurve>(base.gamma, v, Point2{0, 0});
+    if (parameter == "move") problem.gamma = std::make_shared<TransformedCurve>(base.gamma, 0.0, Point2{v, 0});
     const auto start = std::chrono::steady_clock::now();
     const Solution s = solver.solve(problem, options, args.field);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

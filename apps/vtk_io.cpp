@@ -18,7 +18,7 @@ void append_raw(std::ostream& out, const std::vector<T>& values) {
 }  // namespace
 
 void write_vti(std::ostream& out, const Problem& problem, const Solution& s) {
-  const Grid& grid = s.grid;
+  const Grid2& grid = s.grid;
   const int nx = grid.nx(), ny = grid.ny();
   const std::size_t n = std::size_t(nx + 1) * std::size_t(ny + 1);
   const CurveGridIntersection geometry(*problem.gamma, grid);
@@ -47,8 +47,8 @@ void write_vti(std::ostream& out, const Problem& problem, const Solution& s) {
   out.precision(17);
   out << "<?xml version=\"1.0\"?>\n"
       << "<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
-      << "  <ImageData WholeExtent=\"0 " << nx << " 0 " << ny << " 0 0\" Origin=\"" << grid.box().x0 << ' '
-      << grid.box().y0 << " 0\" Spacing=\"" << grid.h() << ' ' << grid.h() << " 1\">\n"
+      << "  <ImageData WholeExtent=\"0 " << nx << " 0 " << ny << " 0 0\" Origin=\"" << grid.box().lower.x << ' '
+      << grid.box().lower.y << " 0\" Spacing=\"" << grid.h() << ' ' << grid.h() << " 1\">\n"
       << "    <Piece Extent=\"0 " << nx << " 0 " << ny << " 0 0\">\n"
       << "      <PointData Scalars=\"u\">\n";
   auto array = [&](const char* type, const char* name, std::uint64_t bytes) {
@@ -83,7 +83,7 @@ void write_vtp(std::ostream& out, const Solution& s) {
   for (int i = 0; i < m; ++i) out << s.collocation.point[i].x << ' ' << s.collocation.point[i].y << " 0\n";
   if (two_curves)
     for (int i = 0; i < m; ++i) {
-      const Point p = s.Gamma->position(s.collocation.t[i]);
+      const Point2 p = s.Gamma->position(s.collocation.t[i]);
       out << p.x << ' ' << p.y << " 0\n";
     }
   out << "        </DataArray>\n      </Points>\n      <Lines>\n"

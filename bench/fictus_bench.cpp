@@ -46,8 +46,8 @@ std::string command_output(const char* command) {
 
 /// Best of `repeats` in-place 2-D DST-I (RODFT00) of the grid's unknowns.
 double dst1_seconds(int N, int threads, int repeats = 3) {
-  const fictus::Grid grid(fictus::Box{}, N);
-  const fictus::DstSolver solver(grid, 1.0, threads);
+  const fictus::Grid2 grid(fictus::Box2{}, N);
+  const fictus::DstSolver<2> solver(grid, 1.0, fictus::Execution(threads));
   fictus::GridVector v(grid.n_unknowns(), 1.0);
   double best = 1e300;
   for (int r = 0; r < repeats; ++r) {
@@ -229,7 +229,7 @@ int main(int argc, char** argv) {
       fictus::Problem p = base;
       const double v = obstacles ? 0.5 + k / 99.0 : 0.5 * k / 19.0;
       if (obstacles) p.g = [g = base.g, v](double x, double y) { return v * g(x, y); };
-      else p.gamma = std::make_shared<fictus::TransformedCurve>(base.gamma, v, fictus::Point{0, 0});
+      else p.gamma = std::make_shared<fictus::TransformedCurve>(base.gamma, v, fictus::Point2{0, 0});
       const auto t = Clock::now();
       const fictus::Solution s = solver.solve(p, o, false);
       (k == 0 ? first : rest) += since(t);

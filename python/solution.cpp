@@ -72,7 +72,7 @@ void bind_solution(py::module_& m) {
                              [](const PySolution& p) {
                                // û at all (ny+1) × (nx+1) nodes, row j = y_j (zero on a Dirichlet boundary).
                                const Solution& s = p.s();
-                               const Grid& g = s.grid;
+                               const Grid2& g = s.grid;
                                py::array_t<double> u({g.ny() + 1, g.nx() + 1});
                                auto a = u.mutable_unchecked<2>();
                                for (int j = 0; j <= g.ny(); ++j)
@@ -82,14 +82,14 @@ void bind_solution(py::module_& m) {
                              })
       .def_property_readonly("x",
                              [](const PySolution& p) {
-                               const Grid& g = p.s().grid;
+                               const Grid2& g = p.s().grid;
                                py::array_t<double> x(g.nx() + 1);
                                for (int i = 0; i <= g.nx(); ++i) x.mutable_data()[i] = g.x(i);
                                return x;
                              })
       .def_property_readonly("y",
                              [](const PySolution& p) {
-                               const Grid& g = p.s().grid;
+                               const Grid2& g = p.s().grid;
                                py::array_t<double> y(g.ny() + 1);
                                for (int j = 0; j <= g.ny(); ++j) y.mutable_data()[j] = g.y(j);
                                return y;
@@ -120,7 +120,7 @@ void bind_solution(py::module_& m) {
                                py::array_t<double> a({py::ssize_t(s.collocation.m), py::ssize_t(2)});
                                auto r = a.mutable_unchecked<2>();
                                for (int i = 0; i < s.collocation.m; ++i) {
-                                 const Point q = s.Gamma->position(s.collocation.t[i]);
+                                 const Point2 q = s.Gamma->position(s.collocation.t[i]);
                                  r(i, 0) = q.x, r(i, 1) = q.y;
                                }
                                return a;

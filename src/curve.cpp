@@ -11,57 +11,57 @@ namespace fictus {
 
 constexpr double two_pi = 2.0 * std::numbers::pi;
 
-Point Curve::outward_normal(double t) const {
-  const Point d = derivative(t);
+Point2 Curve::outward_normal(double t) const {
+  const Point2 d = derivative(t);
   const double s = norm(d);
   return {d.y / s, -d.x / s};
 }
 
 double Curve::curvature(double t) const {
-  const Point d = derivative(t), dd = second_derivative(t);
+  const Point2 d = derivative(t), dd = second_derivative(t);
   const double s = norm(d);
   return (d.x * dd.y - d.y * dd.x) / (s * s * s);
 }
 
-Ellipse::Ellipse(Point center, double a, double b, double angle)
+Ellipse::Ellipse(Point2 center, double a, double b, double angle)
     : center_(center), a_(a), b_(b), cos_(std::cos(angle)), sin_(std::sin(angle)) {
   if (!(a > 0) || !(b > 0) || !std::isfinite(a) || !std::isfinite(b))
     throw std::invalid_argument("geometry.semi_axes: must be positive and finite");
 }
 
-Point Ellipse::position(double t) const {
+Point2 Ellipse::position(double t) const {
   return center_ + rotate({a_ * std::cos(t), b_ * std::sin(t)});
 }
-Point Ellipse::derivative(double t) const { return rotate({-a_ * std::sin(t), b_ * std::cos(t)}); }
-Point Ellipse::second_derivative(double t) const {
+Point2 Ellipse::derivative(double t) const { return rotate({-a_ * std::sin(t), b_ * std::cos(t)}); }
+Point2 Ellipse::second_derivative(double t) const {
   return rotate({-a_ * std::cos(t), -b_ * std::sin(t)});
 }
 
 OffsetCurve::OffsetCurve(std::shared_ptr<const Curve> base, double delta)
     : base_(std::move(base)), delta_(delta) {}
 
-Point OffsetCurve::position(double t) const {
+Point2 OffsetCurve::position(double t) const {
   return base_->position(t) + delta_ * base_->outward_normal(t);
 }
 
-Point OffsetCurve::derivative(double t) const {
+Point2 OffsetCurve::derivative(double t) const {
   // n = J p'/|p'| with J(x, y) = (y, −x); n' = J (p''/|p'| − p' (p'·p'')/|p'|³).
-  const Point d = base_->derivative(t), dd = base_->second_derivative(t);
+  const Point2 d = base_->derivative(t), dd = base_->second_derivative(t);
   const double s = norm(d);
-  const Point w = (1.0 / s) * dd - (dot(d, dd) / (s * s * s)) * d;
-  return d + delta_ * Point{w.y, -w.x};
+  const Point2 w = (1.0 / s) * dd - (dot(d, dd) / (s * s * s)) * d;
+  return d + delta_ * Point2{w.y, -w.x};
 }
 
-Point OffsetCurve::second_derivative(double t) const {
+Point2 OffsetCurve::second_derivative(double t) const {
   const double e = 1e-5;
   return (1.0 / (2 * e)) * (derivative(t + e) - derivative(t - e));
 }
 
-TransformedCurve::TransformedCurve(std::shared_ptr<const Curve> base, double angle, Point shift)
+TransformedCurve::TransformedCurve(std::shared_ptr<const Curve> base, double angle, Point2 shift)
     : base_(std::move(base)), cos_(std::cos(angle)), sin_(std::sin(angle)), shift_(shift) {}
 
-Point TransformedCurve::position(double t) const {
-  const Point c = base_->center();
+Point2 TransformedCurve::position(double t) const {
+  const Point2 c = base_->center();
   return c + rotate(base_->position(t) - c) + shift_;
 }
 

@@ -7,7 +7,7 @@
 
 namespace fictus {
 
-CurveDiscretization::CurveDiscretization(std::shared_ptr<const Curve> gamma, const Grid& grid,
+CurveDiscretization::CurveDiscretization(std::shared_ptr<const Curve> gamma, const Grid2& grid,
                                          const SolverOptions& options, double c, const Execution& execution)
     : gamma_(std::move(gamma)) {
   if (!gamma_) throw std::invalid_argument("geometry: no curve given");
@@ -15,7 +15,7 @@ CurveDiscretization::CurveDiscretization(std::shared_ptr<const Curve> gamma, con
   make_trace_rows(grid, options, c, execution);
 }
 
-void CurveDiscretization::make_geometry(const Grid& grid, SolverOptions options) {
+void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options) {
   const Curve& gamma = *gamma_;
   const double h = grid.h();
   if (signed_area(gamma) <= 0) throw std::invalid_argument("geometry: the curve must be counter-clockwise (ω on its left)");
@@ -56,7 +56,7 @@ void CurveDiscretization::make_geometry(const Grid& grid, SolverOptions options)
   Gamma_geometry_ = std::make_unique<CurveGridIntersection>(*Gamma_, grid, "formulation.offset");
 }
 
-void CurveDiscretization::make_trace_rows(const Grid& grid, const SolverOptions& options, double c,
+void CurveDiscretization::make_trace_rows(const Grid2& grid, const SolverOptions& options, double c,
                                           const Execution& execution) {
   const Collocation& points = collocation_;
   B_gamma_ = point_value_rows(grid, points.point);

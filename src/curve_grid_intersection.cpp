@@ -13,7 +13,7 @@ namespace {
 
 constexpr double two_pi = 2.0 * std::numbers::pi;
 
-double component(Point p, int axis) { return axis == 0 ? p.x : p.y; }
+double component(Point2 p, int axis) { return axis == 0 ? p.x : p.y; }
 
 /// t ∈ [ta, tb] with component(p(t), axis) = value, given that the component minus value changes
 /// sign on [ta, tb] (Newton's method kept inside the shrinking bracket, bisection as fallback).
@@ -39,22 +39,22 @@ struct Crossing {
   double t;
   int line;       // grid line index
   bool vertical;  // x = x_line (else y = y_line)
-  Point p;
+  Point2 p;
 };
 
 }  // namespace
 
-CurveGridIntersection::CurveGridIntersection(const Curve& curve, const Grid& grid, const char* what)
+CurveGridIntersection::CurveGridIntersection(const Curve& curve, const Grid2& grid, const char* what)
     : curve_(curve), grid_(grid) {
   const double h = grid.h();
-  const Box& box = grid.box();
+  const Box2& box = grid.box();
   double max_speed = 0.0;
   for (int k = 0; k < 4096; ++k) max_speed = std::max(max_speed, curve.speed(two_pi * k / 4096));
   const int steps = std::max(256, int(std::ceil(two_pi * max_speed / (h / 8))));
   const double dt = two_pi / steps;
 
-  auto check_inside_box = [&](Point p) {
-    if (!(p.x > box.x0 && p.x < box.x1 && p.y > box.y0 && p.y < box.y1)) {
+  auto check_inside_box = [&](Point2 p) {
+    if (!(p.x > box.lower.x && p.x < box.upper.x && p.y > box.lower.y && p.y < box.upper.y)) {
       std::ostringstream msg;
       msg << what << ": the curve leaves the box at (" << p.x << ", " << p.y << ")";
       throw std::invalid_argument(msg.str());
@@ -62,22 +62,22 @@ CurveGridIntersection::CurveGridIntersection(const Curve& curve, const Grid& gri
   };
 
   std::vector<Crossing> crossings;
-  Point pa = curve.position(0.0);
+  Point2 pa = curve.position(0.0);
   check_inside_box(pa);
   for (int k = 0; k < steps; ++k) {
     const double ta = k * dt, tb = k + 1 == steps ? two_pi : (k + 1) * dt;
     // The last step ends at the start point exactly: a curve that starts on a grid line must cross
     // it again when it closes (position(2π) may differ from position(0) by rounding).
-    const Point pb = k + 1 == steps ? curve.position(0.0) : curve.position(tb);
+    const Point2 pb = k + 1 == steps ? curve.position(0.0) : curve.position(tb);
     check_inside_box(pb);
     for (int axis = 0; axis < 2; ++axis) {
-      const double origin = axis == 0 ? box.x0 : box.y0;
+      const double origin = axis == 0 ? box.lower.x : box.lower.y;
       const int la = int(std::floor((component(pa, axis) - origin) / h));
       const int lb = int(std::floor((component(pb, axis) - origin) / h));
       for (int line = std::min(la, lb) + 1; line <= std::max(la, lb); ++line) {
         const double value = origin + line * h;
         const double t = find_parameter(curve, axis, value, ta, tb);
-        Point p = curve.position(t);
+        Point2 p = curve.position(t);
         (axis == 0 ? p.x : p.y) = value;
         crossings.push_back({t, line, axis == 0, p});
       }
@@ -98,7 +98,7 @@ CurveGridIntersection::CurveGridIntersection(const Curve& curve, const Grid& gri
   double start = 0.0;
   auto add_piece = [&](double t0, double t1) {
     if (t1 - t0 <= 1e-14) return;
-    const Point mid = curve.position(0.5 * (t0 + t1));
+    const Point2 mid = curve.position(0.5 * (t0 + t1));
     pieces_.push_back({t0, t1, grid.cell_x(mid.x), grid.cell_y(mid.y)});
   };
   for (const Crossing& c : crossings) {
@@ -187,7 +187,7 @@ void CurveGridIntersection::cut_cell_rule(const CutCell& cell, int q, std::vecto
   // Integrate along lines of the direction the curve crosses most transversally.
   double extent[2] = {0.0, 0.0};
   for (int k : cell.pieces) {
-    const Point d = curve_.position(pieces_[k].t1) - curve_.position(pieces_[k].t0);
+    const Point2 d = curve_.position(pieces_[k].t1) - curve_.position(pieces_[k].t0);
     extent[0] += std::abs(d.x);
     extent[1] += std::abs(d.y);
   }

@@ -1,70 +1,74 @@
 #include "fictus/dst_solver.hpp"
 
-#include <cmath>
-#include <numbers>
 #include <stdexcept>
 
 #include "fftw_plan.hpp"
 
 namespace fictus {
 
-Spectrum1d::Spectrum1d(int n_cells, double h, Boundary boundary) {
-  const bool periodic = boundary == Boundary::periodic;
-  const int count = periodic ? n_cells : n_cells - 1;
-  stiffness.resize(count);
-  mass.resize(count);
-  for (int k = 0; k < count; ++k) {
-    const double angle = periodic ? 2.0 * std::numbers::pi * k / n_cells : std::numbers::pi * (k + 1) / n_cells;
-    const double cp = std::cos(angle);
-    stiffness[k] = (2.0 / h) * (1.0 - cp);
-    mass[k] = (h / 3.0) * (2.0 + cp);
-  }
+template <int dim>
+std::unique_ptr<FastSolver<dim>> make_fast_solver(const Grid<dim>& grid, double c, const Execution& execution) {
+  if (grid.periodic()) return std::make_unique<PeriodicSolver<dim>>(grid, c, execution);
+  return std::make_unique<DstSolver<dim>>(grid, c, execution);
 }
 
-std::unique_ptr<FastSolver> make_fast_solver(const Grid& grid, double c, int threads) {
-  if (grid.periodic()) return std::make_unique<PeriodicSolver>(grid, c, threads);
-  return std::make_unique<DstSolver>(grid, c, threads);
-}
-
-DstSolver::DstSolver(const Grid& grid, double c, int threads)
-    : grid_(grid), c_(c), threads_(threads < 1 ? 1 : threads), sx_(grid.nx(), grid.h(), Boundary::dirichlet),
-      sy_(grid.ny(), grid.h(), Boundary::dirichlet) {
-  if (!(c >= 0.0) || !std::isfinite(c)) throw std::invalid_argument("data.c: must be finite and >= 0");
+template <int dim>
+DstSolver<dim>::DstSolver(const Grid<dim>& grid, double c, const Execution& execution)
+    : grid_(grid), symbol_(grid, c), threads_(execution.threads()) {
   if (grid.periodic()) throw std::invalid_argument("DstSolver: needs a Dirichlet box");
-  plan_ = std::make_unique<detail::R2rPlan2d>(grid.ny() - 1, grid.nx() - 1, detail::R2rKind::dst1,
-                                              threads_);
+  std::vector<int> shape;  // slowest axis first
+  for (int d = dim - 1; d >= 0; --d) shape.push_back(grid.n(d) - 1);
+  plan_ = std::make_unique<detail::R2rPlan>(shape, detail::R2rKind::dst1, threads_);
 }
 
-DstSolver::~DstSolver() = default;
+template <int dim>
+DstSolver<dim>::~DstSolver() = default;
 
-void DstSolver::scale_by(GridVector& v, bool inverse) const {
-  const int nx = grid_.nx() - 1, ny = grid_.ny() - 1;
-  const double norm = 1.0 / (4.0 * grid_.nx() * grid_.ny());
+template <int dim>
+void DstSolver<dim>::scale_by(GridVector& v, bool inverse) const {
+  const int row_length = grid_.n(0) - 1;
+  int rows = 1;
+  double denominator = double(1 << dim);
+  for (int d = 0; d < dim; ++d) denominator *= grid_.n(d);
+  for (int d = 1; d < dim; ++d) rows *= grid_.n(d) - 1;
+  const double norm = 1.0 / denominator;
 #pragma omp parallel for num_threads(threads_) schedule(static)
-  for (int q = 0; q < ny; ++q) {
-    double* row = v.data() + std::size_t(q) * nx;
-    const double kq = sy_.stiffness[q], mq = sy_.mass[q];
-    for (int p = 0; p < nx; ++p) {
-      const double lambda = sx_.stiffness[p] * mq + sx_.mass[p] * kq + c_ * sx_.mass[p] * mq;
+  for (int r = 0; r < rows; ++r) {
+    std::array<int, dim> slow{};
+    for (int d = 1, rest = r; d < dim; ++d) slow[d] = rest % (grid_.n(d) - 1), rest /= grid_.n(d) - 1;
+    const typename Q1Symbol<dim>::Row factors = symbol_.row(slow);
+    double* row = v.data() + std::size_t(r) * std::size_t(row_length);
+    for (int p = 0; p < row_length; ++p) {
+      const double lambda = symbol_(p, factors);
       row[p] *= inverse ? norm / lambda : norm * lambda;
     }
   }
 }
 
-void DstSolver::solve_in_place(GridVector& r) const {
+template <int dim>
+void DstSolver<dim>::solve_in_place(GridVector& r) const {
   if (r.size() != grid_.n_unknowns()) throw std::invalid_argument("DstSolver: vector size mismatch");
   plan_->execute(r.data());
   scale_by(r, true);
   plan_->execute(r.data());
 }
 
-void DstSolver::transform(GridVector& v) const { plan_->execute(v.data()); }
+template <int dim>
+void DstSolver<dim>::transform(GridVector& v) const {
+  plan_->execute(v.data());
+}
 
-void DstSolver::apply(const GridVector& x, GridVector& y) const {
+template <int dim>
+void DstSolver<dim>::apply(const GridVector& x, GridVector& y) const {
   y = x;
   plan_->execute(y.data());
   scale_by(y, false);
   plan_->execute(y.data());
 }
+
+template class DstSolver<2>;
+template class DstSolver<3>;
+template std::unique_ptr<FastSolver<2>> make_fast_solver(const Grid<2>&, double, const Execution&);
+template std::unique_ptr<FastSolver<3>> make_fast_solver(const Grid<3>&, double, const Execution&);
 
 }  // namespace fictus

@@ -8,11 +8,11 @@ namespace fictus {
 GradientField numerical_gradient(ScalarField u, double scale) {
   const double e = 1e-6 * scale;
   return [u = std::move(u), e](double x, double y) {
-    return Point{(u(x + e, y) - u(x - e, y)) / (2 * e), (u(x, y + e) - u(x, y - e)) / (2 * e)};
+    return Point2{(u(x + e, y) - u(x - e, y)) / (2 * e), (u(x, y + e) - u(x, y - e)) / (2 * e)};
   };
 }
 
-Q1Sample sample_q1(const Grid& grid, const GridVector& u_h, int ix, int iy, double x, double y) {
+Q1Sample sample_q1(const Grid2& grid, const GridVector& u_h, int ix, int iy, double x, double y) {
   auto node = [&](int i, int j) { return grid.has_unknown(i, j) ? u_h[grid.index(i, j)] : 0.0; };
   const double h = grid.h();
   const double xi = (x - grid.x(ix)) / h, eta = (y - grid.y(iy)) / h;
@@ -53,7 +53,7 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
   if (exact_gradient)
     gradient = [exact_gradient](std::size_t n, const double* x, const double* y, double* gx, double* gy) {
       for (std::size_t k = 0; k < n; ++k) {
-        const Point g = exact_gradient(x[k], y[k]);
+        const Point2 g = exact_gradient(x[k], y[k]);
         gx[k] = g.x, gy[k] = g.y;
       }
     };
@@ -62,8 +62,8 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
 
 ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& gamma, const VectorizedField& exact,
                           const VectorizedGradient& exact_gradient, int q, int threads) {
-  const Grid& grid = gamma.grid();
-  const double e = 1e-6 * (grid.box().x1 - grid.box().x0);
+  const Grid2& grid = gamma.grid();
+  const double e = 1e-6 * (grid.box().upper.x - grid.box().lower.x);
   // Over ω, row by row: [e², |∇e|², u², |∇u|²], summed per cell, per row, then over rows.
   std::array<double, 4> omega{};
 #pragma omp parallel num_threads(threads < 1 ? 1 : threads)
@@ -83,8 +83,8 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
       std::array<double, 4> row{}, cell{};
       for (std::size_t k = 0; k < n; ++k) {
         const Q1Sample s = sample_q1(grid, u_h, points[k].ix, iy, x[k], y[k]);
-        const Point du{gx[k], gy[k]};
-        const Point de = s.gradient - du;
+        const Point2 du{gx[k], gy[k]};
+        const Point2 de = s.gradient - du;
         const double w = points[k].weight;
         cell[0] += w * (s.value - u[k]) * (s.value - u[k]);
         cell[1] += w * dot(de, de);
@@ -106,7 +106,7 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
   for (const CurvePiece& piece : gamma.pieces())
     for (int g = 0; g < q; ++g) {
       const double t = piece.t0 + rule.nodes[g] * (piece.t1 - piece.t0);
-      const Point p = gamma.curve().position(t);
+      const Point2 p = gamma.curve().position(t);
       x.push_back(p.x), y.push_back(p.y), cell_x.push_back(piece.ix), cell_y.push_back(piece.iy);
       w.push_back(rule.weights[g] * (piece.t1 - piece.t0) * gamma.curve().speed(t));
     }

@@ -1,39 +1,41 @@
 #pragma once
-// The one place fictus touches FFTW: a non-copyable RAII plan for 2-D real-to-real transforms,
-// executed on caller arrays that come from the FFTW allocator (same alignment as at planning).
+// The one place fictus touches FFTW: non-copyable RAII plans for multi-dimensional real-to-real
+// transforms and real DFTs, executed on caller arrays from the aligned allocator (the alignment the
+// plans were made for).
 #include <fftw3.h>
 
 #include <complex>
 #include <cstddef>
+#include <vector>
 
 namespace fictus::detail {
 
 enum class R2rKind { dst1, dct1 };  // FFTW RODFT00 / REDFT00, unnormalized
 
-class R2rPlan2d {
+class R2rPlan {
  public:
-  /// Plans an in-place transform of an n_slow × n_fast row-major array with `threads` threads.
-  /// FFTW_ESTIMATE: planning never touches data and takes microseconds.
-  R2rPlan2d(int n_slow, int n_fast, R2rKind kind, int threads);
-  ~R2rPlan2d();
-  R2rPlan2d(const R2rPlan2d&) = delete;
-  R2rPlan2d& operator=(const R2rPlan2d&) = delete;
+  /// Plans an in-place transform of a row-major array of shape `shape` (slowest axis first) with
+  /// `threads` threads. FFTW_ESTIMATE: planning never touches data and takes microseconds.
+  R2rPlan(const std::vector<int>& shape, R2rKind kind, int threads);
+  ~R2rPlan();
+  R2rPlan(const R2rPlan&) = delete;
+  R2rPlan& operator=(const R2rPlan&) = delete;
 
-  /// In-place transform of data[0 .. n_slow·n_fast).
+  /// In-place transform of data[0 .. Π shape).
   void execute(double* data) const;
 
  private:
   fftw_plan plan_ = nullptr;
 };
 
-/// Out-of-place 2-D real DFT pair (FFTW r2c / c2r, unnormalized) of an n_slow × n_fast real array
-/// and its n_slow × (n_fast/2 + 1) half spectrum.
-class RealDft2d {
+/// Out-of-place real DFT pair (FFTW r2c / c2r, unnormalized) of a row-major real array of shape
+/// `shape` and its half spectrum (the fastest axis has shape.back()/2 + 1 entries).
+class RealDft {
  public:
-  RealDft2d(int n_slow, int n_fast, int threads);
-  ~RealDft2d();
-  RealDft2d(const RealDft2d&) = delete;
-  RealDft2d& operator=(const RealDft2d&) = delete;
+  RealDft(const std::vector<int>& shape, int threads);
+  ~RealDft();
+  RealDft(const RealDft&) = delete;
+  RealDft& operator=(const RealDft&) = delete;
 
   void forward(double* real, std::complex<double>* spectrum) const;   // keeps `real`
   void backward(std::complex<double>* spectrum, double* real) const;  // overwrites `spectrum`

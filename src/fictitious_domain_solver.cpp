@@ -62,7 +62,7 @@ bool same_curve_options(const SolverOptions& a, const SolverOptions& b) {
          a.krylov_tolerance == b.krylov_tolerance && a.krylov_max_iterations == b.krylov_max_iterations;
 }
 
-std::string format_point(Point p) {
+std::string format_point(Point2 p) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "(%.6g, %.6g)", p.x, p.y);
   return buffer;
@@ -81,14 +81,14 @@ struct CurveSetup {
 };
 
 struct FictitiousDomainSolver::State {
-  Grid grid;
+  Grid2 grid;
   double c;
   Execution execution;
   int load_quadrature;
   ScalarField f;
   VectorizedField f_vectorized;
-  std::unique_ptr<FastSolver> fast;
-  std::unique_ptr<GreenTable> green;
+  std::unique_ptr<FastSolver<2>> fast;
+  std::unique_ptr<GreenTable<2>> green;
   GridVector u0;
   bool have_u0 = false;
   double load_total = 0;
@@ -98,16 +98,16 @@ struct FictitiousDomainSolver::State {
 FictitiousDomainSolver::FictitiousDomainSolver(const Problem& problem, const SolverOptions& options) {
   validate_options(problem, options);
   if (!problem.f && !problem.f_vectorized) throw std::invalid_argument("data.f: not given");
-  const Grid grid(problem.box, problem.N, problem.boundary);
+  const Grid2 grid(problem.box, problem.N, problem.boundary);
   const Execution execution(options.threads);
   state_ = std::make_unique<State>(State{grid, problem.c, execution, options.load_quadrature, problem.f,
-                                         problem.f_vectorized, make_fast_solver(grid, problem.c, execution.threads()),
+                                         problem.f_vectorized, make_fast_solver(grid, problem.c, execution),
                                          nullptr, {}, false, 0.0, nullptr});
 }
 
 FictitiousDomainSolver::~FictitiousDomainSolver() = default;
 
-const Grid& FictitiousDomainSolver::grid() const { return state_->grid; }
+const Grid2& FictitiousDomainSolver::grid() const { return state_->grid; }
 
 namespace {
 
@@ -143,7 +143,7 @@ std::unique_ptr<SchurComplement> schur_blocks(State& st, const BoundaryDiscretiz
                                            boundary.direct());
   }
   if (!st.green) {
-    st.green = std::make_unique<GreenTable>(st.grid, st.c, st.execution.threads());
+    st.green = std::make_unique<GreenTable<2>>(st.grid, st.c, st.execution);
     clock.mark("green_table");
   }
   auto schur = std::make_unique<ExplicitSchur>(*st.green, boundary.B_gamma(), boundary.C_gamma(), boundary.loads(),
@@ -180,7 +180,7 @@ const CurveSetup& curve_setup(State& st, const ContactData& data, const SolverOp
 /// Step 4: g at the collocation points (a batch callable, g(x, y, s) along γ, or g(x, y)).
 std::vector<double> obstacle(const ContactData& data, const BoundaryDiscretization& boundary) {
   const int m = boundary.n_points();
-  const std::vector<Point>& p = boundary.points();
+  const std::vector<Point2>& p = boundary.points();
   std::vector<double> g(m);
   if (data.g_vectorized && !data.g_along_curve) {
     std::vector<double> x(m), y(m);
@@ -257,20 +257,20 @@ void signorini_checks(const BoundaryDiscretization& boundary, Solution& sol) {
 /// Step 8a: the errors of the traces at the points. ∂u/∂n of the exact solution: its gradient when
 /// given, else a one-sided second-order difference into ω (u may be defined in ω only):
 /// (3u(x) − 4u(x − εn) + u(x − 2εn))/(2ε), ε = 1e-5·box width.
-PointErrors point_errors(const ContactData& data, const BoundaryDiscretization& boundary, const Grid& grid,
+PointErrors point_errors(const ContactData& data, const BoundaryDiscretization& boundary, const Grid2& grid,
                          const Solution& sol) {
   const VectorizedField exact = data.exact_vectorized ? data.exact_vectorized : vectorize(data.exact);
-  const std::vector<Point>& p = boundary.points();
-  const std::vector<Point>& n = boundary.normals();
+  const std::vector<Point2>& p = boundary.points();
+  const std::vector<Point2>& n = boundary.normals();
   const std::size_t m = p.size();
   std::vector<double> x(m), y(m), values(m);
   for (std::size_t i = 0; i < m; ++i) x[i] = p[i].x, y[i] = p[i].y;
   exact(m, x.data(), y.data(), values.data());
-  const double step = 1e-5 * (grid.box().x1 - grid.box().x0);
+  const double step = 1e-5 * (grid.box().upper.x - grid.box().lower.x);
   std::vector<double> xs(2 * m), ys(2 * m), inner(2 * m);
   for (std::size_t i = 0; i < m; ++i)
     for (int k = 0; k < 2; ++k) {
-      const Point q = p[i] - (k + 1) * step * n[i];
+      const Point2 q = p[i] - (k + 1) * step * n[i];
       xs[2 * i + k] = q.x, ys[2 * i + k] = q.y;
     }
   if (!data.exact_gradient) exact(2 * m, xs.data(), ys.data(), inner.data());

@@ -1,39 +1,52 @@
 #include "fictus/green_table.hpp"
 
-#include <cmath>
-#include <stdexcept>
-
 #include "fftw_plan.hpp"
-#include "fictus/fast_solver.hpp"
+#include "fictus/q1_symbol.hpp"
 
 namespace fictus {
 
-GreenTable::GreenTable(const Grid& grid, double c, int threads)
-    : grid_(grid), c_(c), periodic_(grid.periodic()),
-      nx_(grid.periodic() ? grid.nx() : 2 * grid.nx()), ny_(grid.periodic() ? grid.ny() : 2 * grid.ny()),
-      width_(std::size_t(nx_ / 2 + 1)) {
-  if (!(c >= 0.0) || !std::isfinite(c)) throw std::invalid_argument("data.c: must be finite and >= 0");
-  const Spectrum1d sx(grid.nx(), grid.h(), grid.boundary()), sy(grid.ny(), grid.h(), grid.boundary());
-  const int rows = ny_ / 2 + 1, cols = int(width_);
-  table_.assign(std::size_t(rows) * width_, 0.0);
-  // Mode (p, q) of the table. Dirichlet: p = 1..nx−1 (spectrum index p−1), zero at p ∈ {0, nx};
-  // periodic: p = 0..nx/2 (spectrum index p), the zero mode dropped when λ = 0.
-  const double scale = periodic_ ? 1.0 / (double(grid.nx()) * grid.ny()) : 1.0 / (4.0 * grid.nx() * grid.ny());
-  const int shift = periodic_ ? 0 : 1;
-#pragma omp parallel for num_threads(threads < 1 ? 1 : threads) schedule(static)
-  for (int q = 0; q < rows; ++q) {
-    const int iq = q - shift;
-    if (iq < 0 || iq >= int(sy.mass.size())) continue;
-    double* row = table_.data() + std::size_t(q) * width_;
-    for (int p = 0; p < cols; ++p) {
+template <int dim>
+GreenTable<dim>::GreenTable(const Grid<dim>& grid, double c, const Execution& execution)
+    : grid_(grid), c_(c), periodic_(grid.periodic()) {
+  const Q1Symbol<dim> symbol(grid, c);
+  std::size_t entries = 1;
+  for (int d = 0; d < dim; ++d) {
+    period_[d] = periodic_ ? grid.n(d) : 2 * grid.n(d);
+    size_[d] = std::size_t(period_[d] / 2 + 1);
+    entries *= size_[d];
+  }
+  table_.assign(entries, 0.0);
+  // Table entry p holds 1/λ of mode p. Dirichlet: p_d = 1..n_d−1 (spectrum index p_d − 1), zero at
+  // p_d ∈ {0, n_d}; periodic: p_d = 0..n_d/2 (spectrum index p_d), the zero mode dropped when λ = 0.
+  double denominator = periodic_ ? 1.0 : double(1 << dim);
+  for (int d = 0; d < dim; ++d) denominator *= grid.n(d);
+  const double scale = 1.0 / denominator;
+  const int shift = periodic_ ? 0 : 1, rows = int(entries / size_[0]), row_length = int(size_[0]);
+#pragma omp parallel for num_threads(execution.threads()) schedule(static)
+  for (int r = 0; r < rows; ++r) {
+    std::array<int, dim> slow{};
+    bool inside = true;
+    for (int d = 1, rest = r; d < dim; ++d) {
+      slow[d] = rest % int(size_[d]) - shift, rest /= int(size_[d]);
+      inside = inside && slow[d] >= 0 && slow[d] < symbol.axis(d).size();
+    }
+    if (!inside) continue;
+    const typename Q1Symbol<dim>::Row factors = symbol.row(slow);
+    double* row = table_.data() + std::size_t(r) * size_[0];
+    for (int p = 0; p < row_length; ++p) {
       const int ip = p - shift;
-      if (ip < 0 || ip >= int(sx.mass.size())) continue;
-      const double lambda = sx.stiffness[ip] * sy.mass[iq] + sx.mass[ip] * sy.stiffness[iq] + c * sx.mass[ip] * sy.mass[iq];
+      if (ip < 0 || ip >= symbol.axis(0).size()) continue;
+      const double lambda = symbol(ip, factors);
       row[p] = lambda > 0 ? scale / lambda : 0.0;
     }
   }
-  detail::R2rPlan2d plan(rows, cols, detail::R2rKind::dct1, threads);
+  std::vector<int> shape;  // slowest axis first
+  for (int d = dim - 1; d >= 0; --d) shape.push_back(int(size_[d]));
+  detail::R2rPlan plan(shape, detail::R2rKind::dct1, execution.threads());
   plan.execute(table_.data());
 }
+
+template class GreenTable<2>;
+template class GreenTable<3>;
 
 }  // namespace fictus

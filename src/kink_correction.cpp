@@ -23,11 +23,11 @@ struct Kink {
   double t = 0.0;      // parameter of the nearest point, in [0, 2π)
   double d = 0.0;      // signed distance, > 0 outside ω
   double kappa = 0.0;  // curvature there
-  Point normal;        // outward unit normal there
-  Point foot;          // the nearest point itself
+  Point2 normal;        // outward unit normal there
+  Point2 foot;          // the nearest point itself
   double q() const { return d - 0.5 * kappa * d * d; }                // ψ outside ω, extended smoothly inside
   double psi() const { return d > 0 ? q() : 0.0; }                    // q(d)⁺
-  Point grad_q() const { return (1.0 - kappa * d) * normal; }          // ∇q (d small)
+  Point2 grad_q() const { return (1.0 - kappa * d) * normal; }          // ∇q (d small)
 };
 
 double wrap(double t) {
@@ -47,18 +47,18 @@ class Projector {
 
   /// The nearest point of a point y near x (within a few cells) from x's nearest point: on a curve
   /// without corners by its osculating circle there (d, n, t to O(κ′|y − x|³)), otherwise exactly.
-  Kink near(const Kink& at_x, Point y, double speed) const {
+  Kink near(const Kink& at_x, Point2 y, double speed) const {
     if (!corners_.empty()) return (*this)(y, at_x.t);
     Kink k = at_x;
-    const Point p = at_x.foot;
+    const Point2 p = at_x.foot;
     if (std::abs(at_x.kappa) * norm(y - p) < 1e-12) {
-      const Point tangent{-at_x.normal.y, at_x.normal.x};
+      const Point2 tangent{-at_x.normal.y, at_x.normal.x};
       k.d = dot(y - p, at_x.normal);
       k.t = wrap(at_x.t + dot(y - p, tangent) / speed);
       return k;
     }
     const double rho = 1.0 / at_x.kappa;
-    const Point centre = p - rho * at_x.normal, v = y - centre, u = p - centre;
+    const Point2 centre = p - rho * at_x.normal, v = y - centre, u = p - centre;
     const double r = norm(v);
     k.d = rho > 0 ? r - rho : -rho - r;
     k.normal = (rho > 0 ? 1.0 / r : -1.0 / r) * v;
@@ -68,7 +68,7 @@ class Projector {
     return k;
   }
 
-  Kink operator()(Point x, double t0) const {
+  Kink operator()(Point2 x, double t0) const {
     if (corners_.empty()) return at(x, wrap(newton(x, t0, -1e300, 1e300)));
     const int n = int(corners_.size());
     // The piece [corner k, corner k+1) holding t0; -1: before the first corner (the last piece).
@@ -86,8 +86,8 @@ class Projector {
     if (!at_corner) return at(x, wrap(best_t));
     // Nearest at the corner V: the side from the mean of the two edge normals there.
     const double tv = wrap(best_t), e = 1e-9;
-    const Point V = curve_.position(tv);
-    const Point mean = curve_.outward_normal(wrap(tv - e)) + curve_.outward_normal(wrap(tv + e));
+    const Point2 V = curve_.position(tv);
+    const Point2 mean = curve_.outward_normal(wrap(tv - e)) + curve_.outward_normal(wrap(tv + e));
     const double r = norm(x - V);
     Kink k;
     k.t = tv;
@@ -99,11 +99,11 @@ class Projector {
   }
 
  private:
-  double newton(Point x, double t, double lo, double hi) const {
+  double newton(Point2 x, double t, double lo, double hi) const {
     for (int it = 0; it < 12; ++it) {
       const double tw = wrap(t);
-      const Point p = curve_.position(tw), d1 = curve_.derivative(tw), d2 = curve_.second_derivative(tw);
-      const Point r = p - x;
+      const Point2 p = curve_.position(tw), d1 = curve_.derivative(tw), d2 = curve_.second_derivative(tw);
+      const Point2 r = p - x;
       const double f = dot(r, d1), df = dot(d1, d1) + dot(r, d2);
       const double step = df > 0 ? f / df : f / dot(d1, d1);
       const double next = std::clamp(t - step, lo, hi);
@@ -112,7 +112,7 @@ class Projector {
     }
     return t;
   }
-  Kink at(Point x, double t) const {
+  Kink at(Point2 x, double t) const {
     Kink k;
     k.t = t;
     k.normal = curve_.outward_normal(t);
@@ -145,7 +145,7 @@ class ArcIndex {
 /// of a cut cell next to it (computed once); nodes met later are projected exactly.
 class NodeKinks {
  public:
-  NodeKinks(const Curve& curve, const Grid& grid) : project_(curve), grid_(grid) {}
+  NodeKinks(const Curve& curve, const Grid2& grid) : project_(curve), grid_(grid) {}
   std::size_t key(int i, int j) const { return std::size_t(j + 2) * std::size_t(grid_.nx() + 5) + std::size_t(i + 2); }
   /// The band: every node of `nodes` with the index of a cut cell near it (the first one wins).
   void build(std::vector<std::pair<std::size_t, int>> nodes, const std::vector<Kink>& centres,
@@ -186,7 +186,7 @@ class NodeKinks {
     return it != keys_.end() && *it == key(i, j) ? &kinks_[std::size_t(it - keys_.begin())] : nullptr;
   }
   Projector project_;
-  const Grid& grid_;
+  const Grid2& grid_;
   std::vector<std::size_t> keys_;  // sorted
   std::vector<Kink> kinks_;
   std::unordered_map<std::size_t, Kink> extra_;
@@ -195,7 +195,7 @@ class NodeKinks {
 /// Q1 on a square cell, local nodes (0,0), (1,0), (0,1), (1,1): value and gradient at (ξ, η).
 struct Q1Basis {
   double value[4];
-  Point gradient[4];
+  Point2 gradient[4];
   Q1Basis(double xi, double eta, double h) {
     for (int k = 0; k < 4; ++k) {
       const int a = k & 1, b = k >> 1;
@@ -247,7 +247,7 @@ const SparseRows& KinkCorrection::galerkin() const { return state_->galerkin; }
 
 KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Collocation& arcs, double c, int threads)
     : state_(std::make_unique<State>(gamma, arcs)) {
-  const Grid& grid = gamma.grid();
+  const Grid2& grid = gamma.grid();
   const Projector project(gamma.curve());
   const double h = grid.h();
   const int m = arcs.m;
@@ -305,7 +305,7 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
         const Kink kink = project.near(centres[n], {x, y}, speeds[n]);
         const Q1Basis basis((x - x0) / h, (y - y0) / h, h);
         const double q = kink.q();
-        const Point grad = kink.grad_q();
+        const Point2 grad = kink.grad_q();
         std::array<double, 4>& v = sums_of(arc_of(kink.t));
         for (int k = 0; k < 4; ++k) v[k] += w * (dot(grad, basis.gradient[k]) + c * q * basis.value[k]);
       };
@@ -348,7 +348,7 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
 }
 
 void KinkCorrection::add_kinks(const std::vector<double>& lambda, GridVector& u) const {
-  const Grid& grid = state_->gamma.grid();
+  const Grid2& grid = state_->gamma.grid();
   state_->nodes.for_each([&](int i, int j, const Kink& kink) {
     const double psi = kink.psi();
     if (psi != 0.0 && grid.has_unknown(i, j)) u[grid.index(i, j)] += lambda[state_->arc_of(kink.t)] * psi;

@@ -13,11 +13,11 @@ VectorizedField vectorize(ScalarField f) {
   };
 }
 
-GridVector assemble_load(const Grid& grid, const ScalarField& f, int q, int threads) {
+GridVector assemble_load(const Grid2& grid, const ScalarField& f, int q, int threads) {
   return assemble_load(grid, vectorize(f), q, threads);
 }
 
-GridVector assemble_load(const Grid& grid, const VectorizedField& f, int q, int threads) {
+GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q, int threads) {
   const GaussRule& rule = gauss_legendre(q);
   const int nx = grid.nx(), ny = grid.ny(), qq = q * q;
   const double h = grid.h(), area = h * h;

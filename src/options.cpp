@@ -126,11 +126,11 @@ std::vector<OptionSpec> make_specs() {
     box.meaning = "Ω = [x0, x1] × [y0, y1]";
     box.rule = "finite, x0 < x1, y0 < y1";
     box.get = [](const Problem& p, const SolverOptions&) -> OptionValue {
-      return std::vector<double>{p.box.x0, p.box.x1, p.box.y0, p.box.y1};
+      return std::vector<double>{p.box.lower.x, p.box.upper.x, p.box.lower.y, p.box.upper.y};
     };
     box.set = [](Problem& p, SolverOptions&, const OptionValue& v) {
       const auto& b = std::get<std::vector<double>>(v);
-      p.box = Box{b[0], b[1], b[2], b[3]};
+      p.box = Box2{{b[0], b[2]}, {b[1], b[3]}};
     };
     box.violation = [](const OptionValue& v) {
       const auto& b = std::get<std::vector<double>>(v);

@@ -18,15 +18,15 @@ double u_exact(double x, double y) {
 Problem paper_problem(int N, double c, Boundary boundary) {
   Problem p;
   p.name = boundary == Boundary::periodic ? "paper_ellipse_periodic" : "paper_ellipse";
-  p.box = Box{0.0, 1.0, 0.0, 1.0};
+  p.box = Box2{};
   p.N = N;
   p.boundary = boundary;
-  p.gamma = std::make_shared<Ellipse>(Point{0.5, 0.5}, 0.4, 0.2, 0.0);
+  p.gamma = std::make_shared<Ellipse>(Point2{0.5, 0.5}, 0.4, 0.2, 0.0);
   p.c = c;
   p.exact = u_exact;
   p.exact_gradient = [](double x, double y) {
     const double a = pos(x - 0.5), b = pos(y - 0.5);
-    return Point{3 * a * a, 1.5 * b * b};
+    return Point2{3 * a * a, 1.5 * b * b};
   };
   // −Δu_ex = −6(x−½)⁺ − 3(y−½)⁺
   p.f = [c](double x, double y) { return -6.0 * pos(x - 0.5) - 3.0 * pos(y - 0.5) + c * u_exact(x, y); };

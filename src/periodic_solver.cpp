@@ -1,33 +1,41 @@
-#include "fictus/fast_solver.hpp"
-
-#include <cmath>
 #include <stdexcept>
 
 #include "fftw_plan.hpp"
+#include "fictus/fast_solver.hpp"
 
 namespace fictus {
 
-PeriodicSolver::PeriodicSolver(const Grid& grid, double c, int threads)
-    : grid_(grid), c_(c), threads_(threads < 1 ? 1 : threads), sx_(grid.nx(), grid.h(), Boundary::periodic),
-      sy_(grid.ny(), grid.h(), Boundary::periodic) {
-  if (!(c >= 0.0) || !std::isfinite(c)) throw std::invalid_argument("data.c: must be finite and >= 0");
+template <int dim>
+PeriodicSolver<dim>::PeriodicSolver(const Grid<dim>& grid, double c, const Execution& execution)
+    : grid_(grid), symbol_(grid, c), threads_(execution.threads()) {
   if (!grid.periodic()) throw std::invalid_argument("PeriodicSolver: needs a periodic box");
-  dft_ = std::make_unique<detail::RealDft2d>(grid.ny(), grid.nx(), threads_);
-  spectrum_.resize(std::size_t(grid.ny()) * std::size_t(grid.nx() / 2 + 1));
+  std::vector<int> shape;  // slowest axis first
+  for (int d = dim - 1; d >= 0; --d) shape.push_back(grid.n(d));
+  dft_ = std::make_unique<detail::RealDft>(shape, threads_);
+  spectrum_.resize(grid.n_unknowns() / std::size_t(grid.n(0)) * std::size_t(grid.n(0) / 2 + 1));
 }
 
-PeriodicSolver::~PeriodicSolver() = default;
+template <int dim>
+PeriodicSolver<dim>::~PeriodicSolver() = default;
 
-void PeriodicSolver::transform(GridVector& v, bool inverse) const {
+template <int dim>
+void PeriodicSolver<dim>::transform(GridVector& v, bool inverse) const {
   if (v.size() != grid_.n_unknowns()) throw std::invalid_argument("PeriodicSolver: vector size mismatch");
   dft_->forward(v.data(), spectrum_.data());
-  const int nq = grid_.ny(), np = grid_.nx() / 2 + 1;
-  const double norm = 1.0 / (double(grid_.nx()) * grid_.ny());
+  const int row_length = grid_.n(0) / 2 + 1;
+  int rows = 1;
+  double denominator = 1.0;
+  for (int d = 0; d < dim; ++d) denominator *= grid_.n(d);
+  for (int d = 1; d < dim; ++d) rows *= grid_.n(d);
+  const double norm = 1.0 / denominator;
 #pragma omp parallel for num_threads(threads_) schedule(static)
-  for (int q = 0; q < nq; ++q) {
-    std::complex<double>* row = spectrum_.data() + std::size_t(q) * np;
-    for (int p = 0; p < np; ++p) {
-      const double lambda = sx_.stiffness[p] * sy_.mass[q] + sx_.mass[p] * sy_.stiffness[q] + c_ * sx_.mass[p] * sy_.mass[q];
+  for (int r = 0; r < rows; ++r) {
+    std::array<int, dim> slow{};
+    for (int d = 1, rest = r; d < dim; ++d) slow[d] = rest % grid_.n(d), rest /= grid_.n(d);
+    const typename Q1Symbol<dim>::Row factors = symbol_.row(slow);
+    std::complex<double>* row = spectrum_.data() + std::size_t(r) * std::size_t(row_length);
+    for (int p = 0; p < row_length; ++p) {
+      const double lambda = symbol_(p, factors);
       if (inverse) row[p] *= lambda > 0 ? norm / lambda : 0.0;  // λ = 0 only for the constants at c = 0
       else row[p] *= norm * lambda;
     }
@@ -35,11 +43,18 @@ void PeriodicSolver::transform(GridVector& v, bool inverse) const {
   dft_->backward(spectrum_.data(), v.data());
 }
 
-void PeriodicSolver::solve_in_place(GridVector& r) const { transform(r, true); }
+template <int dim>
+void PeriodicSolver<dim>::solve_in_place(GridVector& r) const {
+  transform(r, true);
+}
 
-void PeriodicSolver::apply(const GridVector& x, GridVector& y) const {
+template <int dim>
+void PeriodicSolver<dim>::apply(const GridVector& x, GridVector& y) const {
   y = x;
   transform(y, false);
 }
+
+template class PeriodicSolver<2>;
+template class PeriodicSolver<3>;
 
 }  // namespace fictus

@@ -6,7 +6,7 @@
 
 namespace fictus {
 
-ImplicitSchur::ImplicitSchur(const FastSolver& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
+ImplicitSchur::ImplicitSchur(const FastSolver<2>& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
                              const SparseRows& loads, const GmresOptions& options, DirectTerms direct)
     : solver_(solver), B_gamma_(B_gamma), C_gamma_(C_gamma), B_Gamma_(loads), options_(options),
       direct_(std::move(direct)), work_(solver.grid().n_unknowns()) {}
@@ -51,11 +51,11 @@ LinearSolveReport ImplicitSchur::solve(const ActiveSet& active, const Eigen::Vec
   return {g.iterations, g.relative_residual, g.converged};
 }
 
-Eigen::MatrixXd green_block(const GreenTable& green, const SparseRows& R, const SparseRows& Q, int threads) {
+Eigen::MatrixXd green_block(const GreenTable<2>& green, const SparseRows& R, const SparseRows& Q, int threads) {
   return green_blocks(green, {&R}, Q, threads).front();
 }
 
-std::vector<Eigen::MatrixXd> green_blocks(const GreenTable& green, const std::vector<const SparseRows*>& row_sets,
+std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>& green, const std::vector<const SparseRows*>& row_sets,
                                           const SparseRows& Q, int threads) {
   // The distinct nodes of all row sets, and every entry as (node slot, weight).
   std::vector<std::size_t> slot_of;  // by entry, over all row sets in order
@@ -99,7 +99,7 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable& green, const std::ve
   return blocks;
 }
 
-ExplicitSchur::ExplicitSchur(const GreenTable& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
+ExplicitSchur::ExplicitSchur(const GreenTable<2>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
                              const SparseRows& loads, int threads, const DirectTerms& direct) {
   std::vector<Eigen::MatrixXd> blocks = green_blocks(green, {&B_gamma, &C_gamma}, loads, threads);
   S_B_ = std::move(blocks[0]);

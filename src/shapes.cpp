@@ -18,16 +18,16 @@ double wrap_parameter(double t) {
   return t < 0 ? t + two_pi : t;
 }
 
-double cross(Point a, Point b) { return a.x * b.y - a.y * b.x; }
+double cross(Point2 a, Point2 b) { return a.x * b.y - a.y * b.x; }
 
-bool segments_cross(Point a, Point b, Point c, Point d) {
+bool segments_cross(Point2 a, Point2 b, Point2 c, Point2 d) {
   const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
   const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
   return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0)) && d1 != 0 && d2 != 0 && d3 != 0 && d4 != 0;
 }
 }  // namespace
 
-PolygonCurve::PolygonCurve(std::vector<Point> vertices) : vertices_(std::move(vertices)) {
+PolygonCurve::PolygonCurve(std::vector<Point2> vertices) : vertices_(std::move(vertices)) {
   const std::size_t n = vertices_.size();
   if (n < 3) throw std::invalid_argument("geometry.vertices: a polygon needs at least 3 vertices");
   cumulative_.assign(n + 1, 0.0);
@@ -38,7 +38,7 @@ PolygonCurve::PolygonCurve(std::vector<Point> vertices) : vertices_(std::move(ve
   }
   double area = 0, cx = 0, cy = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    const Point a = vertices_[k], b = vertices_[(k + 1) % n];
+    const Point2 a = vertices_[k], b = vertices_[(k + 1) % n];
     const double w = cross(a, b);
     area += w / 2;
     cx += (a.x + b.x) * w / 6;
@@ -53,17 +53,17 @@ int PolygonCurve::edge_of(double t) const {
   return std::clamp(int(it - cumulative_.begin()) - 1, 0, int(vertices_.size()) - 1);
 }
 
-Point PolygonCurve::position(double t) const {
+Point2 PolygonCurve::position(double t) const {
   const int k = edge_of(t);
   const double s = wrap_parameter(t) / two_pi * cumulative_.back();
-  const Point a = vertices_[k], b = vertices_[(k + 1) % vertices_.size()];
+  const Point2 a = vertices_[k], b = vertices_[(k + 1) % vertices_.size()];
   const double w = (s - cumulative_[k]) / (cumulative_[k + 1] - cumulative_[k]);
   return a + w * (b - a);
 }
 
-Point PolygonCurve::derivative(double t) const {
+Point2 PolygonCurve::derivative(double t) const {
   const int k = edge_of(t);
-  const Point a = vertices_[k], b = vertices_[(k + 1) % vertices_.size()];
+  const Point2 a = vertices_[k], b = vertices_[(k + 1) % vertices_.size()];
   return (cumulative_.back() / two_pi / (cumulative_[k + 1] - cumulative_[k])) * (b - a);
 }
 
@@ -73,12 +73,12 @@ std::vector<double> PolygonCurve::corners() const {
   return t;
 }
 
-Point ExpressionCurve::derivative(double t) const {
+Point2 ExpressionCurve::derivative(double t) const {
   const double e = 1e-5;
   return (1.0 / (2 * e)) * (position(t + e) - position(t - e));
 }
 
-Point ExpressionCurve::second_derivative(double t) const {
+Point2 ExpressionCurve::second_derivative(double t) const {
   const double e = 1e-4;
   return (1.0 / (e * e)) * (position(t + e) - 2.0 * position(t) + position(t - e));
 }
@@ -87,9 +87,9 @@ ParametricCurve::ParametricCurve(std::function<double(double)> x, std::function<
   center_ = centroid(*this);
 }
 
-Point ParametricCurve::position(double t) const { return {x_(t), y_(t)}; }
+Point2 ParametricCurve::position(double t) const { return {x_(t), y_(t)}; }
 
-StarCurve::StarCurve(Point center, std::function<double(double)> r) : center_(center), r_(std::move(r)) {
+StarCurve::StarCurve(Point2 center, std::function<double(double)> r) : center_(center), r_(std::move(r)) {
   for (int k = 0; k < 1024; ++k) {
     const double t = two_pi * k / 1024, r = r_(t);
     if (!(r > 0) || !std::isfinite(r))
@@ -98,14 +98,14 @@ StarCurve::StarCurve(Point center, std::function<double(double)> r) : center_(ce
   }
 }
 
-Point StarCurve::position(double t) const {
+Point2 StarCurve::position(double t) const {
   const double r = r_(t);
-  return center_ + Point{r * std::cos(t), r * std::sin(t)};
+  return center_ + Point2{r * std::cos(t), r * std::sin(t)};
 }
 
-Point ReversedCurve::position(double t) const { return base_->position(two_pi - t); }
-Point ReversedCurve::derivative(double t) const { return -1.0 * base_->derivative(two_pi - t); }
-Point ReversedCurve::second_derivative(double t) const { return base_->second_derivative(two_pi - t); }
+Point2 ReversedCurve::position(double t) const { return base_->position(two_pi - t); }
+Point2 ReversedCurve::derivative(double t) const { return -1.0 * base_->derivative(two_pi - t); }
+Point2 ReversedCurve::second_derivative(double t) const { return base_->second_derivative(two_pi - t); }
 std::vector<double> ReversedCurve::corners() const {
   std::vector<double> t;
   for (double c : base_->corners()) t.push_back(c == 0.0 ? 0.0 : two_pi - c);
@@ -140,14 +140,14 @@ double integrate_parameter(const Curve& curve, F&& fn) {
 }  // namespace
 
 double signed_area(const Curve& curve) {
-  return integrate_parameter(curve, [](Point p, Point d) { return 0.5 * cross(p, d); });
+  return integrate_parameter(curve, [](Point2 p, Point2 d) { return 0.5 * cross(p, d); });
 }
 
-Point centroid(const Curve& curve) {
+Point2 centroid(const Curve& curve) {
   const double area = signed_area(curve);
   // Green: ∫x dA = ½∮x² dy, ∫y dA = −½∮y² dx
-  const double mx = integrate_parameter(curve, [](Point p, Point d) { return 0.5 * p.x * p.x * d.y; });
-  const double my = integrate_parameter(curve, [](Point p, Point d) { return -0.5 * p.y * p.y * d.x; });
+  const double mx = integrate_parameter(curve, [](Point2 p, Point2 d) { return 0.5 * p.x * p.x * d.y; });
+  const double my = integrate_parameter(curve, [](Point2 p, Point2 d) { return -0.5 * p.y * p.y * d.x; });
   return {mx / area, my / area};
 }
 
@@ -156,18 +156,18 @@ void check_simple(const Curve& curve, const std::string& what, int samples) {
   for (int k = 0; k < samples; ++k) t.push_back(two_pi * k / samples);
   std::sort(t.begin(), t.end());
   t.erase(std::unique(t.begin(), t.end()), t.end());
-  std::vector<Point> p;
+  std::vector<Point2> p;
   for (double s : t) p.push_back(curve.position(s));
   const std::size_t n = p.size();
   // Bucket the segments on a coarse grid so the check stays near-linear.
   double x0 = p[0].x, x1 = x0, y0 = p[0].y, y1 = y0;
-  for (const Point& q : p) x0 = std::min(x0, q.x), x1 = std::max(x1, q.x), y0 = std::min(y0, q.y), y1 = std::max(y1, q.y);
+  for (const Point2& q : p) x0 = std::min(x0, q.x), x1 = std::max(x1, q.x), y0 = std::min(y0, q.y), y1 = std::max(y1, q.y);
   const int cells = 64;
   const double wx = (x1 - x0) / cells + 1e-300, wy = (y1 - y0) / cells + 1e-300;
   std::vector<std::vector<std::size_t>> bucket(cells * cells);
   auto cell = [&](double v, double origin, double w) { return std::clamp(int((v - origin) / w), 0, cells - 1); };
   for (std::size_t k = 0; k < n; ++k) {
-    const Point a = p[k], b = p[(k + 1) % n];
+    const Point2 a = p[k], b = p[(k + 1) % n];
     for (int i = cell(std::min(a.x, b.x), x0, wx); i <= cell(std::max(a.x, b.x), x0, wx); ++i)
       for (int j = cell(std::min(a.y, b.y), y0, wy); j <= cell(std::max(a.y, b.y), y0, wy); ++j) bucket[j * cells + i].push_back(k);
   }
@@ -184,17 +184,17 @@ void check_simple(const Curve& curve, const std::string& what, int samples) {
       }
 }
 
-void check_inside_box(const Curve& curve, const Box& box, double margin, const std::string& what, int samples) {
+void check_inside_box(const Curve& curve, const Box2& box, double margin, const std::string& what, int samples) {
   std::vector<double> t = curve.corners();
   for (int k = 0; k < samples; ++k) t.push_back(two_pi * k / samples);
   for (double s : t) {
-    const Point p = curve.position(s);
+    const Point2 p = curve.position(s);
     if (!std::isfinite(p.x) || !std::isfinite(p.y)) {
       std::ostringstream msg;
       msg << what << ": the curve is not finite at t = " << s;
       throw std::invalid_argument(msg.str());
     }
-    if (p.x - box.x0 < margin || box.x1 - p.x < margin || p.y - box.y0 < margin || box.y1 - p.y < margin) {
+    if (p.x - box.lower.x < margin || box.upper.x - p.x < margin || p.y - box.lower.y < margin || box.upper.y - p.y < margin) {
       std::ostringstream msg;
       msg << what << ": the curve comes within " << margin << " of the box boundary (or leaves it) at (" << p.x << ", "
           << p.y << ")";

@@ -17,7 +17,7 @@ namespace {
 /// Collects the entries of one row, merging repeated nodes.
 class RowBuilder {
  public:
-  RowBuilder(const Grid& grid, SparseRows& rows) : grid_(grid), rows_(rows) {}
+  RowBuilder(const Grid2& grid, SparseRows& rows) : grid_(grid), rows_(rows) {}
   void add(int i, int j, double value) {
     if (!grid_.has_unknown(i, j)) return;
     const std::size_t index = grid_.index(i, j);  // periodic boxes: (0, j) and (nx, j) are one node
@@ -29,7 +29,7 @@ class RowBuilder {
     rows_.entries.push_back({index, i, j, value});
   }
   /// Bilinear weights of point p in cell (ix, iy), scaled by w.
-  void add_bilinear(int ix, int iy, Point p, double w) {
+  void add_bilinear(int ix, int iy, Point2 p, double w) {
     const double xi = (p.x - grid_.x(ix)) / grid_.h(), eta = (p.y - grid_.y(iy)) / grid_.h();
     add(ix, iy, w * (1 - xi) * (1 - eta));
     add(ix + 1, iy, w * xi * (1 - eta));
@@ -39,7 +39,7 @@ class RowBuilder {
   void end_row() { rows_.row_begin.push_back(rows_.entries.size()); }
 
  private:
-  const Grid& grid_;
+  const Grid2& grid_;
   SparseRows& rows_;
 };
 
@@ -56,25 +56,25 @@ void SparseRows::add_transposed(const std::vector<double>& lambda, GridVector& u
     for (std::size_t k = row_begin[r]; k < row_begin[r + 1]; ++k) u[entries[k].index] += entries[k].value * lambda[r];
 }
 
-SparseRows point_value_rows(const Grid& grid, const std::vector<Point>& points) {
+SparseRows point_value_rows(const Grid2& grid, const std::vector<Point2>& points) {
   SparseRows rows;
   RowBuilder builder(grid, rows);
-  for (const Point& p : points) {
+  for (const Point2& p : points) {
     builder.add_bilinear(grid.cell_x(p.x), grid.cell_y(p.y), p, 1.0);
     builder.end_row();
   }
   return rows;
 }
 
-SparseRows normal_derivative_rows(const Grid& grid, const std::vector<Point>& points,
-                                  const std::vector<Point>& normals, double shift) {
+SparseRows normal_derivative_rows(const Grid2& grid, const std::vector<Point2>& points,
+                                  const std::vector<Point2>& normals, double shift) {
   if (points.size() != normals.size()) throw std::invalid_argument("normal_derivative_rows: size mismatch");
   SparseRows rows;
   RowBuilder builder(grid, rows);
   const double h = grid.h();
   for (std::size_t r = 0; r < points.size(); ++r) {
-    const Point n = normals[r];
-    const Point p = points[r] - shift * n;
+    const Point2 n = normals[r];
+    const Point2 p = points[r] - shift * n;
     const int ix = grid.cell_x(p.x), iy = grid.cell_y(p.y);
     const double xi = (p.x - grid.x(ix)) / h, eta = (p.y - grid.y(iy)) / h;
     // ∇u = (1/h)·( (u10−u00)(1−η) + (u11−u01)η ,  (u01−u00)(1−ξ) + (u11−u10)ξ )
@@ -113,15 +113,15 @@ LagrangeBasis lagrange_basis(int first, int p, double xi) {
 
 }  // namespace
 
-SparseRows normal_derivative_rows_centered(const Grid& grid, const std::vector<Point>& points,
-                                           const std::vector<Point>& normals, int degree) {
+SparseRows normal_derivative_rows_centered(const Grid2& grid, const std::vector<Point2>& points,
+                                           const std::vector<Point2>& normals, int degree) {
   if (points.size() != normals.size()) throw std::invalid_argument("normal_derivative_rows: size mismatch");
   if (degree < 1 || degree > 3) throw std::invalid_argument("normal_derivative_rows_centered: degree must be 1, 2 or 3");
   SparseRows rows;
   RowBuilder builder(grid, rows);
   const double h = grid.h();
   for (std::size_t r = 0; r < points.size(); ++r) {
-    const Point p = points[r], n = normals[r];
+    const Point2 p = points[r], n = normals[r];
     // Local coordinates in cells from the lower-left node of the cell of p; the stencil's first
     // node: the cell itself (p = 1), the nearest node − 1 (p = 2), the cell's node − 1 (p = 3).
     const int ix = grid.cell_x(p.x), iy = grid.cell_y(p.y);
@@ -138,11 +138,11 @@ SparseRows normal_derivative_rows_centered(const Grid& grid, const std::vector<P
   return rows;
 }
 
-SparseRows one_sided_rows(const CurveGridIntersection& gamma, const std::vector<Point>& points,
-                          const std::vector<Point>& normals, OneSidedTrace trace, int degree, double radius) {
+SparseRows one_sided_rows(const CurveGridIntersection& gamma, const std::vector<Point2>& points,
+                          const std::vector<Point2>& normals, OneSidedTrace trace, int degree, double radius) {
   if (points.size() != normals.size()) throw std::invalid_argument("one_sided_rows: size mismatch");
   if (degree < 1 || degree > 2) throw std::invalid_argument("one_sided_rows: degree must be 1 or 2");
-  const Grid& grid = gamma.grid();
+  const Grid2& grid = gamma.grid();
   const double h = grid.h();
   const int n_terms = degree == 1 ? 3 : 6;  // 1, ξ, η (+ ξ²/2, ξη, η²/2), ξ = (x − x_i)/h
   SparseRows rows;
@@ -152,12 +152,12 @@ SparseRows one_sided_rows(const CurveGridIntersection& gamma, const std::vector<
   Eigen::MatrixXd M;
   Eigen::VectorXd W;
   for (std::size_t r = 0; r < points.size(); ++r) {
-    const Point p = points[r], n = normals[r];
+    const Point2 p = points[r], n = normals[r];
     // Nodes of ω in a disc around x_i; the disc grows by ½ cell until the fit is well posed.
     for (double R = radius;; R += 0.5) {
       if (R > radius + 8) throw std::runtime_error("one_sided_rows: too few nodes of ω near a collocation point");
       nodes.clear(), dx.clear(), dy.clear(), w.clear();
-      const double cx = (p.x - grid.box().x0) / h, cy = (p.y - grid.box().y0) / h;
+      const double cx = (p.x - grid.box().lower.x) / h, cy = (p.y - grid.box().lower.y) / h;
       for (int j = std::max(int(std::floor(cy - R)), 0); j <= std::min(int(std::ceil(cy + R)), grid.ny()); ++j)
         for (int i = std::max(int(std::floor(cx - R)), 0); i <= std::min(int(std::ceil(cx + R)), grid.nx()); ++i) {
           const double ex = (grid.x(i) - p.x) / h, ey = (grid.y(j) - p.y) / h;
@@ -195,7 +195,7 @@ SparseRows one_sided_rows(const CurveGridIntersection& gamma, const std::vector<
 
 SparseRows arc_integral_rows(const CurveGridIntersection& geometry, const std::vector<double>& arc_begin,
                              const std::vector<double>& arc_end, int q) {
-  const Grid& grid = geometry.grid();
+  const Grid2& grid = geometry.grid();
   const Curve& curve = geometry.curve();
   const GaussRule& rule = gauss_legendre(q);
   SparseRows rows;

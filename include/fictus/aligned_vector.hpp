@@ -1,6 +1,6 @@
 #pragma once
-// std::vector with storage from the FFTW allocator, so that every grid array has the alignment
-// the FFTW plans were made for (plans are created once and executed on many arrays).
+// std::vector with 64-byte aligned storage: every grid array has the alignment the fast transforms
+// (and SIMD loops) want, whatever allocated it. Plans made on one aligned array run on any other.
 #include <cstddef>
 #include <new>
 #include <vector>
@@ -8,27 +8,25 @@
 namespace fictus {
 
 namespace detail {
-void* fftw_aligned_malloc(std::size_t bytes);
-void fftw_aligned_free(void* p) noexcept;
+inline constexpr std::size_t grid_alignment = 64;
+/// Aligned storage; large blocks are advised to use transparent huge pages (cheaper first touch).
+void* aligned_allocate(std::size_t bytes);
+void aligned_free(void* p) noexcept;
 }  // namespace detail
 
 template <class T>
-struct FftwAllocator {
+struct AlignedAllocator {
   using value_type = T;
-  FftwAllocator() = default;
+  AlignedAllocator() = default;
   template <class U>
-  FftwAllocator(const FftwAllocator<U>&) noexcept {}
-  T* allocate(std::size_t n) {
-    void* p = detail::fftw_aligned_malloc(n * sizeof(T));
-    if (p == nullptr && n != 0) throw std::bad_alloc();
-    return static_cast<T*>(p);
-  }
-  void deallocate(T* p, std::size_t) noexcept { detail::fftw_aligned_free(p); }
+  AlignedAllocator(const AlignedAllocator<U>&) noexcept {}
+  T* allocate(std::size_t n) { return static_cast<T*>(detail::aligned_allocate(n * sizeof(T))); }
+  void deallocate(T* p, std::size_t) noexcept { detail::aligned_free(p); }
   template <class U>
-  bool operator==(const FftwAllocator<U>&) const noexcept { return true; }
+  bool operator==(const AlignedAllocator<U>&) const noexcept { return true; }
 };
 
 template <class T>
-using AlignedVector = std::vector<T, FftwAllocator<T>>;
+using AlignedVector = std::vector<T, AlignedAllocator<T>>;
 
 }  // namespace fictus

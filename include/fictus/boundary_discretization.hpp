@@ -23,8 +23,8 @@ class BoundaryDiscretization {
   virtual ~BoundaryDiscretization() = default;
 
   /// The collocation points x_i on γ, their outward unit normals n_i and arc-length positions s_i.
-  virtual const std::vector<Point>& points() const = 0;
-  virtual const std::vector<Point>& normals() const = 0;
+  virtual const std::vector<Point2>& points() const = 0;
+  virtual const std::vector<Point2>& normals() const = 0;
   virtual const std::vector<double>& arc_positions() const = 0;
   int n_points() const { return int(points().size()); }
 

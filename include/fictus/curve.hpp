@@ -13,11 +13,11 @@ namespace fictus {
 class Curve {
  public:
   virtual ~Curve() = default;
-  virtual Point position(double t) const = 0;
-  virtual Point derivative(double t) const = 0;
-  virtual Point second_derivative(double t) const = 0;
+  virtual Point2 position(double t) const = 0;
+  virtual Point2 derivative(double t) const = 0;
+  virtual Point2 second_derivative(double t) const = 0;
   /// A point inside ω used for the polar angle φ of user data (the ellipse's center).
-  virtual Point center() const = 0;
+  virtual Point2 center() const = 0;
 
   /// Parameters of corners (where p′ jumps), sorted; none for a smooth curve.
   virtual std::vector<double> corners() const { return {}; }
@@ -25,7 +25,7 @@ class Curve {
   virtual bool smooth() const { return true; }
 
   double speed(double t) const { return norm(derivative(t)); }
-  Point outward_normal(double t) const;
+  Point2 outward_normal(double t) const;
   double curvature(double t) const;
 };
 
@@ -33,17 +33,17 @@ class Curve {
 /// p(t) = c + R(angle)·(a cos t, b sin t).
 class Ellipse final : public Curve {
  public:
-  Ellipse(Point center, double a, double b, double angle = 0.0);
-  Point position(double t) const override;
-  Point derivative(double t) const override;
-  Point second_derivative(double t) const override;
-  Point center() const override { return center_; }
+  Ellipse(Point2 center, double a, double b, double angle = 0.0);
+  Point2 position(double t) const override;
+  Point2 derivative(double t) const override;
+  Point2 second_derivative(double t) const override;
+  Point2 center() const override { return center_; }
   double a() const { return a_; }
   double b() const { return b_; }
 
  private:
-  Point rotate(Point v) const { return {cos_ * v.x - sin_ * v.y, sin_ * v.x + cos_ * v.y}; }
-  Point center_;
+  Point2 rotate(Point2 v) const { return {cos_ * v.x - sin_ * v.y, sin_ * v.x + cos_ * v.y}; }
+  Point2 center_;
   double a_, b_, cos_, sin_;
 };
 
@@ -52,11 +52,11 @@ class Ellipse final : public Curve {
 class OffsetCurve final : public Curve {
  public:
   OffsetCurve(std::shared_ptr<const Curve> base, double delta);
-  Point position(double t) const override;
-  Point derivative(double t) const override;
+  Point2 position(double t) const override;
+  Point2 derivative(double t) const override;
   /// By central differences of derivative() (used only for diagnostics of Γ's curvature).
-  Point second_derivative(double t) const override;
-  Point center() const override { return base_->center(); }
+  Point2 second_derivative(double t) const override;
+  Point2 center() const override { return base_->center(); }
   double delta() const { return delta_; }
 
  private:
@@ -67,17 +67,17 @@ class OffsetCurve final : public Curve {
 /// γ rotated by `angle` about its center, then moved by `shift`: p(t) = c + R(p₀(t) − c) + shift.
 class TransformedCurve final : public Curve {
  public:
-  TransformedCurve(std::shared_ptr<const Curve> base, double angle, Point shift);
-  Point position(double t) const override;
-  Point derivative(double t) const override { return rotate(base_->derivative(t)); }
-  Point second_derivative(double t) const override { return rotate(base_->second_derivative(t)); }
-  Point center() const override { return base_->center() + shift_; }
+  TransformedCurve(std::shared_ptr<const Curve> base, double angle, Point2 shift);
+  Point2 position(double t) const override;
+  Point2 derivative(double t) const override { return rotate(base_->derivative(t)); }
+  Point2 second_derivative(double t) const override { return rotate(base_->second_derivative(t)); }
+  Point2 center() const override { return base_->center() + shift_; }
 
  private:
-  Point rotate(Point v) const { return {cos_ * v.x - sin_ * v.y, sin_ * v.x + cos_ * v.y}; }
+  Point2 rotate(Point2 v) const { return {cos_ * v.x - sin_ * v.y, sin_ * v.x + cos_ * v.y}; }
   std::shared_ptr<const Curve> base_;
   double cos_, sin_;
-  Point shift_;
+  Point2 shift_;
 };
 
 /// Cumulative arc length s(t) on [0, 2π] by composite Gauss–Legendre, and its inverse.

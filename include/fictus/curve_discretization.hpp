@@ -19,11 +19,11 @@ class CurveDiscretization final : public BoundaryDiscretization {
   ///      (smooth variant: simple, inside the box, ≥ 4h from γ with reconstructed traces);
   ///   2. trace rows: B_γ, C_γ, B_Γ, and the kink correction's rows and direct terms.
   /// Throws std::invalid_argument naming the option or "geometry" on bad input.
-  CurveDiscretization(std::shared_ptr<const Curve> gamma, const Grid& grid, const SolverOptions& options, double c,
+  CurveDiscretization(std::shared_ptr<const Curve> gamma, const Grid2& grid, const SolverOptions& options, double c,
                       const Execution& execution);
 
-  const std::vector<Point>& points() const override { return collocation_.point; }
-  const std::vector<Point>& normals() const override { return collocation_.normal; }
+  const std::vector<Point2>& points() const override { return collocation_.point; }
+  const std::vector<Point2>& normals() const override { return collocation_.normal; }
   const std::vector<double>& arc_positions() const override { return collocation_.s; }
   const SparseRows& B_gamma() const override { return B_gamma_; }
   const SparseRows& C_gamma() const override { return C_gamma_; }
@@ -42,8 +42,8 @@ class CurveDiscretization final : public BoundaryDiscretization {
   double delta() const { return delta_; }
 
  private:
-  void make_geometry(const Grid& grid, SolverOptions options);
-  void make_trace_rows(const Grid& grid, const SolverOptions& options, double c, const Execution& execution);
+  void make_geometry(const Grid2& grid, SolverOptions options);
+  void make_trace_rows(const Grid2& grid, const SolverOptions& options, double c, const Execution& execution);
 
   std::shared_ptr<const Curve> gamma_, Gamma_;
   Collocation collocation_;

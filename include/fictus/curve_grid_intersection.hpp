@@ -34,10 +34,10 @@ struct CellQuadraturePoint {
 class CurveGridIntersection {
  public:
   /// Throws std::invalid_argument("<what>: …") if the curve is not strictly inside the box.
-  CurveGridIntersection(const Curve& curve, const Grid& grid, const char* what = "geometry");
+  CurveGridIntersection(const Curve& curve, const Grid2& grid, const char* what = "geometry");
 
   const Curve& curve() const { return curve_; }
-  const Grid& grid() const { return grid_; }
+  const Grid2& grid() const { return grid_; }
   const std::vector<CurvePiece>& pieces() const { return pieces_; }
   const std::vector<CutCell>& cut_cells() const { return cut_cells_; }
   /// Cut cells of row iy are cut_cells()[row_begin(iy) .. row_begin(iy+1)).
@@ -62,7 +62,7 @@ class CurveGridIntersection {
 
  private:
   const Curve& curve_;
-  Grid grid_;
+  Grid2 grid_;
   std::vector<CurvePiece> pieces_;
   std::vector<CutCell> cut_cells_;
   std::vector<std::size_t> row_begin_;
@@ -85,7 +85,7 @@ std::array<double, K> integrate_along_curve(const CurveGridIntersection& geometr
 template <int K, class F>
 std::array<double, K> integrate_over_domain(const CurveGridIntersection& geometry, int q, F&& fn,
                                             int threads) {
-  const Grid& grid = geometry.grid();
+  const Grid2& grid = geometry.grid();
   std::array<double, K> total{};
 #pragma omp parallel num_threads(threads < 1 ? 1 : threads)
   {

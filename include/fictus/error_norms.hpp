@@ -10,7 +10,7 @@
 
 namespace fictus {
 
-using GradientField = std::function<Point(double x, double y)>;
+using GradientField = std::function<Point2(double x, double y)>;
 
 struct ErrorNorms {
   double l2_omega = 0, h1semi_omega = 0, h1_omega = 0, l2_gamma = 0;
@@ -35,8 +35,8 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
 /// Value and gradient of the Q1 function u_h in cell (ix, iy) at (x, y).
 struct Q1Sample {
   double value;
-  Point gradient;
+  Point2 gradient;
 };
-Q1Sample sample_q1(const Grid& grid, const GridVector& u_h, int ix, int iy, double x, double y);
+Q1Sample sample_q1(const Grid2& grid, const GridVector& u_h, int ix, int iy, double x, double y);
 
 }  // namespace fictus

@@ -58,8 +58,8 @@ struct Timings {
 };
 
 struct Solution {
-  explicit Solution(const Grid& g) : grid(g) {}
-  Grid grid;
+  explicit Solution(const Grid2& g) : grid(g) {}
+  Grid2 grid;
   SolverOptions options;                // in effect (m resolved)
   GridVector u;                         // û at the unknowns (empty when the field was not asked for)
   Collocation collocation;              // points on γ
@@ -90,7 +90,7 @@ class FictitiousDomainSolver {
   FictitiousDomainSolver(const FictitiousDomainSolver&) = delete;
   FictitiousDomainSolver& operator=(const FictitiousDomainSolver&) = delete;
 
-  const Grid& grid() const;
+  const Grid2& grid() const;
 
   /// Solves with the curve, obstacle and exact solution of `data` and the per-solve options
   /// (options.threads and options.load_quadrature must be the constructor's: they shaped the

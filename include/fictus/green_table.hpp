@@ -1,40 +1,69 @@
 #pragma once
-// Discrete Green's function of A = K + c·M (docs/math.md, DESIGN §3).
-// Dirichlet box:
-//   G[(i,j),(k,l)] = T(i−k, j−l) − T(i+k, j−l) − T(i−k, j+l) + T(i+k, j+l),
-//   T(s,t) = 1/(nx·ny) Σ_{p=1}^{nx−1} Σ_{q=1}^{ny−1} cos(pπs/nx) cos(qπt/ny) / λ_pq,
-//   even and 2n-periodic; the table holds [0,nx]×[0,ny], ONE 2-D DCT-I (REDFT00) of size (nx+1)(ny+1).
-// Periodic box (nx, ny even):
-//   G[(i,j),(k,l)] = T(i−k, j−l),  T(s,t) = 1/(nx·ny) Σ_{p<nx} Σ_{q<ny} cos(2πps/nx) cos(2πqt/ny) / λ_pq,
-//   even and n-periodic; the table holds [0,nx/2]×[0,ny/2], one REDFT00 of size (nx/2+1)(ny/2+1).
+// Discrete Green's function of A = K + c·M (docs/math.md), any dimension.
+// Dirichlet box: G between nodes a and b is the sum over the 2^dim reflections
+//   G[a, b] = Σ_{σ ∈ {−,+}^dim} (−1)^{#+} T(a ∓ b),
+//   T(s) = 1/Π_d n_d · Σ_{p, 1 ≤ p_d ≤ n_d−1} Π_d cos(p_d π s_d / n_d) / λ(p),
+//   even and 2n-periodic in each s_d; the table holds Π_d [0, n_d]: ONE DCT-I (REDFT00) of size Π(n_d + 1).
+//   In 2-D: G[(i,j),(k,l)] = T(i−k, j−l) − T(i+k, j−l) − T(i−k, j+l) + T(i+k, j+l).
+// Periodic box (n_d even):
+//   G[a, b] = T(a − b),  T(s) = 1/Π n_d · Σ_{0 ≤ p_d < n_d} Π_d cos(2π p_d s_d / n_d) / λ(p),
+//   even and n-periodic; the table holds Π_d [0, n_d/2], one REDFT00 of size Π(n_d/2 + 1).
 //   With c = 0 the zero mode is dropped: G is the pseudo-inverse A⁺.
-// Built once per grid, boundary and c; lookups are const and thread-safe.
+// λ(p) comes from Q1Symbol. Built once per grid, boundary and c; lookups are const and thread-safe.
+#include <array>
 #include <cstddef>
 
+#include "fictus/execution.hpp"
 #include "fictus/grid.hpp"
 
 namespace fictus {
 
+template <int dim>
 class GreenTable {
  public:
-  GreenTable(const Grid& grid, double c, int threads = 1);
+  using Index = typename Grid<dim>::Index;
+  GreenTable(const Grid<dim>& grid, double c, const Execution& execution = Execution{});
 
-  const Grid& grid() const { return grid_; }
+  const Grid<dim>& grid() const { return grid_; }
   double c() const { return c_; }
-  /// T(s, t) for any integers s, t (folded into the table).
-  double T(int s, int t) const { return table_[std::size_t(fold(t, ny_)) * width_ + std::size_t(fold(s, nx_))]; }
-  /// (A⁻¹)_{(i,j),(k,l)} between nodes carrying unknowns (A⁺ for a singular periodic A);
-  /// 0 ≤ i, k ≤ nx and 0 ≤ j, l ≤ ny (so the arguments of T need one reflection, no division).
-  double G(int i, int j, int k, int l) const {
-    if (periodic_) return at(near_fold(i - k, nx_), near_fold(j - l, ny_));
-    const int sm = near_fold(i - k, nx_), sp = near_fold(i + k, nx_);
-    const int tm = near_fold(j - l, ny_), tp = near_fold(j + l, ny_);
-    return at(sm, tm) - at(sp, tm) - at(sm, tp) + at(sp, tp);
+  /// T(s) for any integer offsets s (folded into the table).
+  double T(const Index& s) const {
+    Index folded;
+    for (int d = 0; d < dim; ++d) folded[d] = fold(s[d], period_[d]);
+    return at(folded);
   }
+  /// (A⁻¹)_{a,b} between nodes carrying unknowns (A⁺ for a singular periodic A), 0 ≤ a_d, b_d ≤ n_d
+  /// (so the offsets need one reflection, no division).
+  double G(const Index& a, const Index& b) const {
+    Index s;
+    if (periodic_) {
+      for (int d = 0; d < dim; ++d) s[d] = near_fold(a[d] - b[d], period_[d]);
+      return at(s);
+    }
+    double sum = 0.0;
+    for (int pattern = 0; pattern < (1 << dim); ++pattern) {
+      bool minus = false;
+      for (int d = 0; d < dim; ++d) {
+        const bool plus = (pattern >> d) & 1;
+        s[d] = near_fold(plus ? a[d] + b[d] : a[d] - b[d], period_[d]);
+        minus ^= plus;
+      }
+      sum += minus ? -at(s) : at(s);
+    }
+    return sum;
+  }
+  /// The 2-D form, written out: the Schur assembly's inner loop.
+  double G(int i, int j, int k, int l) const requires(dim == 2) {
+    if (periodic_) return at2(near_fold(i - k, period_[0]), near_fold(j - l, period_[1]));
+    const int sm = near_fold(i - k, period_[0]), sp = near_fold(i + k, period_[0]);
+    const int tm = near_fold(j - l, period_[1]), tp = near_fold(j + l, period_[1]);
+    return at2(sm, tm) - at2(sp, tm) - at2(sm, tp) + at2(sp, tp);
+  }
+  double T(int s, int t) const requires(dim == 2) { return T(Index{s, t}); }
   std::size_t memory_bytes() const { return table_.size() * sizeof(double); }
 
  private:
-  /// Dirichlet: period 2n, table [0, n]; periodic: period n, table [0, n/2]. `n` is the period.
+  /// Dirichlet: period 2n, table [0, n]; periodic: period n, table [0, n/2]. `period` is the period.
   static int fold(int s, int period) {
     s %= period;
     s = s < 0 ? s + period : s;
@@ -46,12 +75,17 @@ class GreenTable {
     s = s == period ? 0 : s;
     return s > period / 2 ? period - s : s;
   }
-  double at(int s, int t) const { return table_[std::size_t(t) * width_ + std::size_t(s)]; }
-  Grid grid_;
+  double at(const Index& s) const {
+    std::size_t k = 0;
+    for (int d = dim - 1; d >= 0; --d) k = k * size_[d] + std::size_t(s[d]);
+    return table_[k];
+  }
+  double at2(int s, int t) const { return table_[std::size_t(t) * size_[0] + std::size_t(s)]; }
+  Grid<dim> grid_;
   double c_;
   bool periodic_;
-  int nx_, ny_;  // periods in s and t
-  std::size_t width_;
+  std::array<int, dim> period_;       // of T along each axis
+  std::array<std::size_t, dim> size_;  // table entries along each axis: period/2 + 1
   AlignedVector<double> table_;
 };
 

@@ -1,83 +1,124 @@
 #pragma once
-// Uniform Q1 grid on the box Ω = [x0,x1]×[y0,y1] with square cells of side h.
+// Uniform Q1 grid on a box Ω ⊂ R^dim with cubic cells of side h.
 //
-// Nodes are (i, j), i = 0..nx, j = 0..ny, at (x0 + i·h, y0 + j·h). Unknowns, stored x-fastest:
-//   Dirichlet box (u = 0 on ∂Ω): the interior nodes, index(i, j) = (j − 1)·(nx − 1) + (i − 1);
-//   periodic box: nodes (i mod nx, j mod ny),     index(i, j) = (j mod ny)·nx + (i mod nx).
-// Cell (ix, iy), ix = 0..nx−1, iy = 0..ny−1, is [x0 + ix·h, x0 + (ix+1)·h] × [y0 + iy·h, …].
+// Nodes are multi-indices i = (i_0, …, i_{dim−1}), 0 ≤ i_d ≤ n_d, at lower + i·h. Unknowns, stored
+// with the first coordinate fastest:
+//   Dirichlet box (u = 0 on ∂Ω): the interior nodes, index(i) = Σ_d (i_d − 1)·Π_{e<d}(n_e − 1);
+//   periodic box: nodes (i_d mod n_d),                 index(i) = Σ_d (i_d mod n_d)·Π_{e<d} n_e.
+// Cell c, 0 ≤ c_d < n_d, is Π_d [lower_d + c_d·h, lower_d + (c_d + 1)·h].
+// In 2-D, (i, j) = (i_0, i_1), nx = n_0, ny = n_1, x(i), y(j); in 3-D also k, nz, z(k).
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
-#include <cstdint>
+#include <stdexcept>
+#include <string>
 
 #include "fictus/aligned_vector.hpp"
+#include "fictus/point.hpp"
 
 namespace fictus {
-
-struct Point {
-  double x = 0.0;
-  double y = 0.0;
-};
-
-inline Point operator+(Point a, Point b) { return {a.x + b.x, a.y + b.y}; }
-inline Point operator-(Point a, Point b) { return {a.x - b.x, a.y - b.y}; }
-inline Point operator*(double s, Point a) { return {s * a.x, s * a.y}; }
-inline double dot(Point a, Point b) { return a.x * b.x + a.y * b.y; }
-inline double norm(Point a) { return std::hypot(a.x, a.y); }
-
-struct Box {
-  double x0 = 0.0, x1 = 1.0, y0 = 0.0, y1 = 1.0;
-};
 
 enum class Boundary { dirichlet, periodic };
 const char* to_string(Boundary b);
 
+template <int dim>
 class Grid {
  public:
-  /// nx cells along x; the cell side is h = (x1 − x0)/nx and (y1 − y0)/h must be an integer
-  /// (to 1e-9); throws std::invalid_argument naming the field otherwise. nx ≥ 2 and ny ≥ 2.
-  /// A periodic box needs even nx and ny (the Green's table uses the half period).
-  Grid(const Box& box, int nx, Boundary boundary = Boundary::dirichlet);
+  using Index = std::array<int, dim>;
 
-  const Box& box() const { return box_; }
+  /// n0 cells along the first axis; the cell side is h = width(0)/n0 and every other width must be
+  /// a whole number of cells (to 1e-9); throws std::invalid_argument naming the field otherwise.
+  /// n_d ≥ 2; a periodic box needs even n_d (the Green's table uses the half period).
+  Grid(const Box<dim>& box, int n0, Boundary boundary = Boundary::dirichlet) : box_(box), boundary_(boundary) {
+    for (int d = 0; d < dim; ++d)
+      if (!(box.upper[d] > box.lower[d])) throw std::invalid_argument("domain.box: need lower < upper along every axis");
+    if (n0 < 2) throw std::invalid_argument("domain.N: need at least 2 cells, got " + std::to_string(n0));
+    h_ = box.width(0) / n0;
+    n_[0] = n0;
+    for (int d = 1; d < dim; ++d) {
+      const double cells = box.width(d) / h_;
+      n_[d] = cells < 1e9 ? int(std::lround(cells)) : 0;
+      if (std::abs(cells - n_[d]) > 1e-9 * std::max(1.0, cells) || n_[d] < 2)
+        throw std::invalid_argument("domain.box: every side must be a whole number of cells of side h = (x1 - x0)/N");
+    }
+    for (int d = 0; d < dim; ++d)
+      if (periodic() && n_[d] % 2 != 0)
+        throw std::invalid_argument("domain.N: a periodic box needs an even number of cells along every axis");
+  }
+
+  const Box<dim>& box() const { return box_; }
   Boundary boundary() const { return boundary_; }
   bool periodic() const { return boundary_ == Boundary::periodic; }
-  int nx() const { return nx_; }
-  int ny() const { return ny_; }
+  /// Cells along axis d.
+  int n(int d) const { return n_[d]; }
   double h() const { return h_; }
-  double x(int i) const { return box_.x0 + i * h_; }
-  double y(int j) const { return box_.y0 + j * h_; }
+  double coordinate(int d, int i) const { return box_.lower[d] + i * h_; }
 
-  /// Unknowns ((nx − 1)(ny − 1) Dirichlet, nx·ny periodic) and all nodes (nx + 1)(ny + 1) (the
-  /// paper's n).
+  /// Unknowns (Π(n_d − 1) Dirichlet, Π n_d periodic) and all nodes Π(n_d + 1) (the paper's n).
   std::size_t n_unknowns() const {
-    return periodic() ? std::size_t(nx_) * std::size_t(ny_) : std::size_t(nx_ - 1) * std::size_t(ny_ - 1);
+    std::size_t count = 1;
+    for (int d = 0; d < dim; ++d) count *= std::size_t(periodic() ? n_[d] : n_[d] - 1);
+    return count;
   }
-  std::size_t n_nodes() const { return std::size_t(nx_ + 1) * std::size_t(ny_ + 1); }
-
-  /// Does node (i, j), 0 ≤ i ≤ nx, 0 ≤ j ≤ ny, carry an unknown?
-  bool has_unknown(int i, int j) const { return periodic() || (i > 0 && i < nx_ && j > 0 && j < ny_); }
-  /// Storage index of node (i, j); precondition has_unknown(i, j).
-  std::size_t index(int i, int j) const {
-    if (periodic()) return std::size_t(wrap(j, ny_)) * std::size_t(nx_) + std::size_t(wrap(i, nx_));
-    return std::size_t(j - 1) * std::size_t(nx_ - 1) + std::size_t(i - 1);
+  std::size_t n_nodes() const {
+    std::size_t count = 1;
+    for (int d = 0; d < dim; ++d) count *= std::size_t(n_[d] + 1);
+    return count;
   }
 
-  /// Cell containing (x, y), clamped to the grid: cells are half-open [x_i, x_{i+1}).
-  int cell_x(double x) const;
-  int cell_y(double y) const;
+  /// Does node i, 0 ≤ i_d ≤ n_d, carry an unknown?
+  bool has_unknown(const Index& i) const {
+    if (periodic()) return true;
+    for (int d = 0; d < dim; ++d)
+      if (i[d] <= 0 || i[d] >= n_[d]) return false;
+    return true;
+  }
+  /// Storage index of node i; precondition has_unknown(i).
+  std::size_t index(const Index& i) const {
+    std::size_t k = 0;
+    for (int d = dim - 1; d >= 0; --d)
+      k = periodic() ? k * std::size_t(n_[d]) + std::size_t(wrap(i[d], n_[d]))
+                     : k * std::size_t(n_[d] - 1) + std::size_t(i[d] - 1);
+    return k;
+  }
+  /// The cell along axis d containing coordinate x, clamped to the grid (NaN: 0); cells are half-open.
+  int cell(int d, double x) const {
+    const double c = std::floor((x - box_.lower[d]) / h_);
+    if (!(c > 0)) return 0;
+    return c >= n_[d] - 1 ? n_[d] - 1 : int(c);
+  }
+
+  // The axes by name.
+  int nx() const { return n_[0]; }
+  int ny() const requires(dim >= 2) { return n_[1]; }
+  int nz() const requires(dim >= 3) { return n_[2]; }
+  double x(int i) const { return coordinate(0, i); }
+  double y(int j) const requires(dim >= 2) { return coordinate(1, j); }
+  double z(int k) const requires(dim >= 3) { return coordinate(2, k); }
+  int cell_x(double x) const { return cell(0, x); }
+  int cell_y(double y) const requires(dim >= 2) { return cell(1, y); }
+  int cell_z(double z) const requires(dim >= 3) { return cell(2, z); }
+  bool has_unknown(int i, int j) const requires(dim == 2) { return has_unknown(Index{i, j}); }
+  std::size_t index(int i, int j) const requires(dim == 2) { return index(Index{i, j}); }
+  bool has_unknown(int i, int j, int k) const requires(dim == 3) { return has_unknown(Index{i, j, k}); }
+  std::size_t index(int i, int j, int k) const requires(dim == 3) { return index(Index{i, j, k}); }
 
  private:
   static int wrap(int i, int n) { return ((i % n) + n) % n; }
-  Box box_;
+  Box<dim> box_;
   Boundary boundary_;
-  int nx_, ny_;
-  double h_;
+  std::array<int, dim> n_{};
+  double h_ = 0;
 };
 
-/// Nodal values at the interior nodes, in Grid::index order, aligned for FFTW.
+using Grid2 = Grid<2>;
+using Grid3 = Grid<3>;
+
+/// Nodal values at the unknowns, in Grid::index order, aligned for the fast transforms.
 using GridVector = AlignedVector<double>;
 
-/// Value at (x, y) of the Q1 function with interior nodal values u (zero on ∂Ω).
-double evaluate_q1(const Grid& grid, const GridVector& u, Point p);
+/// Value at p of the Q1 function with nodal values u at the unknowns (zero on a Dirichlet ∂Ω).
+double evaluate_q1(const Grid2& grid, const GridVector& u, Point2 p);
 
 }  // namespace fictus

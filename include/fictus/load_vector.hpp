@@ -16,7 +16,7 @@ VectorizedField vectorize(ScalarField f);
 
 /// q = Gauss points per direction (q = 2 is O(h⁴) per cell, enough for the Q1 rates when f is
 /// smooth inside cells). f must be thread-safe (it is called from `threads` threads).
-GridVector assemble_load(const Grid& grid, const ScalarField& f, int q = 2, int threads = 1);
-GridVector assemble_load(const Grid& grid, const VectorizedField& f, int q = 2, int threads = 1);
+GridVector assemble_load(const Grid2& grid, const ScalarField& f, int q = 2, int threads = 1);
+GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q = 2, int threads = 1);
 
 }  // namespace fictus

@@ -28,7 +28,7 @@ struct ContactData {
 /// FictitiousDomainSolver is built for) and the contact data.
 struct Problem : ContactData {
   std::string name = "problem";
-  Box box;                              // Ω
+  Box2 box;                              // Ω
   Boundary boundary = Boundary::dirichlet;  // conditions on ∂Ω (periodic: c = 0 is allowed)
   int N = 256;                          // cells along x (h = (x1 − x0)/N)
   double c = 1.0;                       // c ≥ 0

@@ -65,7 +65,7 @@ class SchurComplement {
 class ImplicitSchur final : public SchurComplement {
  public:
   /// `loads`: the rows whose transposes carry λ into the grid (B_Γ, or B_Γ + R).
-  ImplicitSchur(const FastSolver& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
+  ImplicitSchur(const FastSolver<2>& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
                 const SparseRows& loads, const GmresOptions& options, DirectTerms direct = {});
   int size() const override { return B_Gamma_.n_rows(); }
   void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override;
@@ -75,7 +75,7 @@ class ImplicitSchur final : public SchurComplement {
   std::optional<double> condition_number(const ActiveSet&) const override { return std::nullopt; }
 
  private:
-  const FastSolver& solver_;
+  const FastSolver<2>& solver_;
   const SparseRows &B_gamma_, &C_gamma_, &B_Gamma_;
   GmresOptions options_;
   DirectTerms direct_;
@@ -87,7 +87,7 @@ class ImplicitSchur final : public SchurComplement {
 class ExplicitSchur final : public SchurComplement {
  public:
   /// Assembles S_B and S_C from the Green's table (threaded over columns); `loads` as above.
-  ExplicitSchur(const GreenTable& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
+  ExplicitSchur(const GreenTable<2>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
                 const SparseRows& loads, int threads = 1, const DirectTerms& direct = {});
   /// From given blocks (tests).
   ExplicitSchur(Eigen::MatrixXd S_B, Eigen::MatrixXd S_C) : S_B_(std::move(S_B)), S_C_(std::move(S_C)) {}
@@ -106,10 +106,10 @@ class ExplicitSchur final : public SchurComplement {
 };
 
 /// Dense (rows × cols) block R G Qᵀ from sparse rows and the Green's table.
-Eigen::MatrixXd green_block(const GreenTable& green, const SparseRows& R, const SparseRows& Q, int threads = 1);
+Eigen::MatrixXd green_block(const GreenTable<2>& green, const SparseRows& R, const SparseRows& Q, int threads = 1);
 /// The blocks R_k G Qᵀ of several row sets at once: (G Qᵀ) is evaluated once per distinct node of
 /// the R_k (B_γ's four nodes of x_i lie in C_γ's 3×3), so the cost is (distinct nodes)·nnz(Q) lookups.
-std::vector<Eigen::MatrixXd> green_blocks(const GreenTable& green, const std::vector<const SparseRows*>& row_sets,
+std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>& green, const std::vector<const SparseRows*>& row_sets,
                                           const SparseRows& Q, int threads = 1);
 
 }  // namespace fictus

@@ -17,59 +17,59 @@ namespace fictus {
 class PolygonCurve final : public Curve {
  public:
   /// At least 3 vertices, no repeated consecutive vertices (the closing edge is implied).
-  explicit PolygonCurve(std::vector<Point> vertices);
-  Point position(double t) const override;
-  Point derivative(double t) const override;
-  Point second_derivative(double) const override { return {0.0, 0.0}; }
-  Point center() const override { return centroid_; }
+  explicit PolygonCurve(std::vector<Point2> vertices);
+  Point2 position(double t) const override;
+  Point2 derivative(double t) const override;
+  Point2 second_derivative(double) const override { return {0.0, 0.0}; }
+  Point2 center() const override { return centroid_; }
   std::vector<double> corners() const override;
   bool smooth() const override { return false; }
-  const std::vector<Point>& vertices() const { return vertices_; }
+  const std::vector<Point2>& vertices() const { return vertices_; }
 
  private:
   int edge_of(double t) const;
-  std::vector<Point> vertices_;
+  std::vector<Point2> vertices_;
   std::vector<double> cumulative_;  // arc length at each vertex, size n + 1
-  Point centroid_;
+  Point2 centroid_;
 };
 
 /// Base for curves given by expressions: derivatives by central differences of position().
 class ExpressionCurve : public Curve {
  public:
-  Point derivative(double t) const override;
-  Point second_derivative(double t) const override;
+  Point2 derivative(double t) const override;
+  Point2 second_derivative(double t) const override;
 };
 
 class ParametricCurve final : public ExpressionCurve {
  public:
   ParametricCurve(std::function<double(double)> x, std::function<double(double)> y);
-  Point position(double t) const override;
-  Point center() const override { return center_; }
+  Point2 position(double t) const override;
+  Point2 center() const override { return center_; }
 
  private:
   std::function<double(double)> x_, y_;
-  Point center_;
+  Point2 center_;
 };
 
 class StarCurve final : public ExpressionCurve {
  public:
   /// r(t) > 0 and finite (checked on samples; throws naming geometry.r).
-  StarCurve(Point center, std::function<double(double)> r);
-  Point position(double t) const override;
-  Point center() const override { return center_; }
+  StarCurve(Point2 center, std::function<double(double)> r);
+  Point2 position(double t) const override;
+  Point2 center() const override { return center_; }
 
  private:
-  Point center_;
+  Point2 center_;
   std::function<double(double)> r_;
 };
 
 class ReversedCurve final : public Curve {
  public:
   explicit ReversedCurve(std::shared_ptr<const Curve> base) : base_(std::move(base)) {}
-  Point position(double t) const override;
-  Point derivative(double t) const override;
-  Point second_derivative(double t) const override;
-  Point center() const override { return base_->center(); }
+  Point2 position(double t) const override;
+  Point2 derivative(double t) const override;
+  Point2 second_derivative(double t) const override;
+  Point2 center() const override { return base_->center(); }
   std::vector<double> corners() const override;
   bool smooth() const override { return base_->smooth(); }
 
@@ -81,13 +81,13 @@ class ReversedCurve final : public Curve {
 double signed_area(const Curve& curve);
 
 /// Area-weighted centroid of the region the curve encloses.
-Point centroid(const Curve& curve);
+Point2 centroid(const Curve& curve);
 
 /// Throws std::invalid_argument("<what>: the curve intersects itself near (x, y)") if the polyline
 /// through `samples` points of the curve (and all corners) crosses itself.
 void check_simple(const Curve& curve, const std::string& what, int samples = 4096);
 
 /// Throws std::invalid_argument("<what>: …") if the curve comes closer than `margin` to ∂box.
-void check_inside_box(const Curve& curve, const Box& box, double margin, const std::string& what, int samples = 4096);
+void check_inside_box(const Curve& curve, const Box2& box, double margin, const std::string& what, int samples = 4096);
 
 }  // namespace fictus

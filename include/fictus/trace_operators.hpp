@@ -29,17 +29,17 @@ struct SparseRows {
   void add_transposed(const std::vector<double>& lambda, GridVector& u) const;
 };
 
-SparseRows point_value_rows(const Grid& grid, const std::vector<Point>& points);
+SparseRows point_value_rows(const Grid2& grid, const std::vector<Point2>& points);
 
 /// shift: distance (length units) from x_i into ω along −n_i where the gradient is taken.
-SparseRows normal_derivative_rows(const Grid& grid, const std::vector<Point>& points,
-                                  const std::vector<Point>& normals, double shift);
+SparseRows normal_derivative_rows(const Grid2& grid, const std::vector<Point2>& points,
+                                  const std::vector<Point2>& normals, double shift);
 
 /// C_γ centered: row i = n_i·∇(I u)(x_i), I the tensor-product Lagrange interpolant of `degree` p on
 /// (p+1)² nodes around x_i: p = 1 the cell of x_i (bilinear), p = 2 the 3×3 nodes around the
 /// nearest node (biquadratic, ∂u/∂n to O(h²)), p = 3 the 4×4 nodes around the cell (bicubic, O(h³)).
-SparseRows normal_derivative_rows_centered(const Grid& grid, const std::vector<Point>& points,
-                                           const std::vector<Point>& normals, int degree = 2);
+SparseRows normal_derivative_rows_centered(const Grid2& grid, const std::vector<Point2>& points,
+                                           const std::vector<Point2>& normals, int degree = 2);
 
 /// One-sided traces from the nodes of ω only: row i = p(x_i) (value) or n_i·∇p(x_i) (normal
 /// derivative), p the weighted least-squares polynomial of `degree` (1 or 2) through u at the nodes
@@ -47,8 +47,8 @@ SparseRows normal_derivative_rows_centered(const Grid& grid, const std::vector<P
 /// well posed). For a û kinked on γ: no node outside ω enters. Orders for smooth u: value h^(p+1),
 /// derivative h^p.
 enum class OneSidedTrace { value, normal_derivative };
-SparseRows one_sided_rows(const CurveGridIntersection& gamma, const std::vector<Point>& points,
-                          const std::vector<Point>& normals, OneSidedTrace trace, int degree = 2, double radius = 2.5);
+SparseRows one_sided_rows(const CurveGridIntersection& gamma, const std::vector<Point2>& points,
+                          const std::vector<Point2>& normals, OneSidedTrace trace, int degree = 2, double radius = 2.5);
 
 /// One row per arc [arc_begin[r], arc_end[r]] of the curve of `geometry` (q Gauss points on every
 /// piece of the arc inside one cell).

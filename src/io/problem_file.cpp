@@ -145,17 +145,17 @@ std::shared_ptr<const Curve> read_geometry(TableReader& g, std::vector<std::stri
   if (shape == "ellipse") {
     const auto c = g.required_numbers("center", 2), ab = g.required_numbers("semi_axes", 2);
     if (!(ab[0] > 0 && ab[1] > 0)) fail("geometry.semi_axes", "must be positive");
-    curve = std::make_shared<Ellipse>(Point{c[0], c[1]}, ab[0], ab[1], g.number("angle", 0.0));
+    curve = std::make_shared<Ellipse>(Point2{c[0], c[1]}, ab[0], ab[1], g.number("angle", 0.0));
   } else if (shape == "circle") {
     const auto c = g.required_numbers("center", 2);
     if (!g.has("radius")) fail("geometry.radius", "missing");
     const double r = g.number("radius", 0.0);
     if (!(r > 0)) fail("geometry.radius", "must be positive");
-    curve = std::make_shared<Ellipse>(Point{c[0], c[1]}, r, r, 0.0);
+    curve = std::make_shared<Ellipse>(Point2{c[0], c[1]}, r, r, 0.0);
   } else if (shape == "polygon") {
     const toml::array* list = g.array("vertices");
     if (!list) fail("geometry.vertices", "missing");
-    std::vector<Point> vertices;
+    std::vector<Point2> vertices;
     for (const toml::node& v : *list) {
       const toml::array* xy = v.as_array();
       if (!xy || xy->size() != 2 || !(*xy)[0].is_number() || !(*xy)[1].is_number())
@@ -178,7 +178,7 @@ std::shared_ptr<const Curve> read_geometry(TableReader& g, std::vector<std::stri
   } else if (shape == "star") {
     const auto c = g.required_numbers("center", 2);
     const Expression r(g.required_string("r"), {"t"}, "geometry.r");
-    curve = std::make_shared<StarCurve>(Point{c[0], c[1]}, [r](double t) { return r({t}); });
+    curve = std::make_shared<StarCurve>(Point2{c[0], c[1]}, [r](double t) { return r({t}); });
   } else {
     fail("geometry.shape", "unknown shape \"" + shape + "\" (ellipse, circle, polygon, parametric, star)");
   }
@@ -236,7 +236,7 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
   const Expression f(data.required_string("f"), {"x", "y"}, "data.f");
   p.f = [f](double x, double y) { return f({x, y}); };
   const Expression g(data.required_string("g"), {"x", "y", "phi", "s"}, "data.g");
-  const Point center = p.gamma->center();
+  const Point2 center = p.gamma->center();
   p.g_along_curve = [g, center](double x, double y, double s) {
     return g({x, y, std::atan2(y - center.y, x - center.x), s});
   };

@@ -229,17 +229,17 @@ def write_cxx(items):
     for p, _ in items:
         name, geo = p["name"], p["geometry"]
         if geo["shape"] == "circle":
-            curve = f"std::make_shared<fictus::Ellipse>(fictus::Point{{0.5, 0.5}}, {geo['radius']}, {geo['radius']})"
+            curve = f"std::make_shared<fictus::Ellipse>(fictus::Point2{{0.5, 0.5}}, {geo['radius']}, {geo['radius']})"
         elif geo["shape"] == "ellipse":
-            curve = (f"std::make_shared<fictus::Ellipse>(fictus::Point{{0.5, 0.5}}, {geo['semi_axes'][0]}, "
+            curve = (f"std::make_shared<fictus::Ellipse>(fictus::Point2{{0.5, 0.5}}, {geo['semi_axes'][0]}, "
                      f"{geo['semi_axes'][1]}, {geo['angle']})")
         else:
-            curve = (f"std::make_shared<fictus::StarCurve>(fictus::Point{{0.5, 0.5}}, "
+            curve = (f"std::make_shared<fictus::StarCurve>(fictus::Point2{{0.5, 0.5}}, "
                      f"[r = fictus::Expression(\"{geo['r']}\", {{\"t\"}}, \"geometry.r\")](double t) {{ return r({{t}}); }})")
         lines += ["  {", "    fictus::Problem p;", f'    p.name = "manufactured_{name}";', "    p.N = N;",
                   f"    p.c = {C};", f"    p.gamma = {curve};", f"    p.f = {name}::f;", f"    p.g = {name}::g;",
                   f"    p.exact = {name}::u;",
-                  f"    p.exact_gradient = [](double x, double y) {{ return fictus::Point{{{name}::ux(x, y), {name}::uy(x, y)}}; }};",
+                  f"    p.exact_gradient = [](double x, double y) {{ return fictus::Point2{{{name}::ux(x, y), {name}::uy(x, y)}}; }};",
                   f'    out.push_back({{"{name}", p}});', "  }"]
     lines += ["  return out;", "}", "", "}  // namespace manufactured", ""]
     with open(os.path.join(ROOT, "tests", "convergence", "manufactured_solutions.hpp"), "w") as out:

@@ -434,11 +434,11 @@ inline std::vector<Problem> all(int N) {
     p.name = "manufactured_circle";
     p.N = N;
     p.c = 1.0;
-    p.gamma = std::make_shared<fictus::Ellipse>(fictus::Point{0.5, 0.5}, 0.3, 0.3);
+    p.gamma = std::make_shared<fictus::Ellipse>(fictus::Point2{0.5, 0.5}, 0.3, 0.3);
     p.f = circle::f;
     p.g = circle::g;
     p.exact = circle::u;
-    p.exact_gradient = [](double x, double y) { return fictus::Point{circle::ux(x, y), circle::uy(x, y)}; };
+    p.exact_gradient = [](double x, double y) { return fictus::Point2{circle::ux(x, y), circle::uy(x, y)}; };
     out.push_back({"circle", p});
   }
   {
@@ -446,11 +446,11 @@ inline std::vector<Problem> all(int N) {
     p.name = "manufactured_ellipse";
     p.N = N;
     p.c = 1.0;
-    p.gamma = std::make_shared<fictus::Ellipse>(fictus::Point{0.5, 0.5}, 0.35, 0.22, -0.4);
+    p.gamma = std::make_shared<fictus::Ellipse>(fictus::Point2{0.5, 0.5}, 0.35, 0.22, -0.4);
     p.f = ellipse::f;
     p.g = ellipse::g;
     p.exact = ellipse::u;
-    p.exact_gradient = [](double x, double y) { return fictus::Point{ellipse::ux(x, y), ellipse::uy(x, y)}; };
+    p.exact_gradient = [](double x, double y) { return fictus::Point2{ellipse::ux(x, y), ellipse::uy(x, y)}; };
     out.push_back({"ellipse", p});
   }
   {
@@ -458,11 +458,11 @@ inline std::vector<Problem> all(int N) {
     p.name = "manufactured_star";
     p.N = N;
     p.c = 1.0;
-    p.gamma = std::make_shared<fictus::StarCurve>(fictus::Point{0.5, 0.5}, [r = fictus::Expression("0.3 * (1 - 0.6 * cos(6 * t))^(-1/6)", {"t"}, "geometry.r")](double t) { return r({t}); });
+    p.gamma = std::make_shared<fictus::StarCurve>(fictus::Point2{0.5, 0.5}, [r = fictus::Expression("0.3 * (1 - 0.6 * cos(6 * t))^(-1/6)", {"t"}, "geometry.r")](double t) { return r({t}); });
     p.f = star::f;
     p.g = star::g;
     p.exact = star::u;
-    p.exact_gradient = [](double x, double y) { return fictus::Point{star::ux(x, y), star::uy(x, y)}; };
+    p.exact_gradient = [](double x, double y) { return fictus::Point2{star::ux(x, y), star::uy(x, y)}; };
     out.push_back({"star", p});
   }
   return out;

@@ -24,7 +24,7 @@ constexpr double two_pi = 2.0 * std::numbers::pi;
 
 struct Reference {
   std::string name;
-  fictus::Point center;
+  fictus::Point2 center;
   std::function<double(double)> radius;  // r_b(θ), θ the polar angle about the center
   int n_theta = 0, n_rho = 0;
   std::vector<double> u, ux, uy;          // interior samples, index j·n_rho + k
@@ -57,8 +57,8 @@ inline Reference load(const std::string& folder, const std::string& name) {
   return r;
 }
 
-inline fictus::Point boundary_point(const Reference& r, double theta) {
-  return r.center + r.radius(theta) * fictus::Point{std::cos(theta), std::sin(theta)};
+inline fictus::Point2 boundary_point(const Reference& r, double theta) {
+  return r.center + r.radius(theta) * fictus::Point2{std::cos(theta), std::sin(theta)};
 }
 
 struct Comparison {
@@ -67,7 +67,7 @@ struct Comparison {
 };
 
 inline Comparison compare(const Reference& r, const fictus::Solution& s) {
-  const fictus::Grid& grid = s.grid;
+  const fictus::Grid2& grid = s.grid;
   // ω: the reference's rule, weights (2π/n_θ)·w_k·ρ_k·r_b(θ_j)².
   const fictus::GaussRule& rule = fictus::gauss_legendre(r.n_rho);
   double e0 = 0, e1 = 0;
@@ -75,7 +75,7 @@ inline Comparison compare(const Reference& r, const fictus::Solution& s) {
     const double theta = two_pi * (j + 0.5) / r.n_theta, rb = r.radius(theta);
     for (int k = 0; k < r.n_rho; ++k) {
       const double rho = rule.nodes[k], w = two_pi / r.n_theta * rule.weights[k] * rho * rb * rb;
-      const fictus::Point x = r.center + rho * rb * fictus::Point{std::cos(theta), std::sin(theta)};
+      const fictus::Point2 x = r.center + rho * rb * fictus::Point2{std::cos(theta), std::sin(theta)};
       const auto q = fictus::sample_q1(grid, s.u, grid.cell_x(x.x), grid.cell_y(x.y), x.x, x.y);
       const std::size_t n = std::size_t(j) * r.n_rho + k;
       e0 += w * std::pow(q.value - r.u[n], 2);
@@ -96,14 +96,14 @@ inline Comparison compare(const Reference& r, const fictus::Solution& s) {
              std::sqrt(e0 + e1) / std::hypot(r.l2_omega, r.h1semi_omega),
              std::sqrt(eg) / r.l2_gamma};
   // Contact ends: fictus's lie between two collocation points of different status (the arc boundary).
-  std::vector<fictus::Point> ends;
+  std::vector<fictus::Point2> ends;
   const int m = s.collocation.m;
   for (int i = 0; i < m; ++i)
     if (s.newton.active[i] != s.newton.active[(i + 1) % m])
       ends.push_back(0.5 * (s.collocation.point[i] + s.collocation.point[(i + 1) % m]));
   for (double theta : r.ends) {
     double best = 1e300;
-    for (const fictus::Point& e : ends) best = std::min(best, fictus::norm(e - boundary_point(r, theta)));
+    for (const fictus::Point2& e : ends) best = std::min(best, fictus::norm(e - boundary_point(r, theta)));
     c.end_error_spacings = std::max(c.end_error_spacings, best / s.collocation.spacing);
   }
   return c;

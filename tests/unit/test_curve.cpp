@@ -31,18 +31,18 @@ TEST(Curve, ArcLengthInverse) {
 
 TEST(Curve, OutwardNormalAndCurvature) {
   const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2);
-  const fictus::Point n0 = e.outward_normal(0.0), n1 = e.outward_normal(pi / 2);
+  const fictus::Point2 n0 = e.outward_normal(0.0), n1 = e.outward_normal(pi / 2);
   EXPECT_NEAR(n0.x, 1.0, 1e-15);
   EXPECT_NEAR(n1.y, 1.0, 1e-15);
   EXPECT_NEAR(e.curvature(0.0), 0.4 / (0.2 * 0.2), 1e-12);  // a/b² at the end of the major axis
 }
 
 TEST(Curve, OffsetCurveLengthGrowsByTwoPiDelta) {
-  auto e = std::make_shared<fictus::Ellipse>(fictus::Point{0.5, 0.5}, 0.4, 0.2);
+  auto e = std::make_shared<fictus::Ellipse>(fictus::Point2{0.5, 0.5}, 0.4, 0.2);
   const double delta = 0.03;
   const fictus::OffsetCurve gamma(e, delta);
   EXPECT_NEAR(fictus::ArcLengthTable(gamma).length(), ellipse_perimeter(0.4, 0.2) + 2 * pi * delta, 1e-11);
-  const fictus::Point p = gamma.position(1.0), q = e->position(1.0), n = e->outward_normal(1.0);
+  const fictus::Point2 p = gamma.position(1.0), q = e->position(1.0), n = e->outward_normal(1.0);
   EXPECT_NEAR(fictus::dot(p - q, n), delta, 1e-15);
 }
 

@@ -10,7 +10,7 @@ namespace {
 
 // A = K + cM assembled cell by cell from the Q1 element matrices (independent of the tensor form).
 // Dirichlet: boundary nodes dropped; periodic: Grid::index wraps the node indices.
-Eigen::SparseMatrix<double> assemble_q1(const fictus::Grid& grid, double c) {
+Eigen::SparseMatrix<double> assemble_q1(const fictus::Grid2& grid, double c) {
   const double h = grid.h();
   const int ci[4] = {0, 1, 1, 0}, cj[4] = {0, 0, 1, 1};  // corners counter-clockwise
   const double K[4][4] = {{4, -1, -2, -1}, {-1, 4, -1, -2}, {-2, -1, 4, -1}, {-1, -2, -1, 4}};
@@ -33,7 +33,7 @@ class DstSolverTest : public ::testing::TestWithParam<double> {};
 
 TEST_P(DstSolverTest, MatchesSparseDirectSolve) {
   const double c = GetParam();
-  const fictus::Grid grid(fictus::Box{0.0, 1.0, 0.0, 0.75}, 16);  // 16 × 12 cells, nx ≠ ny
+  const fictus::Grid2 grid(fictus::Box2{{0.0, 0.0}, {1.0, 0.75}}, 16);  // 16 × 12 cells, nx ≠ ny
   const fictus::DstSolver solver(grid, c);
   const Eigen::SparseMatrix<double> A = assemble_q1(grid, c);
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(A);
@@ -59,7 +59,7 @@ TEST_P(DstSolverTest, MatchesSparseDirectSolve) {
 INSTANTIATE_TEST_SUITE_P(ReactionCoefficients, DstSolverTest, ::testing::Values(0.0, 1.0, 100.0));
 
 TEST(DstSolver, RejectsNegativeReaction) {
-  const fictus::Grid grid(fictus::Box{}, 8);
+  const fictus::Grid2 grid(fictus::Box2{}, 8);
   EXPECT_THROW(fictus::DstSolver(grid, -1.0), std::invalid_argument);
 }
 
@@ -73,7 +73,7 @@ class PeriodicSolverTest : public ::testing::TestWithParam<double> {};
 
 TEST_P(PeriodicSolverTest, MatchesSparseDirectSolve) {
   const double c = GetParam();
-  const fictus::Grid grid(fictus::Box{0.0, 1.0, 0.0, 0.75}, 16, fictus::Boundary::periodic);
+  const fictus::Grid2 grid(fictus::Box2{{0.0, 0.0}, {1.0, 0.75}}, 16, fictus::Boundary::periodic);
   const auto solver = fictus::make_fast_solver(grid, c);
   fictus::GridVector r(grid.n_unknowns());
   std::mt19937 rng(3);
@@ -95,7 +95,7 @@ INSTANTIATE_TEST_SUITE_P(ReactionCoefficients, PeriodicSolverTest, ::testing::Va
 
 TEST(PeriodicSolver, SingularCaseIsThePseudoInverse) {
   // c = 0: A is singular with the constants as null space. A·A⁺r = r − mean(r), and A⁺r has zero mean.
-  const fictus::Grid grid(fictus::Box{}, 16, fictus::Boundary::periodic);
+  const fictus::Grid2 grid(fictus::Box2{}, 16, fictus::Boundary::periodic);
   const auto solver = fictus::make_fast_solver(grid, 0.0);
   ASSERT_TRUE(solver->singular());
   fictus::GridVector r(grid.n_unknowns());

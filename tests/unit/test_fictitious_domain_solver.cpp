@@ -38,7 +38,7 @@ TEST_P(SingularPeriodic, SolvabilityHoldsAndTheExactSolutionIsFound) {
     // mean-free load balances; check it on the assembled data through the arc lengths.
     double total_load = 0;
     {
-      const fictus::Grid& grid = solver.grid();
+      const fictus::Grid2& grid = solver.grid();
       fictus::GridVector load = fictus::assemble_load(grid, problem.f);
       for (double v : load) total_load += v;
     }
@@ -112,7 +112,7 @@ TEST(Reuse, NewCurveMatchesAFreshSolve) {
   fictus::FictitiousDomainSolver solver(problem);
   const fictus::SolverOptions o = options_for(fictus::Variant::nonsmooth, fictus::InnerSolver::green, 256);
   solver.solve(problem, o);
-  problem.gamma = std::make_shared<fictus::Ellipse>(fictus::Point{0.5, 0.5}, 0.4, 0.2, 0.3);
+  problem.gamma = std::make_shared<fictus::Ellipse>(fictus::Point2{0.5, 0.5}, 0.4, 0.2, 0.3);
   const fictus::Solution moved = solver.solve(problem, o);
   EXPECT_FALSE(moved.reused_curve);
   const fictus::Solution fresh = fictus::solve(problem, o);

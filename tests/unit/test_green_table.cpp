@@ -15,9 +15,9 @@ class GreenTableTest : public ::testing::TestWithParam<Case> {};
 
 TEST_P(GreenTableTest, MatchesColumnsOfInverse) {
   const auto [boundary, c] = GetParam();
-  const fictus::Grid grid(fictus::Box{0.0, 1.0, 0.0, 0.75}, 16, boundary);
+  const fictus::Grid2 grid(fictus::Box2{{0.0, 0.0}, {1.0, 0.75}}, 16, boundary);
   const auto solver = fictus::make_fast_solver(grid, c);
-  const fictus::GreenTable green(grid, c);
+  const fictus::GreenTable<2> green(grid, c);
   const int columns[][2] = {{1, 1}, {8, 6}, {15, 11}, {3, 10}, {12, 2}};
   for (const auto& col : columns) {
     fictus::GridVector e(grid.n_unknowns(), 0.0);

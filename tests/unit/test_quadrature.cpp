@@ -21,7 +21,7 @@ TEST_P(DomainQuadrature, AreaMomentsAndPerimeterOfEllipse) {
   const auto [N, angle] = GetParam();
   const double a = 0.4, b = 0.2, cx = 0.5, cy = 0.47;
   const fictus::Ellipse e({cx, cy}, a, b, angle);
-  const fictus::Grid grid(fictus::Box{}, N);
+  const fictus::Grid2 grid(fictus::Box2{}, N);
   const fictus::CurveGridIntersection geometry(e, grid);
   const auto moments = fictus::integrate_over_domain<3>(geometry, 4, [&](int, int, double x, double y) {
     return std::array<double, 3>{1.0, x, (x - cx) * (x - cx) + (y - cy) * (y - cy)};
@@ -31,7 +31,7 @@ TEST_P(DomainQuadrature, AreaMomentsAndPerimeterOfEllipse) {
   EXPECT_NEAR(moments[1] / (area * cx), 1.0, 1e-12);
   EXPECT_NEAR(moments[2] / (area * (a * a + b * b) / 4), 1.0, 1e-12);  // polar moment, any rotation
 
-  const auto length = fictus::integrate_along_curve<1>(geometry, 6, [](int, int, double, fictus::Point) {
+  const auto length = fictus::integrate_along_curve<1>(geometry, 6, [](int, int, double, fictus::Point2) {
     return std::array<double, 1>{1.0};
   });
   EXPECT_NEAR(length[0], 4 * a * std::comp_ellint_2(std::sqrt(1 - b * b / (a * a))), 1e-12);
@@ -42,7 +42,7 @@ INSTANTIATE_TEST_SUITE_P(Grids, DomainQuadrature,
 
 TEST(CurveGridIntersection, InsideTestMatchesEllipseEquation) {
   const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2, 0.4);
-  const fictus::Grid grid(fictus::Box{}, 64);
+  const fictus::Grid2 grid(fictus::Box2{}, 64);
   const fictus::CurveGridIntersection geometry(e, grid);
   int mismatches = 0;
   for (int j = 0; j <= 64; ++j)
@@ -57,7 +57,7 @@ TEST(CurveGridIntersection, InsideTestMatchesEllipseEquation) {
 TEST(CurveGridIntersection, CurveStartingOnAGridLineKeepsTheParityOfThatRow) {
   // The paper's ellipse starts at (0.9, 0.5), on grid row y = ½ for every even N.
   const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2);
-  const fictus::Grid grid(fictus::Box{}, 128);
+  const fictus::Grid2 grid(fictus::Box2{}, 128);
   const fictus::CurveGridIntersection geometry(e, grid);
   for (int i = 0; i <= 128; ++i) {
     const double x = grid.x(i);
@@ -67,7 +67,7 @@ TEST(CurveGridIntersection, CurveStartingOnAGridLineKeepsTheParityOfThatRow) {
 
 TEST(CurveGridIntersection, RejectsCurveLeavingTheBox) {
   const fictus::Ellipse e({0.5, 0.5}, 0.6, 0.2);
-  const fictus::Grid grid(fictus::Box{}, 32);
+  const fictus::Grid2 grid(fictus::Box2{}, 32);
   EXPECT_THROW(fictus::CurveGridIntersection(e, grid), std::invalid_argument);
 }
 

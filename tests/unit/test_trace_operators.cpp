@@ -17,8 +17,8 @@ namespace {
 constexpr double pi = std::numbers::pi;
 
 struct EllipseFixture {
-  fictus::Grid grid{fictus::Box{}, 64};
-  std::shared_ptr<fictus::Ellipse> gamma = std::make_shared<fictus::Ellipse>(fictus::Point{0.5, 0.5}, 0.4, 0.2, 0.2);
+  fictus::Grid2 grid{fictus::Box2{}, 64};
+  std::shared_ptr<fictus::Ellipse> gamma = std::make_shared<fictus::Ellipse>(fictus::Point2{0.5, 0.5}, 0.4, 0.2, 0.2);
   fictus::ArcLengthTable arc{*gamma};
   fictus::Collocation points = fictus::make_collocation(*gamma, arc, 40);
 
@@ -94,12 +94,12 @@ TEST(TraceOperators, ArcRowsIntegrateQ1FunctionsExactly) {
 /// Largest error of rows R applied to u against the exact n·∇u at the points.
 double max_normal_derivative_error(const EllipseFixture& s, const fictus::SparseRows& C,
                                    const std::function<double(double, double)>& u,
-                                   const std::function<fictus::Point(double, double)>& grad) {
+                                   const std::function<fictus::Point2(double, double)>& grad) {
   std::vector<double> values;
   C.multiply(s.sample(u), values);
   double error = 0.0;
   for (int i = 0; i < s.points.m; ++i) {
-    const fictus::Point p = s.points.point[i], g = grad(p.x, p.y);
+    const fictus::Point2 p = s.points.point[i], g = grad(p.x, p.y);
     error = std::max(error, std::abs(values[i] - fictus::dot(s.points.normal[i], g)));
   }
   return error;
@@ -109,10 +109,10 @@ TEST(TraceOperators, CenteredRowsReproducePolynomialsOfTheirDegree) {
   const EllipseFixture s;
   // Biquadratic rows are exact on x²y², bicubic rows on x³y³ (tensor-product interpolation).
   auto quadratic = [](double x, double y) { return 1 + x - 2 * y + 3 * x * x * y * y - x * y; };
-  auto quadratic_grad = [](double x, double y) { return fictus::Point{1 + 6 * x * y * y - y, -2 + 6 * x * x * y - x}; };
+  auto quadratic_grad = [](double x, double y) { return fictus::Point2{1 + 6 * x * y * y - y, -2 + 6 * x * x * y - x}; };
   auto cubic = [](double x, double y) { return x * x * x * y * y * y - 2 * x * x * y; };
   auto cubic_grad = [](double x, double y) {
-    return fictus::Point{3 * x * x * y * y * y - 4 * x * y, 3 * x * x * x * y * y - 2 * x * x};
+    return fictus::Point2{3 * x * x * y * y * y - 4 * x * y, 3 * x * x * x * y * y - 2 * x * x};
   };
   const auto C2 = fictus::normal_derivative_rows_centered(s.grid, s.points.point, s.points.normal, 2);
   const auto C3 = fictus::normal_derivative_rows_centered(s.grid, s.points.point, s.points.normal, 3);
@@ -124,12 +124,12 @@ TEST(TraceOperators, CenteredRowsReproducePolynomialsOfTheirDegree) {
 TEST(TraceOperators, CenteredRowsAreSecondOrderWhereTheShiftedOnesAreNot) {
   auto u = [](double x, double y) { return std::sin(2 * x + 1) * std::cos(3 * y) + x * x * y; };
   auto grad = [](double x, double y) {
-    return fictus::Point{2 * std::cos(2 * x + 1) * std::cos(3 * y) + 2 * x * y, -3 * std::sin(2 * x + 1) * std::sin(3 * y) + x * x};
+    return fictus::Point2{2 * std::cos(2 * x + 1) * std::cos(3 * y) + 2 * x * y, -3 * std::sin(2 * x + 1) * std::sin(3 * y) + x * x};
   };
   double centered[2], shifted[2];
   for (int k = 0; k < 2; ++k) {
     EllipseFixture s;
-    s.grid = fictus::Grid(fictus::Box{}, 128 << k);
+    s.grid = fictus::Grid2(fictus::Box2{}, 128 << k);
     centered[k] = max_normal_derivative_error(s, fictus::normal_derivative_rows_centered(s.grid, s.points.point, s.points.normal, 2), u, grad);
     shifted[k] = max_normal_derivative_error(s, fictus::normal_derivative_rows(s.grid, s.points.point, s.points.normal, s.grid.h()), u, grad);
   }
@@ -153,7 +153,7 @@ TEST(TraceOperators, OneSidedRowsUseNodesOfOmegaOnlyAndReproduceQuadratics) {
   D.multiply(u, derivative);
   V.multiply(u, value);
   for (int i = 0; i < s.points.m; ++i) {
-    const fictus::Point p = s.points.point[i], n = s.points.normal[i];
+    const fictus::Point2 p = s.points.point[i], n = s.points.normal[i];
     EXPECT_NEAR(value[i], q(p.x, p.y), 1e-10);
     EXPECT_NEAR(derivative[i], n.x * (1 + 6 * p.x - p.y) + n.y * (-2 - p.x + p.y), 1e-9);
   }
@@ -163,11 +163,11 @@ TEST(KinkCorrection, TracesOfAKinkedFieldAreThoseOfItsSmoothPart) {
   // û = w − λψ with ψ = q(d)⁺ the kink of strength λ on γ (λ the same on every arc): the corrected
   // rows R û + Dλ give the traces of the smooth w, to the order of R.
   EllipseFixture s;
-  s.grid = fictus::Grid(fictus::Box{}, 256);
+  s.grid = fictus::Grid2(fictus::Box2{}, 256);
   const fictus::CurveGridIntersection geometry(*s.gamma, s.grid);
   const fictus::KinkCorrection kink(geometry, s.points, 1.0);
   auto w = [](double x, double y) { return std::cos(3 * x - y) + x * y; };
-  auto grad_w = [](double x, double y) { return fictus::Point{-3 * std::sin(3 * x - y) + y, std::sin(3 * x - y) + x}; };
+  auto grad_w = [](double x, double y) { return fictus::Point2{-3 * std::sin(3 * x - y) + y, std::sin(3 * x - y) + x}; };
   const double lambda = 2.5;
   std::vector<double> lambdas(s.points.m, lambda);
   // I_h(w − λψ): start from I_h w, subtract λψ at the nodes of the band (add_kinks adds +λψ).
@@ -183,7 +183,7 @@ TEST(KinkCorrection, TracesOfAKinkedFieldAreThoseOfItsSmoothPart) {
   C.multiply(kinked, derivative);
   double raw_error = 0.0;
   for (int i = 0; i < s.points.m; ++i) {
-    const fictus::Point p = s.points.point[i];
+    const fictus::Point2 p = s.points.point[i];
     EXPECT_NEAR(trace[i] + dB(i), w(p.x, p.y), 2e-5);  // O(h²) of the bilinear interpolant
     EXPECT_NEAR(derivative[i] + dC(i), fictus::dot(s.points.normal[i], grad_w(p.x, p.y)), 2e-3);
     raw_error = std::max(raw_error, std::abs(derivative[i] - fictus::dot(s.points.normal[i], grad_w(p.x, p.y))));
@@ -216,9 +216,9 @@ TEST(KinkCorrection, GalerkinRowsLiveOnTheCutCellsAndCarryNoMassWhenCIsZero) {
 TEST(KinkCorrection, KinkValuesOfAPolygonFollowTheDistanceToEdgesAndCorners) {
   // ψ = q(d)⁺ with q(d) = d on straight edges: outside a convex corner d is the distance to the
   // vertex, beside an edge the distance to its line (the projection must not flip between edges).
-  const fictus::Grid grid(fictus::Box{}, 64);
+  const fictus::Grid2 grid(fictus::Box2{}, 64);
   const auto square = std::make_shared<fictus::PolygonCurve>(
-      std::vector<fictus::Point>{{0.3, 0.3}, {0.7, 0.32}, {0.68, 0.7}, {0.31, 0.69}});
+      std::vector<fictus::Point2>{{0.3, 0.3}, {0.7, 0.32}, {0.68, 0.7}, {0.31, 0.69}});
   const fictus::ArcLengthTable arc(*square);
   const fictus::Collocation points = fictus::make_collocation(*square, arc, 24, fictus::phase_off_corners(*square, arc, 24));
   const fictus::CurveGridIntersection geometry(*square, grid);
@@ -226,15 +226,15 @@ TEST(KinkCorrection, KinkValuesOfAPolygonFollowTheDistanceToEdgesAndCorners) {
   fictus::GridVector psi(grid.n_unknowns(), 0.0);
   kink.add_kinks(std::vector<double>(points.m, 1.0), psi);
   const auto& v = square->vertices();
-  auto segment_distance = [](fictus::Point p, fictus::Point a, fictus::Point b) {
-    const fictus::Point e = b - a;
+  auto segment_distance = [](fictus::Point2 p, fictus::Point2 a, fictus::Point2 b) {
+    const fictus::Point2 e = b - a;
     const double t = std::clamp(fictus::dot(p - a, e) / fictus::dot(e, e), 0.0, 1.0);
     return fictus::norm(p - (a + t * e));
   };
   int checked = 0;
   for (int j = 1; j < grid.ny(); ++j)
     for (int i = 1; i < grid.nx(); ++i) {
-      const fictus::Point x{grid.x(i), grid.y(j)};
+      const fictus::Point2 x{grid.x(i), grid.y(j)};
       if (geometry.node_inside(i, j)) {
         EXPECT_EQ(psi[grid.index(i, j)], 0.0);
         continue;
