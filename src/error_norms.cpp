@@ -3,6 +3,8 @@
 #include <cmath>
 #include <vector>
 
+#include "fictus/q1_element.hpp"
+
 namespace fictus {
 
 GradientField numerical_gradient(ScalarField u, double scale) {
@@ -13,12 +15,17 @@ GradientField numerical_gradient(ScalarField u, double scale) {
 }
 
 Q1Sample sample_q1(const Grid2& grid, const GridVector& u_h, int ix, int iy, double x, double y) {
-  auto node = [&](int i, int j) { return grid.has_unknown(i, j) ? u_h[grid.index(i, j)] : 0.0; };
   const double h = grid.h();
-  const double xi = (x - grid.x(ix)) / h, eta = (y - grid.y(iy)) / h;
-  const double u00 = node(ix, iy), u10 = node(ix + 1, iy), u01 = node(ix, iy + 1), u11 = node(ix + 1, iy + 1);
-  return {u00 * (1 - xi) * (1 - eta) + u10 * xi * (1 - eta) + u01 * (1 - xi) * eta + u11 * xi * eta,
-          {((u10 - u00) * (1 - eta) + (u11 - u01) * eta) / h, ((u01 - u00) * (1 - xi) + (u11 - u10) * xi) / h}};
+  const Q1Element<2> element({(x - grid.x(ix)) / h, (y - grid.y(iy)) / h}, h);
+  Q1Sample sample{0.0, {0.0, 0.0}};
+  for (int k = 0; k < Q1Element<2>::n_nodes; ++k) {
+    const int i = ix + Q1Element<2>::offset(k, 0), j = iy + Q1Element<2>::offset(k, 1);
+    if (!grid.has_unknown(i, j)) continue;
+    const double u = u_h[grid.index(i, j)];
+    sample.value += u * element.value[k];
+    sample.gradient = sample.gradient + u * element.gradient[k];
+  }
+  return sample;
 }
 
 namespace {

@@ -1,15 +1,19 @@
 #include "fictus/grid.hpp"
 
+#include "fictus/q1_element.hpp"
+
 namespace fictus {
 
 const char* to_string(Boundary b) { return b == Boundary::periodic ? "periodic" : "dirichlet"; }
 
 double evaluate_q1(const Grid2& grid, const GridVector& u, Point2 p) {
-  const int ix = grid.cell_x(p.x), iy = grid.cell_y(p.y);
-  const double xi = (p.x - grid.x(ix)) / grid.h(), eta = (p.y - grid.y(iy)) / grid.h();
-  auto value = [&](int i, int j) { return grid.has_unknown(i, j) ? u[grid.index(i, j)] : 0.0; };
-  return value(ix, iy) * (1 - xi) * (1 - eta) + value(ix + 1, iy) * xi * (1 - eta) +
-         value(ix, iy + 1) * (1 - xi) * eta + value(ix + 1, iy + 1) * xi * eta;
+  const Q1Cell2 cell = q1_cell(grid, p);
+  double sum = 0.0;
+  for (int k = 0; k < Q1Element<2>::n_nodes; ++k) {
+    const int i = cell.ix + Q1Element<2>::offset(k, 0), j = cell.iy + Q1Element<2>::offset(k, 1);
+    if (grid.has_unknown(i, j)) sum += u[grid.index(i, j)] * cell.element.value[k];
+  }
+  return sum;
 }
 
 }  // namespace fictus

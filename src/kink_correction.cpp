@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "fictus/q1_element.hpp"
 #include "fictus/quadrature.hpp"
 
 namespace fictus {
@@ -193,19 +194,6 @@ class NodeKinks {
 };
 
 /// Q1 on a square cell, local nodes (0,0), (1,0), (0,1), (1,1): value and gradient at (ξ, η).
-struct Q1Basis {
-  double value[4];
-  Point2 gradient[4];
-  Q1Basis(double xi, double eta, double h) {
-    for (int k = 0; k < 4; ++k) {
-      const int a = k & 1, b = k >> 1;
-      const double fx = a ? xi : 1 - xi, fy = b ? eta : 1 - eta;
-      value[k] = fx * fy;
-      gradient[k] = {(a ? 1.0 : -1.0) * fy / h, (b ? 1.0 : -1.0) * fx / h};
-    }
-  }
-};
-
 struct RowEntry {
   int arc, i, j;
   double value;
@@ -282,7 +270,7 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
   //    Each quadrature point goes to the arc its nearest curve point lies on.
   const GaussRule& rule = gauss_legendre(3);  // q(d) is smooth on the cell: degree-5 exactness suffices
   constexpr int cut_q = 3;
-  // Element matrix of −Δ + c on a square Q1 cell (local nodes as in Q1Basis).
+  // Element matrix of −Δ + c on a square Q1 cell (local nodes as in Q1Element).
   const double K[4][4] = {{4, -1, -1, -2}, {-1, 4, -2, -1}, {-1, -2, 4, -1}, {-2, -1, -1, 4}};
   const double M[4][4] = {{4, 2, 2, 1}, {2, 4, 1, 2}, {2, 1, 4, 2}, {1, 2, 2, 4}};
   std::vector<std::vector<RowEntry>> by_cell(cells.size());  // summed in cell order: the same for any thread count
@@ -303,7 +291,7 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
       const double x0 = grid.x(cell.ix), y0 = grid.y(cell.iy);
       auto add_point = [&](double x, double y, double w) {
         const Kink kink = project.near(centres[n], {x, y}, speeds[n]);
-        const Q1Basis basis((x - x0) / h, (y - y0) / h, h);
+        const Q1Element<2> basis({(x - x0) / h, (y - y0) / h}, h);
         const double q = kink.q();
         const Point2 grad = kink.grad_q();
         std::array<double, 4>& v = sums_of(arc_of(kink.t));

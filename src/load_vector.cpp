@@ -1,8 +1,10 @@
 #include "fictus/load_vector.hpp"
 
+#include <array>
 #include <stdexcept>
 #include <vector>
 
+#include "fictus/q1_element.hpp"
 #include "fictus/quadrature.hpp"
 
 namespace fictus {
@@ -22,6 +24,9 @@ GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q, int
   const int nx = grid.nx(), ny = grid.ny(), qq = q * q;
   const double h = grid.h(), area = h * h;
   GridVector load(grid.n_unknowns(), 0.0);
+  std::vector<Q1Element<2>> elements;  // the shape functions at the q×q Gauss points of a cell
+  for (int b = 0; b < q; ++b)
+    for (int a = 0; a < q; ++a) elements.emplace_back(Point2{rule.nodes[a], rule.nodes[b]}, h);
   // Cell rows of one parity write to disjoint node rows {iy, iy+1}: two parallel sweeps.
   for (int parity = 0; parity < 2; ++parity) {
 #pragma omp parallel num_threads(threads < 1 ? 1 : threads)
@@ -37,23 +42,17 @@ GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q, int
             }
         f(xs.size(), xs.data(), ys.data(), values.data());
         for (int ix = 0; ix < nx; ++ix) {
-          double w00 = 0, w10 = 0, w01 = 0, w11 = 0;
+          std::array<double, Q1Element<2>::n_nodes> w{};
           for (int b = 0; b < q; ++b)
             for (int a = 0; a < q; ++a) {
-              const double xi = rule.nodes[a], eta = rule.nodes[b];
+              const Q1Element<2>& element = elements[std::size_t(b) * q + a];
               const double v = values[std::size_t(ix) * qq + b * q + a] * rule.weights[a] * rule.weights[b] * area;
-              w00 += v * (1 - xi) * (1 - eta);
-              w10 += v * xi * (1 - eta);
-              w01 += v * (1 - xi) * eta;
-              w11 += v * xi * eta;
+              for (int k = 0; k < Q1Element<2>::n_nodes; ++k) w[k] += v * element.value[k];
             }
-          auto add = [&](int i, int j, double w) {
-            if (grid.has_unknown(i, j)) load[grid.index(i, j)] += w;
-          };
-          add(ix, iy, w00);
-          add(ix + 1, iy, w10);
-          add(ix, iy + 1, w01);
-          add(ix + 1, iy + 1, w11);
+          for (int k = 0; k < Q1Element<2>::n_nodes; ++k) {
+            const int i = ix + Q1Element<2>::offset(k, 0), j = iy + Q1Element<2>::offset(k, 1);
+            if (grid.has_unknown(i, j)) load[grid.index(i, j)] += w[k];
+          }
         }
       }
     }

@@ -8,6 +8,7 @@
 
 #include <Eigen/Dense>
 
+#include "fictus/q1_element.hpp"
 #include "fictus/quadrature.hpp"
 
 namespace fictus {
@@ -30,11 +31,9 @@ class RowBuilder {
   }
   /// Bilinear weights of point p in cell (ix, iy), scaled by w.
   void add_bilinear(int ix, int iy, Point2 p, double w) {
-    const double xi = (p.x - grid_.x(ix)) / grid_.h(), eta = (p.y - grid_.y(iy)) / grid_.h();
-    add(ix, iy, w * (1 - xi) * (1 - eta));
-    add(ix + 1, iy, w * xi * (1 - eta));
-    add(ix, iy + 1, w * (1 - xi) * eta);
-    add(ix + 1, iy + 1, w * xi * eta);
+    const Q1Element<2> element({(p.x - grid_.x(ix)) / grid_.h(), (p.y - grid_.y(iy)) / grid_.h()}, grid_.h());
+    for (int k = 0; k < Q1Element<2>::n_nodes; ++k)
+      add(ix + Q1Element<2>::offset(k, 0), iy + Q1Element<2>::offset(k, 1), w * element.value[k]);
   }
   void end_row() { rows_.row_begin.push_back(rows_.entries.size()); }
 
@@ -71,17 +70,13 @@ SparseRows normal_derivative_rows(const Grid2& grid, const std::vector<Point2>& 
   if (points.size() != normals.size()) throw std::invalid_argument("normal_derivative_rows: size mismatch");
   SparseRows rows;
   RowBuilder builder(grid, rows);
-  const double h = grid.h();
   for (std::size_t r = 0; r < points.size(); ++r) {
     const Point2 n = normals[r];
     const Point2 p = points[r] - shift * n;
-    const int ix = grid.cell_x(p.x), iy = grid.cell_y(p.y);
-    const double xi = (p.x - grid.x(ix)) / h, eta = (p.y - grid.y(iy)) / h;
-    // ∇u = (1/h)·( (u10−u00)(1−η) + (u11−u01)η ,  (u01−u00)(1−ξ) + (u11−u10)ξ )
-    builder.add(ix, iy, (-n.x * (1 - eta) - n.y * (1 - xi)) / h);
-    builder.add(ix + 1, iy, (n.x * (1 - eta) - n.y * xi) / h);
-    builder.add(ix, iy + 1, (-n.x * eta + n.y * (1 - xi)) / h);
-    builder.add(ix + 1, iy + 1, (n.x * eta + n.y * xi) / h);
+    const Q1Cell2 cell = q1_cell(grid, p);  // n·∇u_h of the cell holding p
+    for (int k = 0; k < Q1Element<2>::n_nodes; ++k)
+      builder.add(cell.ix + Q1Element<2>::offset(k, 0), cell.iy + Q1Element<2>::offset(k, 1),
+                  dot(n, cell.element.gradient[k]));
     builder.end_row();
   }
   return rows;
