@@ -68,7 +68,7 @@ void CurveDiscretization::make_trace_rows(const Grid2& grid, const SolverOptions
   }
   C_gamma_ = normal_derivative_rows_centered(grid, points.point, points.normal, 2);
   if (options.variant == Variant::nonsmooth) {
-    kink_ = std::make_unique<KinkCorrection>(*gamma_geometry_, collocation_, c, execution.threads());
+    kink_ = std::make_unique<KinkCorrection>(*gamma_geometry_, collocation_, c, execution);
     loads_ = add_rows(B_Gamma_, kink_->galerkin());
     direct_.trace = kink_->direct(B_gamma_);
     direct_.normal_derivative = kink_->direct(C_gamma_);
@@ -99,8 +99,8 @@ std::optional<std::vector<double>> CurveDiscretization::independent_normal_deriv
 ErrorNorms CurveDiscretization::errors(const GridVector& u, const ContactData& data, int quadrature,
                                        const Execution& execution) const {
   if (data.exact_vectorized)
-    return compute_errors(u, *gamma_geometry_, data.exact_vectorized, {}, quadrature, execution.threads());
-  return compute_errors(u, *gamma_geometry_, data.exact, data.exact_gradient, quadrature, execution.threads());
+    return compute_errors(u, *gamma_geometry_, data.exact_vectorized, {}, quadrature, execution);
+  return compute_errors(u, *gamma_geometry_, data.exact, data.exact_gradient, quadrature, execution);
 }
 
 }  // namespace fictus

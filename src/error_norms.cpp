@@ -55,7 +55,7 @@ void gradient_at(const VectorizedField& u, const VectorizedGradient& gradient, d
 }  // namespace
 
 ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& gamma, const ScalarField& exact,
-                          const GradientField& exact_gradient, int q, int threads) {
+                          const GradientField& exact_gradient, int q, const Execution& execution) {
   VectorizedGradient gradient;
   if (exact_gradient)
     gradient = [exact_gradient](std::size_t n, const double* x, const double* y, double* gx, double* gy) {
@@ -64,16 +64,16 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
         gx[k] = g.x, gy[k] = g.y;
       }
     };
-  return compute_errors(u_h, gamma, vectorize(exact), gradient, q, threads);
+  return compute_errors(u_h, gamma, vectorize(exact), gradient, q, execution);
 }
 
 ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& gamma, const VectorizedField& exact,
-                          const VectorizedGradient& exact_gradient, int q, int threads) {
+                          const VectorizedGradient& exact_gradient, int q, const Execution& execution) {
   const Grid2& grid = gamma.grid();
   const double e = 1e-6 * (grid.box().upper.x - grid.box().lower.x);
   // Over ω, row by row: [e², |∇e|², u², |∇u|²], summed per cell, per row, then over rows.
   std::array<double, 4> omega{};
-#pragma omp parallel num_threads(threads < 1 ? 1 : threads)
+#pragma omp parallel num_threads(execution.threads())
   {
     std::array<double, 4> local{};
     std::vector<CellQuadraturePoint> points;

@@ -116,9 +116,8 @@ using State = FictitiousDomainSolver::State;
 /// Step 0: the load vector and u₀ = A⁻¹f (A⁺f for a singular A), once per solver.
 void load_and_u0(State& st, PhaseClock& clock, std::size_t& fast_solves) {
   if (st.have_u0) return;
-  const int threads = st.execution.threads();
-  st.u0 = st.f_vectorized ? assemble_load(st.grid, st.f_vectorized, st.load_quadrature, threads)
-                          : assemble_load(st.grid, st.f, st.load_quadrature, threads);
+  st.u0 = st.f_vectorized ? assemble_load(st.grid, st.f_vectorized, st.load_quadrature, st.execution)
+                          : assemble_load(st.grid, st.f, st.load_quadrature, st.execution);
   st.load_total = 0;
   for (double v : st.u0) {
     if (!std::isfinite(v)) throw std::invalid_argument("data.f: not finite somewhere in the box");
@@ -147,7 +146,7 @@ std::unique_ptr<SchurComplement> schur_blocks(State& st, const BoundaryDiscretiz
     clock.mark("green_table");
   }
   auto schur = std::make_unique<ExplicitSchur>(*st.green, boundary.B_gamma(), boundary.C_gamma(), boundary.loads(),
-                                               st.execution.threads(), boundary.direct());
+                                               st.execution, boundary.direct());
   clock.mark("schur");
   return schur;
 }

@@ -150,14 +150,14 @@ class NodeKinks {
   std::size_t key(int i, int j) const { return std::size_t(j + 2) * std::size_t(grid_.nx() + 5) + std::size_t(i + 2); }
   /// The band: every node of `nodes` with the index of a cut cell near it (the first one wins).
   void build(std::vector<std::pair<std::size_t, int>> nodes, const std::vector<Kink>& centres,
-             const std::vector<double>& speeds, int threads) {
+             const std::vector<double>& speeds, const Execution& execution) {
     std::stable_sort(nodes.begin(), nodes.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     nodes.erase(std::unique(nodes.begin(), nodes.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
                 nodes.end());
     keys_.resize(nodes.size());
     kinks_.resize(nodes.size());
     const std::size_t width = std::size_t(grid_.nx() + 5);
-#pragma omp parallel for num_threads(threads < 1 ? 1 : threads) schedule(static)
+#pragma omp parallel for num_threads(execution.threads()) schedule(static)
     for (std::size_t n = 0; n < nodes.size(); ++n) {
       const auto [k, cell] = nodes[n];
       const int i = int(k % width) - 2, j = int(k / width) - 2;
@@ -233,7 +233,8 @@ KinkCorrection& KinkCorrection::operator=(KinkCorrection&&) noexcept = default;
 
 const SparseRows& KinkCorrection::galerkin() const { return state_->galerkin; }
 
-KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Collocation& arcs, double c, int threads)
+KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Collocation& arcs, double c,
+                               const Execution& execution)
     : state_(std::make_unique<State>(gamma, arcs)) {
   const Grid2& grid = gamma.grid();
   const Projector project(gamma.curve());
@@ -251,7 +252,7 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
   //    cut cells and of the two rings of cells around them (the band that trace stencils reach).
   std::vector<Kink> centres(cells.size());
   std::vector<double> speeds(cells.size());
-#pragma omp parallel for num_threads(threads < 1 ? 1 : threads) schedule(static)
+#pragma omp parallel for num_threads(execution.threads()) schedule(static)
   for (std::size_t n = 0; n < cells.size(); ++n) {
     centres[n] = project({grid.x(cells[n].ix) + 0.5 * h, grid.y(cells[n].iy) + 0.5 * h}, cell_parameter(cells[n]));
     speeds[n] = gamma.curve().speed(centres[n].t);
@@ -263,7 +264,7 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
       for (int j = cells[n].iy - 2; j <= cells[n].iy + 3; ++j)
         for (int i = cells[n].ix - 2; i <= cells[n].ix + 3; ++i)
           if (i >= 0 && j >= 0 && i <= grid.nx() && j <= grid.ny()) band.emplace_back(nodes.key(i, j), int(n));
-    nodes.build(std::move(band), centres, speeds, threads);
+    nodes.build(std::move(band), centres, speeds, execution);
   }
   // 2. r_j,k = a(ψ_j − I_hψ_j, φ_k) on every cut cell: the part outside ω is the whole cell minus
   //    its part in ω (ψ_j's smooth extension q(d) on both), and I_hψ_j takes the element matrix.
@@ -274,7 +275,7 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
   const double K[4][4] = {{4, -1, -1, -2}, {-1, 4, -2, -1}, {-1, -2, 4, -1}, {-2, -1, -1, 4}};
   const double M[4][4] = {{4, 2, 2, 1}, {2, 4, 1, 2}, {2, 1, 4, 2}, {1, 2, 2, 4}};
   std::vector<std::vector<RowEntry>> by_cell(cells.size());  // summed in cell order: the same for any thread count
-#pragma omp parallel num_threads(threads < 1 ? 1 : threads)
+#pragma omp parallel num_threads(execution.threads())
   {
     std::vector<QuadraturePoint> inside;
 #pragma omp for schedule(dynamic, 16)

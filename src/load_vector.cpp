@@ -15,11 +15,11 @@ VectorizedField vectorize(ScalarField f) {
   };
 }
 
-GridVector assemble_load(const Grid2& grid, const ScalarField& f, int q, int threads) {
-  return assemble_load(grid, vectorize(f), q, threads);
+GridVector assemble_load(const Grid2& grid, const ScalarField& f, int q, const Execution& execution) {
+  return assemble_load(grid, vectorize(f), q, execution);
 }
 
-GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q, int threads) {
+GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q, const Execution& execution) {
   const GaussRule& rule = gauss_legendre(q);
   const int nx = grid.nx(), ny = grid.ny(), qq = q * q;
   const double h = grid.h(), area = h * h;
@@ -29,7 +29,7 @@ GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q, int
     for (int a = 0; a < q; ++a) elements.emplace_back(Point2{rule.nodes[a], rule.nodes[b]}, h);
   // Cell rows of one parity write to disjoint node rows {iy, iy+1}: two parallel sweeps.
   for (int parity = 0; parity < 2; ++parity) {
-#pragma omp parallel num_threads(threads < 1 ? 1 : threads)
+#pragma omp parallel num_threads(execution.threads())
     {
       std::vector<double> xs(std::size_t(nx) * qq), ys(xs.size()), values(xs.size());
 #pragma omp for schedule(dynamic, 4)

@@ -51,12 +51,12 @@ LinearSolveReport ImplicitSchur::solve(const ActiveSet& active, const Eigen::Vec
   return {g.iterations, g.relative_residual, g.converged};
 }
 
-Eigen::MatrixXd green_block(const GreenTable<2>& green, const SparseRows& R, const SparseRows& Q, int threads) {
-  return green_blocks(green, {&R}, Q, threads).front();
+Eigen::MatrixXd green_block(const GreenTable<2>& green, const SparseRows& R, const SparseRows& Q, const Execution& execution) {
+  return green_blocks(green, {&R}, Q, execution).front();
 }
 
 std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>& green, const std::vector<const SparseRows*>& row_sets,
-                                          const SparseRows& Q, int threads) {
+                                          const SparseRows& Q, const Execution& execution) {
   // The distinct nodes of all row sets, and every entry as (node slot, weight).
   std::vector<std::size_t> slot_of;  // by entry, over all row sets in order
   std::vector<std::pair<int, int>> nodes;
@@ -71,7 +71,7 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>& green, const std:
   }
   std::vector<Eigen::MatrixXd> blocks;
   for (const SparseRows* R : row_sets) blocks.emplace_back(R->n_rows(), Q.n_rows());
-#pragma omp parallel num_threads(threads < 1 ? 1 : threads)
+#pragma omp parallel num_threads(execution.threads())
   {
     std::vector<double> column(nodes.size());  // (G Qᵀ)(node, col) for the nodes of the rows
 #pragma omp for schedule(dynamic, 4)
@@ -100,8 +100,8 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>& green, const std:
 }
 
 ExplicitSchur::ExplicitSchur(const GreenTable<2>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
-                             const SparseRows& loads, int threads, const DirectTerms& direct) {
-  std::vector<Eigen::MatrixXd> blocks = green_blocks(green, {&B_gamma, &C_gamma}, loads, threads);
+                             const SparseRows& loads, const Execution& execution, const DirectTerms& direct) {
+  std::vector<Eigen::MatrixXd> blocks = green_blocks(green, {&B_gamma, &C_gamma}, loads, execution);
   S_B_ = std::move(blocks[0]);
   S_C_ = std::move(blocks[1]);
   if (!direct.empty()) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "fictus/curve.hpp"
+#include "fictus/execution.hpp"
 #include "fictus/quadrature.hpp"
 
 namespace fictus {
@@ -74,7 +75,7 @@ class CurveGridIntersection {
 /// curve-following rule on cut cells. F(ix, iy, x, y) must be thread-safe.
 template <int K, class F>
 std::array<double, K> integrate_over_domain(const CurveGridIntersection& geometry, int q, F&& fn,
-                                            int threads = 1);
+                                            const Execution& execution = Execution{});
 
 /// ∫_γ F ds along the whole curve (q-point Gauss on each piece). F(ix, iy, t, p) returns K values.
 template <int K, class F>
@@ -84,10 +85,10 @@ std::array<double, K> integrate_along_curve(const CurveGridIntersection& geometr
 
 template <int K, class F>
 std::array<double, K> integrate_over_domain(const CurveGridIntersection& geometry, int q, F&& fn,
-                                            int threads) {
+                                            const Execution& execution) {
   const Grid2& grid = geometry.grid();
   std::array<double, K> total{};
-#pragma omp parallel num_threads(threads < 1 ? 1 : threads)
+#pragma omp parallel num_threads(execution.threads())
   {
     std::array<double, K> local{};
     std::vector<CellQuadraturePoint> points;

@@ -21,7 +21,7 @@ struct ErrorNorms {
 GradientField numerical_gradient(ScalarField u, double scale);
 
 ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& gamma, const ScalarField& exact,
-                          const GradientField& exact_gradient, int q = 3, int threads = 1);
+                          const GradientField& exact_gradient, int q = 3, const Execution& execution = Execution{});
 
 /// ∇u on many points at once: (gx[k], gy[k]) = ∇u(x[k], y[k]).
 using VectorizedGradient =
@@ -30,7 +30,8 @@ using VectorizedGradient =
 /// The same for an exact solution evaluated in batches (one per cell row, one along γ). Without a
 /// gradient, ∇u by central differences (step 1e-6·box width): four more batches.
 ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& gamma, const VectorizedField& exact,
-                          const VectorizedGradient& exact_gradient = {}, int q = 3, int threads = 1);
+                          const VectorizedGradient& exact_gradient = {}, int q = 3,
+                          const Execution& execution = Execution{});
 
 /// Value and gradient of the Q1 function u_h in cell (ix, iy) at (x, y).
 struct Q1Sample {

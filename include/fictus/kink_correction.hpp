@@ -22,7 +22,8 @@ namespace fictus {
 class KinkCorrection {
  public:
   /// The kink model for the arcs of `arcs` on the curve of `gamma`; computes r_j for A = K + cM.
-  KinkCorrection(const CurveGridIntersection& gamma, const Collocation& arcs, double c, int threads = 1);
+  KinkCorrection(const CurveGridIntersection& gamma, const Collocation& arcs, double c,
+                 const Execution& execution = Execution{});
   ~KinkCorrection();
   KinkCorrection(KinkCorrection&&) noexcept;
   KinkCorrection& operator=(KinkCorrection&&) noexcept;

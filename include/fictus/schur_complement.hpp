@@ -88,7 +88,7 @@ class ExplicitSchur final : public SchurComplement {
  public:
   /// Assembles S_B and S_C from the Green's table (threaded over columns); `loads` as above.
   ExplicitSchur(const GreenTable<2>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
-                const SparseRows& loads, int threads = 1, const DirectTerms& direct = {});
+                const SparseRows& loads, const Execution& execution = Execution{}, const DirectTerms& direct = {});
   /// From given blocks (tests).
   ExplicitSchur(Eigen::MatrixXd S_B, Eigen::MatrixXd S_C) : S_B_(std::move(S_B)), S_C_(std::move(S_C)) {}
   int size() const override { return int(S_B_.rows()); }
@@ -106,10 +106,11 @@ class ExplicitSchur final : public SchurComplement {
 };
 
 /// Dense (rows × cols) block R G Qᵀ from sparse rows and the Green's table.
-Eigen::MatrixXd green_block(const GreenTable<2>& green, const SparseRows& R, const SparseRows& Q, int threads = 1);
+Eigen::MatrixXd green_block(const GreenTable<2>& green, const SparseRows& R, const SparseRows& Q,
+                            const Execution& execution = Execution{});
 /// The blocks R_k G Qᵀ of several row sets at once: (G Qᵀ) is evaluated once per distinct node of
 /// the R_k (B_γ's four nodes of x_i lie in C_γ's 3×3), so the cost is (distinct nodes)·nnz(Q) lookups.
 std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>& green, const std::vector<const SparseRows*>& row_sets,
-                                          const SparseRows& Q, int threads = 1);
+                                          const SparseRows& Q, const Execution& execution = Execution{});
 
 }  // namespace fictus
