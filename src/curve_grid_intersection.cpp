@@ -179,6 +179,49 @@ void CurveGridIntersection::row_rule(int iy, int q, std::vector<CellQuadraturePo
   }
 }
 
+namespace {
+
+/// The pieces of `cell` split where the outer coordinate turns, so that each part is monotone in
+/// it; the outer coordinates of the parts' ends are appended to `breaks`.
+struct MonotonePart {
+  double t0, t1, c_min, c_max;
+};
+std::vector<MonotonePart> monotone_parts(const Curve& curve, const std::vector<CurvePiece>& pieces, const CutCell& cell,
+                                         int outer, std::vector<double>& breaks) {
+  std::vector<MonotonePart> parts;
+  for (int k : cell.pieces) {
+    const CurvePiece& piece = pieces[k];
+    std::vector<double> cuts = {piece.t0};
+    constexpr int probes = 8;
+    double prev_t = piece.t0, prev_d = component(curve.derivative(prev_t), outer);
+    for (int s = 1; s <= probes; ++s) {
+      const double t = piece.t0 + (piece.t1 - piece.t0) * s / probes;
+      const double d = component(curve.derivative(t), outer);
+      if ((d > 0) != (prev_d > 0) && d != 0.0 && prev_d != 0.0) {
+        double a = prev_t, b = t, da = prev_d;
+        for (int it = 0; it < 60; ++it) {
+          const double m = 0.5 * (a + b), dm = component(curve.derivative(m), outer);
+          if ((dm > 0) == (da > 0)) a = m, da = dm; else b = m;
+        }
+        cuts.push_back(0.5 * (a + b));
+      }
+      prev_t = t;
+      prev_d = d;
+    }
+    cuts.push_back(piece.t1);
+    for (std::size_t s = 0; s + 1 < cuts.size(); ++s) {
+      const double c0 = component(curve.position(cuts[s]), outer);
+      const double c1 = component(curve.position(cuts[s + 1]), outer);
+      parts.push_back({cuts[s], cuts[s + 1], std::min(c0, c1), std::max(c0, c1)});
+      breaks.push_back(c0);
+      breaks.push_back(c1);
+    }
+  }
+  return parts;
+}
+
+}  // namespace
+
 void CurveGridIntersection::cut_cell_rule(const CutCell& cell, int q, std::vector<QuadraturePoint>& out) const {
   const double h = grid_.h();
   const double lo[2] = {grid_.x(cell.ix), grid_.y(cell.iy)};
@@ -194,39 +237,8 @@ void CurveGridIntersection::cut_cell_rule(const CutCell& cell, int q, std::vecto
   const int outer = extent[0] >= extent[1] ? 0 : 1, inner = 1 - outer;
 
   // Split the pieces where the outer coordinate turns, so that each part is monotone.
-  struct Monotone {
-    double t0, t1, c_min, c_max;
-  };
-  std::vector<Monotone> parts;
   std::vector<double> breaks = {lo[outer], hi[outer]};
-  for (int k : cell.pieces) {
-    const CurvePiece& piece = pieces_[k];
-    std::vector<double> cuts = {piece.t0};
-    constexpr int probes = 8;
-    double prev_t = piece.t0, prev_d = component(curve_.derivative(prev_t), outer);
-    for (int s = 1; s <= probes; ++s) {
-      const double t = piece.t0 + (piece.t1 - piece.t0) * s / probes;
-      const double d = component(curve_.derivative(t), outer);
-      if ((d > 0) != (prev_d > 0) && d != 0.0 && prev_d != 0.0) {
-        double a = prev_t, b = t, da = prev_d;
-        for (int it = 0; it < 60; ++it) {
-          const double m = 0.5 * (a + b), dm = component(curve_.derivative(m), outer);
-          if ((dm > 0) == (da > 0)) a = m, da = dm; else b = m;
-        }
-        cuts.push_back(0.5 * (a + b));
-      }
-      prev_t = t;
-      prev_d = d;
-    }
-    cuts.push_back(piece.t1);
-    for (std::size_t s = 0; s + 1 < cuts.size(); ++s) {
-      const double c0 = component(curve_.position(cuts[s]), outer);
-      const double c1 = component(curve_.position(cuts[s + 1]), outer);
-      parts.push_back({cuts[s], cuts[s + 1], std::min(c0, c1), std::max(c0, c1)});
-      breaks.push_back(c0);
-      breaks.push_back(c1);
-    }
-  }
+  const std::vector<MonotonePart> parts = monotone_parts(curve_, pieces_, cell, outer, breaks);
   for (double& b : breaks) b = std::clamp(b, lo[outer], hi[outer]);
   std::sort(breaks.begin(), breaks.end());
 
@@ -247,7 +259,7 @@ void CurveGridIntersection::cut_cell_rule(const CutCell& cell, int q, std::vecto
     for (std::size_t g = 0; g < outer_rule.nodes.size(); ++g) {
       const double xi = a + outer_rule.nodes[g] * (b - a), w_outer = outer_rule.weights[g] * (b - a);
       hits.clear();
-      for (const Monotone& part : parts) {
+      for (const MonotonePart& part : parts) {
         if (!(xi > part.c_min && xi < part.c_max)) continue;
         const double t = find_parameter(curve_, outer, xi, part.t0, part.t1);
         hits.push_back({component(curve_.position(t), inner), component(curve_.outward_normal(t), inner)});

@@ -199,6 +199,29 @@ struct RowEntry {
   double value;
 };
 
+/// Rows r_j (one per arc) from the per-cell entries: merged per (arc, node) in cell order (the same
+/// for any thread count), boundary nodes of the box dropped.
+SparseRows merge_rows(const std::vector<std::vector<RowEntry>>& by_cell, int m, const Grid2& grid) {
+  std::vector<RowEntry> entries;
+  for (const auto& cell_entries : by_cell) entries.insert(entries.end(), cell_entries.begin(), cell_entries.end());
+  std::stable_sort(entries.begin(), entries.end(), [&](const RowEntry& a, const RowEntry& b) {
+    return std::tie(a.arc, a.j, a.i) < std::tie(b.arc, b.j, b.i);
+  });
+  SparseRows rows;
+  std::size_t e = 0;
+  for (int arc = 0; arc < m; ++arc) {
+    for (; e < entries.size() && entries[e].arc == arc;) {
+      const RowEntry first = entries[e];
+      double value = 0.0;
+      for (; e < entries.size() && entries[e].arc == arc && entries[e].i == first.i && entries[e].j == first.j; ++e)
+        value += entries[e].value;
+      if (grid.has_unknown(first.i, first.j)) rows.entries.push_back({grid.index(first.i, first.j), first.i, first.j, value});
+    }
+    rows.row_begin.push_back(rows.entries.size());
+  }
+  return rows;
+}
+
 }  // namespace
 
 SparseRows add_rows(const SparseRows& a, const SparseRows& b) {
@@ -233,6 +256,8 @@ KinkCorrection& KinkCorrection::operator=(KinkCorrection&&) noexcept = default;
 
 const SparseRows& KinkCorrection::galerkin() const { return state_->galerkin; }
 
+// Steps 1–2 stay together: step 2 is one quadrature loop over the cut cells that shares step 1's
+// band of kink values and nearest points.
 KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Collocation& arcs, double c,
                                const Execution& execution)
     : state_(std::make_unique<State>(gamma, arcs)) {
@@ -315,25 +340,7 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
         for (int k = 0; k < 4; ++k) by_cell[n].push_back({arc, cell.ix + (k & 1), cell.iy + (k >> 1), v[k]});
     }
   }
-
-  // Rows r_j: entries merged per (arc, node), boundary nodes of the box dropped.
-  std::vector<RowEntry> entries;
-  for (const auto& cell_entries : by_cell) entries.insert(entries.end(), cell_entries.begin(), cell_entries.end());
-  std::stable_sort(entries.begin(), entries.end(), [&](const RowEntry& a, const RowEntry& b) {
-    return std::tie(a.arc, a.j, a.i) < std::tie(b.arc, b.j, b.i);
-  });
-  SparseRows& rows = state_->galerkin;
-  std::size_t e = 0;
-  for (int arc = 0; arc < m; ++arc) {
-    for (; e < entries.size() && entries[e].arc == arc;) {
-      const RowEntry first = entries[e];
-      double value = 0.0;
-      for (; e < entries.size() && entries[e].arc == arc && entries[e].i == first.i && entries[e].j == first.j; ++e)
-        value += entries[e].value;
-      if (grid.has_unknown(first.i, first.j)) rows.entries.push_back({grid.index(first.i, first.j), first.i, first.j, value});
-    }
-    rows.row_begin.push_back(rows.entries.size());
-  }
+  state_->galerkin = merge_rows(by_cell, m, grid);
 }
 
 void KinkCorrection::add_kinks(const std::vector<double>& lambda, GridVector& u) const {
