@@ -7,9 +7,9 @@ LEVELS ?= 7-12
 DEBIAN_PACKAGES = cmake g++ make pkg-config libfftw3-dev libeigen3-dev libcli11-dev \
                   nlohmann-json3-dev libfmt-dev libgtest-dev libbenchmark-dev \
                   libmuparser-dev libtomlplusplus-dev python3 python3-dev python3-numpy python3-matplotlib \
-                  python3-vtk9 python3-pytest pybind11-dev
+                  python3-vtk9 python3-pytest pybind11-dev clang-format
 
-.PHONY: deps configure build run test bench references manufactured clean
+.PHONY: deps configure build run test bench references manufactured format clean
 
 deps:
 	@missing=""; for p in $(DEBIAN_PACKAGES); do \
@@ -44,6 +44,11 @@ manufactured:
 	@dpkg -s python3-sympy >/dev/null 2>&1 || { SUDO=""; [ "$$(id -u)" -eq 0 ] || SUDO=sudo; \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq python3-sympy; }
 	/usr/bin/python3 tests/convergence/manufactured.py
+
+# Rewrite every C++ file in the project's style (.clang-format); the ctest style.clang_format checks it.
+FORMAT_FILES = $(shell find src include apps python tests bench -name '*.[ch]pp' ! -name manufactured_solutions.hpp)
+format:
+	clang-format -i $(FORMAT_FILES)
 
 clean:
 	rm -rf $(BUILD_DIR)

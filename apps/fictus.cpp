@@ -2,29 +2,29 @@
 // the library.
 #include <CLI/CLI.hpp>
 
-#include <cstdio>
-#include <cstdlib>
-#include <functional>
-#include <filesystem>
-#include <iostream>
-#include <regex>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <regex>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "fictus/convergence_table.hpp"
 #include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/paper_problem.hpp"
+#include "fictus/io/problem_file.hpp"
 #include "fictus/io/process.hpp"
 #include "fictus/options.hpp"
-#include "fictus/io/problem_file.hpp"
+#include "fictus/paper_problem.hpp"
 #include "option_flags.hpp"
 #include "results_io.hpp"
-#include "vtk_io.hpp"
 #include "sweep.hpp"
+#include "vtk_io.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -35,7 +35,8 @@ bool formulation_or_solver(const fictus::OptionSpec& s) { return s.section == "f
 
 void print_summary(const fictus::Solution& s) {
   std::printf("N = %d (h = %.3g), n = %zu nodes, m = %d, variant %s, inner solver %s\n", s.grid.nx(), s.grid.h(),
-              s.grid.n_nodes(), s.collocation.m, fictus::to_string(s.options.variant), fictus::to_string(s.options.inner));
+              s.grid.n_nodes(), s.collocation.m, fictus::to_string(s.options.variant),
+              fictus::to_string(s.options.inner));
   std::printf("Newton: %d steps, %s, %ld active of %d; fast solves %zu, Krylov iterations %d\n", s.newton.iterations,
               s.newton.converged ? "converged" : "NOT converged",
               long(std::count(s.newton.active.begin(), s.newton.active.end(), 1)), s.collocation.m, s.fast_solves,
@@ -44,10 +45,10 @@ void print_summary(const fictus::Solution& s) {
   std::printf("Signorini checks: min gap %.2e, min du/dn %.2e, max |complementarity| %.2e\n", s.signorini.min_gap,
               s.signorini.min_normal_derivative, s.signorini.max_complementarity);
   if (s.check)
-    std::printf("  with an independent du/dn (%s): min du/dn %.2e, max |complementarity| %.2e, "
-                "max |difference| %.2e\n",
-                s.check->rule.c_str(), s.check->min_normal_derivative, s.check->max_complementarity,
-                s.check->max_difference);
+    std::printf(
+        "  with an independent du/dn (%s): min du/dn %.2e, max |complementarity| %.2e, "
+        "max |difference| %.2e\n",
+        s.check->rule.c_str(), s.check->min_normal_derivative, s.check->max_complementarity, s.check->max_difference);
   if (s.errors)
     std::printf("relative errors: L2(omega) %.3e, H1(omega) %.3e (semi %.3e), L2(gamma) %.3e\n", s.errors->rel_l2_omega,
                 s.errors->rel_h1_omega, s.errors->rel_h1semi_omega, s.errors->rel_l2_gamma);
@@ -86,7 +87,8 @@ int run_solve(const std::string& problem_path, const fictus::cli::OptionFlags& f
     for (const std::string& f : files)
       if (std::find(fictus::output_file_names().begin(), fictus::output_file_names().end(), f) ==
           fictus::output_file_names().end())
-        throw std::invalid_argument("output.files: unknown file \"" + f + "\" (results.json, points.csv, solution.vti, curves.vtp)");
+        throw std::invalid_argument("output.files: unknown file \"" + f +
+                                    "\" (results.json, points.csv, solution.vti, curves.vtp)");
     spec.output.files = files;
   }
   for (const std::string& w : spec.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
@@ -105,7 +107,8 @@ int run_solve(const std::string& problem_path, const fictus::cli::OptionFlags& f
       else if (name == "points.csv")
         fictus::cli::write_atomically(dir / name, fictus::cli::points_csv(solution));
       else if (name == "solution.vti")
-        fictus::cli::write_atomically(dir / name, [&](std::ostream& out) { fictus::cli::write_vti(out, problem, solution); });
+        fictus::cli::write_atomically(dir / name,
+                                      [&](std::ostream& out) { fictus::cli::write_vti(out, problem, solution); });
       else if (name == "curves.vtp")
         fictus::cli::write_atomically(dir / name, [&](std::ostream& out) { fictus::cli::write_vtp(out, solution); });
     }
@@ -165,8 +168,11 @@ int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out,
     std::printf("%s\n", fictus::format_convergence_table(title, rows, variant).c_str());
     json rates = json::array();
     for (const auto& r : fictus::observed_rates(rows)) rates.push_back(r);
-    json out{{"table", number}, {"variant", fictus::to_string(variant)}, {"levels", levels},
-             {"observed_rates", rates}, {"fitted_rates", fictus::fitted_rates(rows)},
+    json out{{"table", number},
+             {"variant", fictus::to_string(variant)},
+             {"levels", levels},
+             {"observed_rates", rates},
+             {"fitted_rates", fictus::fitted_rates(rows)},
              {"paper_rates", fictus::paper_rates(variant)}};
     files.emplace_back("table" + std::to_string(number) + ".json", out.dump(2) + "\n");
     files.emplace_back("table" + std::to_string(number) + ".csv", fictus::cli::levels_csv(rows));
@@ -191,17 +197,21 @@ int main(int argc, char** argv) {
   std::vector<std::string> files;
   fictus::cli::OptionFlags solve_flags;
   CLI::App* solve_cmd = app.add_subcommand("solve", "solve a problem file, or the paper's problem without one");
-  solve_cmd->add_option("problem", problem_path, "problem file (TOML, see docs/problem_files.md)")->check(CLI::ExistingFile);
-  CLI::Option* out_option =
-      solve_cmd->add_option("--out", out, "output.dir: folder for the output files (\"\": none)")->capture_default_str();
+  solve_cmd->add_option("problem", problem_path, "problem file (TOML, see docs/problem_files.md)")
+      ->check(CLI::ExistingFile);
+  CLI::Option* out_option = solve_cmd->add_option("--out", out, "output.dir: folder for the output files (\"\": none)")
+                                ->capture_default_str();
   solve_cmd->add_option("--dir", out, "alias of --out")->group("");
   CLI::Option* files_option =
-      solve_cmd->add_option("--files", files, "output.files, comma-separated: results.json,points.csv,solution.vti,curves.vtp")
+      solve_cmd
+          ->add_option("--files", files,
+                       "output.files, comma-separated: results.json,points.csv,solution.vti,curves.vtp")
           ->delimiter(',')
           ->allow_extra_args(false);
-  const std::map<std::string, std::string> paper_note = {
-      {"multipliers", "without a problem file: the paper's m"}, {"offset", "without a problem file: 1 (the paper's δ = L/m)"}};
-  solve_flags.add(*solve_cmd, [](const fictus::OptionSpec&) { return true; }, paper_note);
+  const std::map<std::string, std::string> paper_note = {{"multipliers", "without a problem file: the paper's m"},
+                                                         {"offset", "without a problem file: 1 (the paper's δ = L/m)"}};
+  solve_flags.add(
+      *solve_cmd, [](const fictus::OptionSpec&) { return true; }, paper_note);
 
   std::string plot_dir;
   CLI::App* plot_cmd = app.add_subcommand("plot", "PNG plots of the results in a folder (matplotlib)");
@@ -214,9 +224,11 @@ int main(int argc, char** argv) {
   reproduce_cmd->add_option("--table", table, "1 (non-smooth), 2 (smooth) or both")->capture_default_str();
   reproduce_cmd->add_option("--levels", levels, "levels A-B, h = 2^-level")->capture_default_str();
   reproduce_cmd->add_option("--out", reproduce_out, "write table<k>.json and table<k>.csv here");
-  reproduce_flags.add(*reproduce_cmd, [](const fictus::OptionSpec& s) {
-    return formulation_or_solver(s) && s.key != "variant" && s.key != "multipliers";
-  }, {{"offset", "here: 1 (the paper's δ = L/m)"}});
+  reproduce_flags.add(*reproduce_cmd,
+                      [](const fictus::OptionSpec& s) {
+                        return formulation_or_solver(s) && s.key != "variant" && s.key != "multipliers";
+                      },
+                      {{"offset", "here: 1 (the paper's δ = L/m)"}});
 
   // sweep: the paper's problem on one grid; its m unless --multipliers is given.
   fictus::cli::OptionFlags sweep_flags;
@@ -224,12 +236,14 @@ int main(int argc, char** argv) {
   CLI::App* sweep_cmd = app.add_subcommand(
       "sweep", "solve a family of problems on one grid (paper's problem; g scaled, or the curve rotated or moved)");
   sweep_cmd->add_option("--g-scale", sweep_args.g_scale, "obstacle factors: a,b,c or start:stop:count");
-  sweep_cmd->add_option("--rotate", sweep_args.rotate, "rotations of γ about its center [rad]: a,b,c or start:stop:count");
+  sweep_cmd->add_option("--rotate", sweep_args.rotate,
+                        "rotations of γ about its center [rad]: a,b,c or start:stop:count");
   sweep_cmd->add_option("--move", sweep_args.move, "shifts of γ along x: a,b,c or start:stop:count");
   sweep_cmd->add_flag("--field", sweep_args.field, "also compute the grid field û for every problem");
   sweep_cmd->add_option("--out", sweep_args.out, "write sweep.csv here (\"\": none)")->capture_default_str();
   sweep_flags.add(*sweep_cmd, [](const fictus::OptionSpec& s) { return s.section != "data" && s.key != "box"; },
-                  {{"multipliers", "here: the paper's m"}, {"offset", "here: 1 (the paper's δ = L/m)"},
+                  {{"multipliers", "here: the paper's m"},
+                   {"offset", "here: 1 (the paper's δ = L/m)"},
                    {"condition_number", "here: false"}});
 
   CLI::App* options_cmd = app.add_subcommand("options", "list every option: key, default, allowed values, meaning");

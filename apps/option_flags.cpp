@@ -22,7 +22,8 @@ void OptionFlags::add(CLI::App& command, const std::function<bool(const OptionSp
       flag.options.push_back(command.add_option("--" + alias, text, "alias of --" + spec.key)->group(""));
     flags_.push_back(flag);
     if (spec.key == "condition_number") {
-      no_condition_flag_ = command.add_flag("--no-condition", no_condition_, "same as --condition_number false")->group("");
+      no_condition_flag_ =
+          command.add_flag("--no-condition", no_condition_, "same as --condition_number false")->group("");
     }
   }
 }

@@ -1,10 +1,10 @@
 #include "results_io.hpp"
 
+#include <unistd.h>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
-#include <unistd.h>
 #include <variant>
 
 #include "fictus/options.hpp"
@@ -24,7 +24,7 @@ json options_schema_json() {
   static const char* const types[] = {"boolean", "integer", "number", "choice", "numbers"};
   json list = json::array();
   for (const OptionSpec& spec : option_specs()) {
-    json j{{"section", spec.section}, {"key", spec.key},     {"type", types[int(spec.type)]},
+    json j{{"section", spec.section}, {"key", spec.key},         {"type", types[int(spec.type)]},
            {"rule", spec.rule},       {"meaning", spec.meaning}, {"aliases", spec.aliases}};
     std::visit([&](const auto& v) { j["default"] = v; }, spec.default_value());
     if (spec.type == OptionType::choice) j["choices"] = spec.choices;
@@ -39,21 +39,27 @@ json solution_to_json(const Problem& problem, const Solution& s) {
   j["problem"] = problem.name;
   j["options"] = options_to_json(problem, s.options);
   j["alpha"] = s.alpha;
-  j["grid"] = {{"N", s.grid.nx()}, {"Ny", s.grid.ny()}, {"h", s.grid.h()}, {"n_nodes", s.grid.n_nodes()},
+  j["grid"] = {{"N", s.grid.nx()},
+               {"Ny", s.grid.ny()},
+               {"h", s.grid.h()},
+               {"n_nodes", s.grid.n_nodes()},
                {"n_unknowns", s.grid.n_unknowns()}};
   j["multipliers"] = s.collocation.m;
   j["curve"] = {{"length", s.collocation.length}, {"spacing", s.collocation.spacing}, {"delta", s.delta}};
   json history = json::array();
   for (const NewtonStep& step : s.newton.history)
-    history.push_back({{"n_active", step.n_active}, {"inner_iterations", step.inner_iterations},
-                       {"residual", step.residual}, {"n_changed", step.n_changed}});
+    history.push_back({{"n_active", step.n_active},
+                       {"inner_iterations", step.inner_iterations},
+                       {"residual", step.residual},
+                       {"n_changed", step.n_changed}});
   j["newton"] = {{"iterations", s.newton.iterations},
                  {"converged", s.newton.converged},
                  {"n_active", std::count(s.newton.active.begin(), s.newton.active.end(), 1)},
                  {"residual", s.newton.residual},
                  {"history", history}};
   if (!s.newton.converged) j["newton"]["failure"] = s.newton.failure;
-  j["inner"] = {{"solver", to_string(s.options.inner)}, {"fast_solves", s.fast_solves},
+  j["inner"] = {{"solver", to_string(s.options.inner)},
+                {"fast_solves", s.fast_solves},
                 {"krylov_iterations", s.inner_iterations}};
   json timings;
   for (const auto& [phase, seconds] : s.timings.phases) timings[phase] = seconds;
@@ -71,10 +77,14 @@ json solution_to_json(const Problem& problem, const Solution& s) {
                                {"rms_difference", s.check->rms_difference}};
   if (s.errors) {
     const ErrorNorms& e = *s.errors;
-    j["errors"] = {{"l2_omega", e.l2_omega},         {"h1_omega", e.h1_omega},
-                   {"h1semi_omega", e.h1semi_omega}, {"l2_gamma", e.l2_gamma},
-                   {"rel_l2_omega", e.rel_l2_omega}, {"rel_h1_omega", e.rel_h1_omega},
-                   {"rel_h1semi_omega", e.rel_h1semi_omega}, {"rel_l2_gamma", e.rel_l2_gamma}};
+    j["errors"] = {{"l2_omega", e.l2_omega},
+                   {"h1_omega", e.h1_omega},
+                   {"h1semi_omega", e.h1semi_omega},
+                   {"l2_gamma", e.l2_gamma},
+                   {"rel_l2_omega", e.rel_l2_omega},
+                   {"rel_h1_omega", e.rel_h1_omega},
+                   {"rel_h1semi_omega", e.rel_h1semi_omega},
+                   {"rel_l2_gamma", e.rel_l2_gamma}};
     if (s.point_errors) {
       j["errors"]["max_trace_at_points"] = s.point_errors->max_trace;
       j["errors"]["max_normal_derivative_at_points"] = s.point_errors->max_normal_derivative;

@@ -46,8 +46,10 @@ int run_sweep(const SweepArguments& args, SolverOptions options) {
   const int kinds = !args.g_scale.empty() + !args.rotate.empty() + !args.move.empty();
   if (kinds != 1) throw std::invalid_argument("sweep: give exactly one of --g-scale, --rotate, --move");
   const std::string parameter = !args.g_scale.empty() ? "g_scale" : !args.rotate.empty() ? "rotate" : "move";
-  const std::vector<double> values = parse_values(
-      !args.g_scale.empty() ? args.g_scale : !args.rotate.empty() ? args.rotate : args.move, "--" + parameter);
+  const std::vector<double> values = parse_values(!args.g_scale.empty()  ? args.g_scale
+                                                  : !args.rotate.empty() ? args.rotate
+                                                                         : args.move,
+                                                  "--" + parameter);
 
   const Problem base = paper_problem(args.N, args.c, args.boundary);
   if (options.multipliers == 0) options.multipliers = paper_multipliers(args.N);
@@ -72,8 +74,8 @@ int run_sweep(const SweepArguments& args, SolverOptions options) {
     const long active = std::count(s.newton.active.begin(), s.newton.active.end(), 1);
     std::printf("%-10.4g %5d %8ld %12.3e %12.3e %10.4f%s\n", v, s.newton.iterations, active, s.signorini.min_gap,
                 s.signorini.min_normal_derivative, seconds, s.newton.converged ? "" : "  NOT converged");
-    csv << v << ',' << s.newton.iterations << ',' << s.newton.converged << ',' << active << ',' << s.signorini.min_gap << ','
-        << s.signorini.min_normal_derivative << ',' << s.signorini.max_complementarity << ',' << seconds << '\n';
+    csv << v << ',' << s.newton.iterations << ',' << s.newton.converged << ',' << active << ',' << s.signorini.min_gap
+        << ',' << s.signorini.min_normal_derivative << ',' << s.signorini.max_complementarity << ',' << seconds << '\n';
   }
   const std::size_t n_rest = values.size() - 1;
   std::printf("first problem %.3f s (grid setup included); ", first);

@@ -78,7 +78,8 @@ void write_vtp(std::ostream& out, const Solution& s) {
   const int n_points = two_curves ? 2 * m : m;
   out.precision(17);
   out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\">\n"
-      << "  <PolyData>\n    <Piece NumberOfPoints=\"" << n_points << "\" NumberOfLines=\"" << (two_curves ? 2 : 1) << "\">\n"
+      << "  <PolyData>\n    <Piece NumberOfPoints=\"" << n_points << "\" NumberOfLines=\"" << (two_curves ? 2 : 1)
+      << "\">\n"
       << "      <Points>\n        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
   for (int i = 0; i < m; ++i) out << s.collocation.point[i].x << ' ' << s.collocation.point[i].y << " 0\n";
   if (two_curves)
@@ -110,7 +111,8 @@ void write_vtp(std::ostream& out, const Solution& s) {
   out << "        <DataArray type=\"Int32\" Name=\"curve\" format=\"ascii\">\n";
   for (int c = 0; c < (two_curves ? 2 : 1); ++c)
     for (int i = 0; i < m; ++i) out << c << '\n';
-  out << "        </DataArray>\n        <DataArray type=\"Float64\" Name=\"normal\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  out << "        </DataArray>\n        <DataArray type=\"Float64\" Name=\"normal\" NumberOfComponents=\"3\" "
+         "format=\"ascii\">\n";
   for (int c = 0; c < (two_curves ? 2 : 1); ++c)
     for (int i = 0; i < m; ++i) out << s.collocation.normal[i].x << ' ' << s.collocation.normal[i].y << " 0\n";
   out << "        </DataArray>\n      </PointData>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";

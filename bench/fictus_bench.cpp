@@ -1,7 +1,7 @@
 // fictus benchmark: the paper's problem at h = 1/512 … 1/4096 with both inner solvers, the green
 // path on larger grids, the time of one DST-I of each grid measured in the same run, 1 vs 2
-// threads per phase, parameter sweeps, and the trace rules and m rule compared in one run. Writes a Markdown report (machine, compiler, threads,
-// commit beside every figure). Not part of the test suite: `make bench`.
+// threads per phase, parameter sweeps, and the trace rules and m rule compared in one run. Writes a Markdown report
+// (machine, compiler, threads, commit beside every figure). Not part of the test suite: `make bench`.
 #include <unistd.h>
 
 #include <algorithm>
@@ -76,13 +76,15 @@ Run run(int N, fictus::Variant variant, fictus::InnerSolver inner, int threads,
   o.threads = threads;
   o.condition_number = false;
   o.krylov_tolerance = 1e-12;  // so that both paths give λ to ~1e-9 (cond S up to 1e4)
-  std::fprintf(stderr, "  N = %d, %s, %s, %d thread(s)...\n", N, fictus::to_string(variant), fictus::to_string(inner), threads);
+  std::fprintf(stderr, "  N = %d, %s, %s, %d thread(s)...\n", N, fictus::to_string(variant), fictus::to_string(inner),
+               threads);
   auto s = std::make_unique<fictus::Solution>(fictus::solve(fictus::paper_problem(N), o));
   s->peak_memory_bytes = fictus::peak_memory_bytes();
   return {N, variant, inner, threads, std::move(s)};
 }
 
-const char* phase_names[] = {"load", "u0", "geometry", "green_table", "schur", "newton", "final_solve", "check", "errors"};
+const char* phase_names[] = {"load",   "u0",          "geometry", "green_table", "schur",
+                             "newton", "final_solve", "check",    "errors"};
 
 std::string phase_cells(const fictus::Solution& s) {
   std::string out;
@@ -102,19 +104,26 @@ int main(int argc, char** argv) {
       if (k + 1 >= argc) throw std::runtime_error(a + " needs a value");
       return argv[++k];
     };
-    if (a == "--out") out_dir = next();
-    else if (a == "--max-level") max_level = std::stoi(next());
-    else if (a == "--krylov-max-level") krylov_max_level = std::stoi(next());
-    else if (a == "--threads") threads = std::stoi(next());
-    else if (a == "--sections") sections = next();
+    if (a == "--out")
+      out_dir = next();
+    else if (a == "--max-level")
+      max_level = std::stoi(next());
+    else if (a == "--krylov-max-level")
+      krylov_max_level = std::stoi(next());
+    else if (a == "--threads")
+      threads = std::stoi(next());
+    else if (a == "--sections")
+      sections = next();
     else {
-      std::fprintf(stderr, "usage: fictus_bench [--out DIR] [--max-level 14] [--krylov-max-level 12] [--threads 2] "
-                           "[--sections all|traces]\n");
+      std::fprintf(stderr,
+                   "usage: fictus_bench [--out DIR] [--max-level 14] [--krylov-max-level 12] [--threads 2] "
+                   "[--sections all|traces]\n");
       return 1;
     }
   }
-  const std::string machine = format("%s, %ld cores, %.0f GiB", command_output("sed -n 's/^model name\\s*: //p' /proc/cpuinfo | head -1").c_str(),
-                                     sysconf(_SC_NPROCESSORS_ONLN), sysconf(_SC_PHYS_PAGES) * double(sysconf(_SC_PAGESIZE)) / (1 << 30));
+  const std::string machine = format(
+      "%s, %ld cores, %.0f GiB", command_output("sed -n 's/^model name\\s*: //p' /proc/cpuinfo | head -1").c_str(),
+      sysconf(_SC_NPROCESSORS_ONLN), sysconf(_SC_PHYS_PAGES) * double(sysconf(_SC_PAGESIZE)) / (1 << 30));
   const std::string commit = command_output("git rev-parse --short HEAD 2>/dev/null");
   const std::string compiler = std::string("g++ ") + __VERSION__ + " -O3 (Release)";
   char date[32];
@@ -141,12 +150,13 @@ int main(int argc, char** argv) {
       for (int config = 0; config < 3; ++config) {
         const auto traces = config == 0 ? fictus::NormalDerivative::shifted : fictus::NormalDerivative::reconstructed;
         std::vector<Run> repeats;
-        for (int r = 0; r < 3; ++r) repeats.push_back(run(N, v, fictus::InnerSolver::green, threads, traces, config == 2));
+        for (int r = 0; r < 3; ++r)
+          repeats.push_back(run(N, v, fictus::InnerSolver::green, threads, traces, config == 2));
         std::sort(repeats.begin(), repeats.end(),
                   [](const Run& a, const Run& b) { return a.solution->timings.total < b.solution->timings.total; });
         const fictus::Solution& s = *repeats[1].solution;
-        md << format("| 1/%d | %s | %s | %d%s | %.3f |", N, fictus::to_string(v), fictus::to_string(traces), s.collocation.m,
-                     config == 2 ? " (default)" : " (paper)", s.timings.total)
+        md << format("| 1/%d | %s | %s | %d%s | %.3f |", N, fictus::to_string(v), fictus::to_string(traces),
+                     s.collocation.m, config == 2 ? " (default)" : " (paper)", s.timings.total)
            << phase_cells(s) << format(" %.3e |\n", s.errors->rel_l2_omega);
       }
   }
@@ -158,7 +168,7 @@ int main(int argc, char** argv) {
 
   // 1. Both variants, both inner solvers, with the DST-I reference of each grid.
   md << "## End to end, both inner solvers\n\n"
-     << "| h | variant | inner | it0/it1 | total | DST-I | total / DST-I |" ;
+     << "| h | variant | inner | it0/it1 | total | DST-I | total / DST-I |";
   for (const char* p : phase_names) md << ' ' << p << " |";
   md << " rel L2(w) | peak MiB |\n|---|---|---|---|---|---|---|";
   for (std::size_t k = 0; k < std::size(phase_names); ++k) md << "---|";
@@ -174,15 +184,17 @@ int main(int argc, char** argv) {
         if (inner == fictus::InnerSolver::krylov && level > krylov_max_level) continue;
         runs.push_back(run(N, v, inner, threads));
         const fictus::Solution& s = *runs.back().solution;
-        md << format("| 1/%d | %s | %s | %d/%zu | %.3f | %.3f | %.1f |", N, fictus::to_string(v), fictus::to_string(inner),
-                     s.newton.iterations, s.fast_solves, s.timings.total, dst_time[N], s.timings.total / dst_time[N])
+        md << format("| 1/%d | %s | %s | %d/%zu | %.3f | %.3f | %.1f |", N, fictus::to_string(v),
+                     fictus::to_string(inner), s.newton.iterations, s.fast_solves, s.timings.total, dst_time[N],
+                     s.timings.total / dst_time[N])
            << phase_cells(s) << format(" %.3e | %.0f |\n", s.errors->rel_l2_omega, s.peak_memory_bytes / 1048576.0);
         md.flush();
       }
     }
   }
   // 2. Green against Krylov: speed and agreement.
-  md << "\n## green vs krylov (same run)\n\n| h | variant | time green | time krylov | speed-up | max rel diff of λ | active sets |\n|---|---|---|---|---|---|---|\n";
+  md << "\n## green vs krylov (same run)\n\n| h | variant | time green | time krylov | speed-up | max rel diff of λ | "
+        "active sets |\n|---|---|---|---|---|---|---|\n";
   for (const Run& a : runs) {
     if (a.inner != fictus::InnerSolver::green) continue;
     for (const Run& b : runs) {
@@ -194,8 +206,9 @@ int main(int argc, char** argv) {
         diff = std::max(diff, std::abs(la[i] - lb[i]));
         scale = std::max(scale, std::abs(la[i]));
       }
-      md << format("| 1/%d | %s | %.3f | %.3f | %.0fx | %.1e | %s |\n", a.N, fictus::to_string(a.variant), a.solution->timings.total,
-                   b.solution->timings.total, b.solution->timings.total / a.solution->timings.total, diff / scale,
+      md << format("| 1/%d | %s | %.3f | %.3f | %.0fx | %.1e | %s |\n", a.N, fictus::to_string(a.variant),
+                   a.solution->timings.total, b.solution->timings.total,
+                   b.solution->timings.total / a.solution->timings.total, diff / scale,
                    a.solution->newton.active == b.solution->newton.active ? "identical" : "DIFFERENT");
     }
   }
@@ -207,7 +220,8 @@ int main(int argc, char** argv) {
   md << "\n";
   Run one = run(4096, fictus::Variant::smooth, fictus::InnerSolver::green, 1);
   Run two = run(4096, fictus::Variant::smooth, fictus::InnerSolver::green, 2);
-  for (const Run* r : {&one, &two}) md << format("| %d | %.3f |", r->threads, r->solution->timings.total) << phase_cells(*r->solution) << "\n";
+  for (const Run* r : {&one, &two})
+    md << format("| %d | %.3f |", r->threads, r->solution->timings.total) << phase_cells(*r->solution) << "\n";
   md << "| speed-up | " << format("%.2f", one.solution->timings.total / two.solution->timings.total) << " |";
   for (const char* p : phase_names) {
     const double a = one.solution->timings[p], b = two.solution->timings[p];
@@ -215,7 +229,8 @@ int main(int argc, char** argv) {
   }
   md << "\n";
   // 4. Sweeps at h = 1/1024 on one solver: 100 obstacles (boundary quantities only), 20 rotations.
-  md << "\n## Sweeps on one grid, h = 1/1024, smooth, green, boundary quantities only\n\n| sweep | problems | first [s] | per problem after the first [s] | problems per second |\n|---|---|---|---|---|\n";
+  md << "\n## Sweeps on one grid, h = 1/1024, smooth, green, boundary quantities only\n\n| sweep | problems | first "
+        "[s] | per problem after the first [s] | problems per second |\n|---|---|---|---|---|\n";
   for (const std::string kind : {"100 obstacles g·s, s ∈ [0.5, 1.5]", "20 rotations of γ, [0, 0.5] rad"}) {
     const bool obstacles = kind[0] == '1';
     const int count = obstacles ? 100 : 20;
@@ -228,14 +243,17 @@ int main(int argc, char** argv) {
     for (int k = 0; k < count; ++k) {
       fictus::Problem p = base;
       const double v = obstacles ? 0.5 + k / 99.0 : 0.5 * k / 19.0;
-      if (obstacles) p.g = [g = base.g, v](double x, double y) { return v * g(x, y); };
-      else p.gamma = std::make_shared<fictus::TransformedCurve>(base.gamma, v, fictus::Point2{0, 0});
+      if (obstacles)
+        p.g = [g = base.g, v](double x, double y) { return v * g(x, y); };
+      else
+        p.gamma = std::make_shared<fictus::TransformedCurve>(base.gamma, v, fictus::Point2{0, 0});
       const auto t = Clock::now();
       const fictus::Solution s = solver.solve(p, o, false);
       (k == 0 ? first : rest) += since(t);
       if (!s.newton.converged) std::fprintf(stderr, "sweep: not converged at %g\n", v);
     }
-    md << format("| %s | %d | %.3f | %.4f | %.1f |\n", kind.c_str(), count, first, rest / (count - 1), (count - 1) / rest);
+    md << format("| %s | %d | %.3f | %.4f | %.1f |\n", kind.c_str(), count, first, rest / (count - 1),
+                 (count - 1) / rest);
   }
   std::filesystem::create_directories(out_dir);
   const std::string path = out_dir + "/" + date + "-" + command_output("hostname") + ".md";

@@ -61,18 +61,23 @@ int main(int argc, char** argv) {
   bool before_after = false;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
-    if (a == "--before-after") before_after = true;
-    else if (a == "--out" && k + 1 < argc) out_path = argv[++k];
-    else if (a == "--levels" && k + 1 < argc) std::sscanf(argv[++k], "%d-%d", &first, &last);
+    if (a == "--before-after")
+      before_after = true;
+    else if (a == "--out" && k + 1 < argc)
+      out_path = argv[++k];
+    else if (a == "--levels" && k + 1 < argc)
+      std::sscanf(argv[++k], "%d-%d", &first, &last);
   }
   const std::string source = FICTUS_SOURCE_DIR;
   std::vector<reference::Reference> refs;
-  for (const char* name : {"ellipse", "star", "peanut"}) refs.push_back(reference::load(source + "/tests/references", name));
+  for (const char* name : {"ellipse", "star", "peanut"})
+    refs.push_back(reference::load(source + "/tests/references", name));
 
   std::ostringstream report;
   if (before_after) {
     report << "# Before and after: earlier defaults (shifted C_γ, m ∝ N^0.85, δ = s) vs current (reconstructed "
-              "traces, s = 8h smooth / 12h non-smooth, δ = 1.5s)\n\nRelative errors; contact ends: largest distance of a reference end "
+              "traces, s = 8h smooth / 12h non-smooth, δ = 1.5s)\n\nRelative errors; contact ends: largest distance of "
+              "a reference end "
               "to fictus's, in spacings s.\n";
     for (int p = 0; p < 6; ++p)
       for (const fictus::Variant variant : {fictus::Variant::smooth, fictus::Variant::nonsmooth})
@@ -116,18 +121,21 @@ int main(int argc, char** argv) {
           report << "\n### " << name << ", " << fictus::to_string(variant) << ", " << (after ? "current" : "earlier")
                  << "\n\n| N | m | Newton | L²(ω) | H¹(ω) | L²(γ) | ends/s |\n|---|---|---|---|---|---|---|\n"
                  << lines << format("| rates | | | %.2f | %.2f | %.2f | |\n", fit[0], fit[1], fit[2]);
-          std::cerr << name << ' ' << fictus::to_string(variant) << (after ? " current" : " earlier") << format(" rates %.2f %.2f %.2f", fit[0], fit[1], fit[2]) << std::endl;
+          std::cerr << name << ' ' << fictus::to_string(variant) << (after ? " current" : " earlier")
+                    << format(" rates %.2f %.2f %.2f", fit[0], fit[1], fit[2]) << std::endl;
         }
-    if (out_path.empty()) std::cout << report.str();
-    else std::ofstream(out_path) << report.str();
+    if (out_path.empty())
+      std::cout << report.str();
+    else
+      std::ofstream(out_path) << report.str();
     return 0;
   }
   report << "# Spacing study (bench/spacing_study.cpp)\n\n"
          << "Relative L²(ω) errors at N = 2^" << first << " … 2^" << last
          << ", least-squares rate, cond(S) and the largest contact-end error (in spacings) at the finest level.\n\n";
   for (const fictus::Variant variant : {fictus::Variant::smooth, fictus::Variant::nonsmooth}) {
-    const std::vector<double> offsets = variant == fictus::Variant::smooth ? std::vector<double>{1.0, 1.5, 2.0}
-                                                                           : std::vector<double>{1.0};
+    const std::vector<double> offsets =
+        variant == fictus::Variant::smooth ? std::vector<double>{1.0, 1.5, 2.0} : std::vector<double>{1.0};
     report << "## " << fictus::to_string(variant) << " variant\n\n"
            << "| problem | s/h | δ/s | errors | rate | cond | Newton | ends/s |\n|---|---|---|---|---|---|---|---|\n";
     for (int p = 0; p < 6; ++p) {
@@ -160,8 +168,15 @@ int main(int argc, char** argv) {
                 row = cmp.level;
                 end_error = cmp.end_error_spacings;
               } else {
-                row = {N, 0, s.collocation.m, s.newton.iterations, s.fast_solves, 0, s.errors->rel_l2_omega,
-                       s.errors->rel_h1_omega, s.errors->rel_l2_gamma};
+                row = {N,
+                       0,
+                       s.collocation.m,
+                       s.newton.iterations,
+                       s.fast_solves,
+                       0,
+                       s.errors->rel_l2_omega,
+                       s.errors->rel_h1_omega,
+                       s.errors->rel_l2_gamma};
               }
               rows.push_back(row);
               errors += format("%s%.2e", errors.empty() ? "" : ", ", row.l2_omega);

@@ -15,9 +15,9 @@
 
 #include "bindings.hpp"
 #include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/io/problem_file.hpp"
 #include "fictus/options.hpp"
 #include "fictus/paper_problem.hpp"
-#include "fictus/io/problem_file.hpp"
 #include "python_problem.hpp"
 
 namespace py = pybind11;
@@ -46,19 +46,25 @@ toml::array to_array(py::handle list, const std::string& where) {
 }
 
 void insert(toml::table& table, const std::string& key, py::handle value, const std::string& where) {
-  if (py::isinstance<py::bool_>(value)) table.insert_or_assign(key, value.cast<bool>());
-  else if (py::isinstance<py::int_>(value)) table.insert_or_assign(key, value.cast<int64_t>());
-  else if (py::isinstance<py::float_>(value)) table.insert_or_assign(key, value.cast<double>());
-  else if (py::isinstance<py::str>(value)) table.insert_or_assign(key, value.cast<std::string>());
+  if (py::isinstance<py::bool_>(value))
+    table.insert_or_assign(key, value.cast<bool>());
+  else if (py::isinstance<py::int_>(value))
+    table.insert_or_assign(key, value.cast<int64_t>());
+  else if (py::isinstance<py::float_>(value))
+    table.insert_or_assign(key, value.cast<double>());
+  else if (py::isinstance<py::str>(value))
+    table.insert_or_assign(key, value.cast<std::string>());
   else if (py::isinstance<py::dict>(value)) {
     toml::table sub;
     for (auto [k, v] : value.cast<py::dict>()) insert(sub, py::str(k), v, where + "." + std::string(py::str(k)));
     table.insert_or_assign(key, std::move(sub));
   } else if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value) || py::isinstance<py::array>(value)) {
-    const py::object items = py::isinstance<py::array>(value) ? value.attr("tolist")() : py::reinterpret_borrow<py::object>(value);
+    const py::object items =
+        py::isinstance<py::array>(value) ? value.attr("tolist")() : py::reinterpret_borrow<py::object>(value);
     table.insert_or_assign(key, to_array(items, where));
   } else {
-    throw std::invalid_argument(where + ": unsupported value of type " + std::string(py::str(value.get_type().attr("__name__"))));
+    throw std::invalid_argument(where + ": unsupported value of type " +
+                                std::string(py::str(value.get_type().attr("__name__"))));
   }
 }
 
@@ -101,7 +107,8 @@ PyProblem PyProblem::from_config(py::dict config) {
   };
   for (auto [k, v] : config) {
     const std::string key = py::str(k);
-    if (key == "domain" || key == "geometry" || key == "formulation" || key == "data" || key == "solver" || key == "output") {
+    if (key == "domain" || key == "geometry" || key == "formulation" || key == "data" || key == "solver" ||
+        key == "output") {
       if (!py::isinstance<py::dict>(v)) throw std::invalid_argument(key + ": expected a dict");
       py::dict target = section(key);
       for (auto [kk, vv] : v.cast<py::dict>()) target[kk] = vv;
@@ -146,14 +153,15 @@ PyProblem PyProblem::paper(int N, double c, const std::string& boundary, py::dic
   // Options through the same reader: a minimal file around them.
   if (!options.empty()) {
     py::dict config;
-    config["geometry"] = py::dict(py::arg("shape") = "circle", py::arg("center") = py::make_tuple(0.5, 0.5),
-                                  py::arg("radius") = 0.25);
+    config["geometry"] =
+        py::dict(py::arg("shape") = "circle", py::arg("center") = py::make_tuple(0.5, 0.5), py::arg("radius") = 0.25);
     config["data"] = py::dict(py::arg("f") = "0", py::arg("g") = "0");
     for (auto [k, v] : options) {
       const std::string key = py::str(k);
       const char* section = section_of(key);
       if (!section || std::string(section) == "domain" || std::string(section) == "data")
-        throw std::invalid_argument(key + ": not an option of the paper's problem (use Problem(...) for data and domain)");
+        throw std::invalid_argument(key +
+                                    ": not an option of the paper's problem (use Problem(...) for data and domain)");
       if (!config.contains(section)) config[section] = py::dict();
       config[section][py::str(key)] = v;
     }
@@ -177,20 +185,23 @@ void bind_problem(py::module_& m) {
     Problem.from_dict(d), Problem.from_toml(text), Problem.paper(N=256, c=1.0, boundary="dirichlet", **options)
 )doc")
       .def(py::init([](py::kwargs kwargs) { return PyProblem::from_config(kwargs); }))
-      .def_static("from_dict", [](py::dict d) { return PyProblem::from_config(d); }, py::arg("config"))
-      .def_static("from_toml",
-                  [](const std::string& text) {
-                    PyProblem p;
-                    p.spec = parse_problem_text(text, "problem");
-                    return p;
-                  },
-                  py::arg("text"))
-      .def_static("paper",
-                  [](int N, double c, const std::string& boundary, py::kwargs options) {
-                    return PyProblem::paper(N, c, boundary, options);
-                  },
-                  py::arg("N") = Problem{}.N, py::arg("c") = Problem{}.c,
-                  py::arg("boundary") = std::string(to_string(Problem{}.boundary)))
+      .def_static(
+          "from_dict", [](py::dict d) { return PyProblem::from_config(d); }, py::arg("config"))
+      .def_static(
+          "from_toml",
+          [](const std::string& text) {
+            PyProblem p;
+            p.spec = parse_problem_text(text, "problem");
+            return p;
+          },
+          py::arg("text"))
+      .def_static(
+          "paper",
+          [](int N, double c, const std::string& boundary, py::kwargs options) {
+            return PyProblem::paper(N, c, boundary, options);
+          },
+          py::arg("N") = Problem{}.N, py::arg("c") = Problem{}.c,
+          py::arg("boundary") = std::string(to_string(Problem{}.boundary)))
       .def_property_readonly("N", [](const PyProblem& p) { return p.spec.problem.N; })
       .def_property_readonly("warnings", [](const PyProblem& p) { return p.spec.warnings; })
       .def("solve", &PyProblem::solve, py::arg("field") = true,

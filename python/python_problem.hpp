@@ -12,7 +12,6 @@
 
 namespace fictus::python {
 
-
 /// Errors raised inside Python callables while the solver ran (they cannot cross its threads).
 struct CallbackErrors {
   std::mutex mutex;

@@ -9,9 +9,9 @@
 #include <stdexcept>
 
 #include "bindings.hpp"
+#include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/io/process.hpp"
 #include "fictus/options.hpp"
-#include "fictus/fictitious_domain_solver.hpp"
 #include "python_problem.hpp"
 
 namespace py = pybind11;
@@ -94,19 +94,23 @@ void bind_solution(py::module_& m) {
                                for (int j = 0; j <= g.ny(); ++j) y.mutable_data()[j] = g.y(j);
                                return y;
                              })
-      .def_property_readonly("points", [](py::object self) { return pairs_view(self.cast<const PySolution&>().points(), self); })
+      .def_property_readonly("points",
+                             [](py::object self) { return pairs_view(self.cast<const PySolution&>().points(), self); })
       .def_property_readonly("normals",
                              [](py::object self) { return pairs_view(self.cast<const PySolution&>().normals(), self); })
-      .def_property_readonly("s", [](py::object self) { return view(self.cast<const PySolution&>().s().collocation.s, self); },
-                             "arc length of each collocation point")
+      .def_property_readonly(
+          "s", [](py::object self) { return view(self.cast<const PySolution&>().s().collocation.s, self); },
+          "arc length of each collocation point")
       .def_property_readonly("g", [](py::object self) { return view(self.cast<const PySolution&>().s().g, self); })
-      .def_property_readonly("u_gamma", [](py::object self) { return view(self.cast<const PySolution&>().s().trace, self); },
-                             "B_γû at the collocation points")
-      .def_property_readonly("dudn",
-                             [](py::object self) { return view(self.cast<const PySolution&>().s().normal_derivative, self); },
-                             "C_γû at the collocation points")
-      .def_property_readonly("lambda_", [](py::object self) { return view(self.cast<const PySolution&>().s().lambda, self); },
-                             "the multipliers (controls on Γ in the smooth variant)")
+      .def_property_readonly(
+          "u_gamma", [](py::object self) { return view(self.cast<const PySolution&>().s().trace, self); },
+          "B_γû at the collocation points")
+      .def_property_readonly(
+          "dudn", [](py::object self) { return view(self.cast<const PySolution&>().s().normal_derivative, self); },
+          "C_γû at the collocation points")
+      .def_property_readonly(
+          "lambda_", [](py::object self) { return view(self.cast<const PySolution&>().s().lambda, self); },
+          "the multipliers (controls on Γ in the smooth variant)")
       .def_property_readonly("contact",
                              [](const PySolution& p) {
                                const auto& c = p.contact_flags();
@@ -114,18 +118,19 @@ void bind_solution(py::module_& m) {
                                for (std::size_t i = 0; i < c.size(); ++i) a.mutable_data()[i] = c[i];
                                return a;
                              })
-      .def_property_readonly("gamma_points",
-                             [](const PySolution& p) {
-                               const Solution& s = p.s();
-                               py::array_t<double> a({py::ssize_t(s.collocation.m), py::ssize_t(2)});
-                               auto r = a.mutable_unchecked<2>();
-                               for (int i = 0; i < s.collocation.m; ++i) {
-                                 const Point2 q = s.Gamma->position(s.collocation.t[i]);
-                                 r(i, 0) = q.x, r(i, 1) = q.y;
-                               }
-                               return a;
-                             },
-                             "the points of Γ carrying λ (= points in the non-smooth variant)")
+      .def_property_readonly(
+          "gamma_points",
+          [](const PySolution& p) {
+            const Solution& s = p.s();
+            py::array_t<double> a({py::ssize_t(s.collocation.m), py::ssize_t(2)});
+            auto r = a.mutable_unchecked<2>();
+            for (int i = 0; i < s.collocation.m; ++i) {
+              const Point2 q = s.Gamma->position(s.collocation.t[i]);
+              r(i, 0) = q.x, r(i, 1) = q.y;
+            }
+            return a;
+          },
+          "the points of Γ carrying λ (= points in the non-smooth variant)")
       .def_property_readonly("iterations", [](const PySolution& p) { return p.s().newton.iterations; })
       .def_property_readonly("converged", [](const PySolution& p) { return p.s().newton.converged; })
       .def_property_readonly("fast_solves", [](const PySolution& p) { return p.s().fast_solves; })
@@ -163,7 +168,8 @@ void bind_solution(py::module_& m) {
                                if (!p.s().errors) return py::none();
                                const ErrorNorms& e = *p.s().errors;
                                py::dict d;
-                               d["l2_omega"] = e.l2_omega, d["h1_omega"] = e.h1_omega, d["h1semi_omega"] = e.h1semi_omega;
+                               d["l2_omega"] = e.l2_omega, d["h1_omega"] = e.h1_omega,
+                               d["h1semi_omega"] = e.h1semi_omega;
                                d["l2_gamma"] = e.l2_gamma, d["rel_l2_omega"] = e.rel_l2_omega;
                                d["rel_h1_omega"] = e.rel_h1_omega, d["rel_h1semi_omega"] = e.rel_h1semi_omega;
                                d["rel_l2_gamma"] = e.rel_l2_gamma;
@@ -184,8 +190,8 @@ void bind_solution(py::module_& m) {
       .def("__repr__", [](const PySolution& p) {
         const Solution& s = p.s();
         return "<fictus.Solution N=" + std::to_string(s.grid.nx()) + " m=" + std::to_string(s.collocation.m) +
-               " newton=" + std::to_string(s.newton.iterations) + " active=" +
-               std::to_string(std::count(s.newton.active.begin(), s.newton.active.end(), 1)) + ">";
+               " newton=" + std::to_string(s.newton.iterations) +
+               " active=" + std::to_string(std::count(s.newton.active.begin(), s.newton.active.end(), 1)) + ">";
       });
 }
 

@@ -44,13 +44,13 @@ std::array<double, 3> fitted_rates(const std::vector<LevelResult>& rows) {
 std::string format_convergence_table(const std::string& title, const std::vector<LevelResult>& rows,
                                      std::optional<Variant> paper_variant) {
   std::string out = title + "\n";
-  out += printf_string("%-7s %-14s | %-9s %9s %9s %9s %9s | %-8s %8s %9s %9s %9s\n", "h", "n/m", "it0/it1",
-                       "time[s]", "L2(w)", "H1(w)", "L2(g)", "paper", "time[s]", "L2(w)", "H1(w)", "L2(g)");
+  out += printf_string("%-7s %-14s | %-9s %9s %9s %9s %9s | %-8s %8s %9s %9s %9s\n", "h", "n/m", "it0/it1", "time[s]",
+                       "L2(w)", "H1(w)", "L2(g)", "paper", "time[s]", "L2(w)", "H1(w)", "L2(g)");
   for (const LevelResult& r : rows) {
     out += printf_string("1/%-5d %-14s | %-9s %9.3f %9.2e %9.2e %9.2e |", r.N,
                          (std::to_string(r.n_nodes) + "/" + std::to_string(r.m)).c_str(),
-                         (std::to_string(r.it0) + "/" + std::to_string(r.it1)).c_str(), r.time, r.l2_omega,
-                         r.h1_omega, r.l2_gamma);
+                         (std::to_string(r.it0) + "/" + std::to_string(r.it1)).c_str(), r.time, r.l2_omega, r.h1_omega,
+                         r.l2_gamma);
     std::optional<PaperRow> p = paper_variant ? paper_row(*paper_variant, r.N) : std::nullopt;
     if (p)
       out += printf_string(" %-8s %8.1f %9.2e %9.2e %9.2e\n",

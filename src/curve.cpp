@@ -29,20 +29,13 @@ Ellipse::Ellipse(Point2 center, double a, double b, double angle)
     throw std::invalid_argument("geometry.semi_axes: must be positive and finite");
 }
 
-Point2 Ellipse::position(double t) const {
-  return center_ + rotate({a_ * std::cos(t), b_ * std::sin(t)});
-}
+Point2 Ellipse::position(double t) const { return center_ + rotate({a_ * std::cos(t), b_ * std::sin(t)}); }
 Point2 Ellipse::derivative(double t) const { return rotate({-a_ * std::sin(t), b_ * std::cos(t)}); }
-Point2 Ellipse::second_derivative(double t) const {
-  return rotate({-a_ * std::cos(t), -b_ * std::sin(t)});
-}
+Point2 Ellipse::second_derivative(double t) const { return rotate({-a_ * std::cos(t), -b_ * std::sin(t)}); }
 
-OffsetCurve::OffsetCurve(std::shared_ptr<const Curve> base, double delta)
-    : base_(std::move(base)), delta_(delta) {}
+OffsetCurve::OffsetCurve(std::shared_ptr<const Curve> base, double delta) : base_(std::move(base)), delta_(delta) {}
 
-Point2 OffsetCurve::position(double t) const {
-  return base_->position(t) + delta_ * base_->outward_normal(t);
-}
+Point2 OffsetCurve::position(double t) const { return base_->position(t) + delta_ * base_->outward_normal(t); }
 
 Point2 OffsetCurve::derivative(double t) const {
   // n = J p'/|p'| with J(x, y) = (y, −x); n' = J (p''/|p'| − p' (p'·p'')/|p'|³).
@@ -75,8 +68,7 @@ double ArcLengthTable::partial(int panel, double t) const {
   const GaussRule& rule = gauss_legendre(12);
   const double t0 = panel * dt_, span = t - t0;
   double sum = 0.0;
-  for (std::size_t g = 0; g < rule.nodes.size(); ++g)
-    sum += rule.weights[g] * curve_.speed(t0 + rule.nodes[g] * span);
+  for (std::size_t g = 0; g < rule.nodes.size(); ++g) sum += rule.weights[g] * curve_.speed(t0 + rule.nodes[g] * span);
   return sum * span;
 }
 
@@ -94,7 +86,10 @@ double ArcLengthTable::t_of_s(double s) const {
   double t = lo + (s - cumulative_[k]) / (cumulative_[k + 1] - cumulative_[k]) * dt_;
   for (int it_count = 0; it_count < 50; ++it_count) {
     const double r = cumulative_[k] + partial(k, t) - s;
-    if (r > 0) hi = t; else lo = t;
+    if (r > 0)
+      hi = t;
+    else
+      lo = t;
     double next = t - r / curve_.speed(t);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
     if (std::abs(next - t) < 1e-15 * two_pi) return next;

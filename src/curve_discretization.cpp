@@ -18,7 +18,8 @@ CurveDiscretization::CurveDiscretization(std::shared_ptr<const Curve> gamma, con
 void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options) {
   const Curve& gamma = *gamma_;
   const double h = grid.h();
-  if (signed_area(gamma) <= 0) throw std::invalid_argument("geometry: the curve must be counter-clockwise (ω on its left)");
+  if (signed_area(gamma) <= 0)
+    throw std::invalid_argument("geometry: the curve must be counter-clockwise (ω on its left)");
   check_simple(gamma, "geometry");
   check_inside_box(gamma, grid.box(), 2 * h, "geometry");
   gamma_geometry_ = std::make_unique<CurveGridIntersection>(gamma, grid, "geometry");
@@ -29,8 +30,8 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
       options.variant == Variant::smooth ? default_spacing_cells_smooth : default_spacing_cells_nonsmooth;
   const int m = options.multipliers == 0 ? default_multipliers(L, h, spacing_cells) : options.multipliers;
   if (m < minimum_multipliers)
-    throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) + " is too small (need m >= " +
-                                std::to_string(minimum_multipliers) + ")");
+    throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) +
+                                " is too small (need m >= " + std::to_string(minimum_multipliers) + ")");
   if (L / m < 2 * h)
     throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) +
                                 " is too large for the grid (spacing L/m = " + std::to_string(L / m) +
@@ -42,8 +43,9 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
     return;
   }
   if (!gamma.smooth())
-    throw std::invalid_argument("formulation.variant: the smooth variant needs a curve with a continuous normal "
-                                "(use \"nonsmooth\" for polygons)");
+    throw std::invalid_argument(
+        "formulation.variant: the smooth variant needs a curve with a continuous normal "
+        "(use \"nonsmooth\" for polygons)");
   delta_ = options.offset * collocation_.spacing;
   // The biquadratic stencil of C_γ reaches 1.5·√2·h ≈ 2.1h from x_i; its nodes must stay out of the
   // cells cut by Γ (which reach 1.4h from Γ), where the kink of û pollutes the nodal values.

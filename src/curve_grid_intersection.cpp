@@ -25,7 +25,10 @@ double find_parameter(const Curve& curve, int axis, double value, double ta, dou
   for (int it = 0; it < 100; ++it) {
     const double f = component(curve.position(t), axis) - value;
     if (f == 0.0) return t;
-    if ((f > 0) == (fa > 0)) lo = t; else hi = t;
+    if ((f > 0) == (fa > 0))
+      lo = t;
+    else
+      hi = t;
     const double df = component(curve.derivative(t), axis);
     double next = df != 0.0 ? t - f / df : 0.5 * (lo + hi);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
@@ -89,8 +92,10 @@ CurveGridIntersection::CurveGridIntersection(const Curve& curve, const Grid2& gr
   row_crossings_.assign(grid.ny() + 1, {});
   col_crossings_.assign(grid.nx() + 1, {});
   for (const Crossing& c : crossings) {
-    if (c.vertical) col_crossings_[c.line].push_back(c.p.y);
-    else row_crossings_[c.line].push_back(c.p.x);
+    if (c.vertical)
+      col_crossings_[c.line].push_back(c.p.y);
+    else
+      row_crossings_[c.line].push_back(c.p.x);
   }
   for (auto& row : row_crossings_) std::sort(row.begin(), row.end());
   for (auto& col : col_crossings_) std::sort(col.begin(), col.end());
@@ -134,10 +139,9 @@ bool CurveGridIntersection::inside_on_column(int i, double y) const {
 }
 
 std::pair<std::size_t, std::size_t> CurveGridIntersection::pieces_in(double ta, double tb) const {
-  const auto first = std::lower_bound(pieces_.begin(), pieces_.end(), ta,
-                                      [](const CurvePiece& p, double t) { return p.t1 <= t; });
-  const auto last = std::lower_bound(first, pieces_.end(), tb,
-                                     [](const CurvePiece& p, double t) { return p.t0 < t; });
+  const auto first =
+      std::lower_bound(pieces_.begin(), pieces_.end(), ta, [](const CurvePiece& p, double t) { return p.t1 <= t; });
+  const auto last = std::lower_bound(first, pieces_.end(), tb, [](const CurvePiece& p, double t) { return p.t0 < t; });
   return {std::size_t(first - pieces_.begin()), std::size_t(last - pieces_.begin())};
 }
 
@@ -201,7 +205,10 @@ std::vector<MonotonePart> monotone_parts(const Curve& curve, const std::vector<C
         double a = prev_t, b = t, da = prev_d;
         for (int it = 0; it < 60; ++it) {
           const double m = 0.5 * (a + b), dm = component(curve.derivative(m), outer);
-          if ((dm > 0) == (da > 0)) a = m, da = dm; else b = m;
+          if ((dm > 0) == (da > 0))
+            a = m, da = dm;
+          else
+            b = m;
         }
         cuts.push_back(0.5 * (a + b));
       }

@@ -38,7 +38,9 @@ class PhaseClock {
  private:
   using Clock = std::chrono::steady_clock;
   static Clock::time_point now() { return Clock::now(); }
-  static double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+  static double seconds(Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double>(b - a).count();
+  }
   Timings& timings_;
   Clock::time_point start_, last_;
 };
@@ -76,8 +78,8 @@ struct CurveSetup {
   SolverOptions options;  // as asked (m = 0 stays 0), so the next request compares equal
   std::unique_ptr<CurveDiscretization> boundary;
   std::unique_ptr<SchurComplement> schur;
-  Eigen::VectorXd b0, c0;             // B_γu₀, C_γu₀
-  std::optional<ConstantMode> mode;   // singular A only
+  Eigen::VectorXd b0, c0;            // B_γu₀, C_γu₀
+  std::optional<ConstantMode> mode;  // singular A only
 };
 
 struct FictitiousDomainSolver::State {
@@ -100,9 +102,18 @@ FictitiousDomainSolver::FictitiousDomainSolver(const Problem& problem, const Sol
   if (!problem.f && !problem.f_vectorized) throw std::invalid_argument("data.f: not given");
   const Grid2 grid(problem.box, problem.N, problem.boundary);
   const Execution execution(options.threads);
-  state_ = std::make_unique<State>(State{grid, problem.c, execution, options.load_quadrature, problem.f,
-                                         problem.f_vectorized, make_fast_solver(grid, problem.c, execution),
-                                         nullptr, {}, false, 0.0, nullptr});
+  state_ = std::make_unique<State>(State{grid,
+                                         problem.c,
+                                         execution,
+                                         options.load_quadrature,
+                                         problem.f,
+                                         problem.f_vectorized,
+                                         make_fast_solver(grid, problem.c, execution),
+                                         nullptr,
+                                         {},
+                                         false,
+                                         0.0,
+                                         nullptr});
 }
 
 FictitiousDomainSolver::~FictitiousDomainSolver() = default;
@@ -168,8 +179,8 @@ const CurveSetup& curve_setup(State& st, const ContactData& data, const SolverOp
   setup->b0 = to_eigen(b0);
   setup->c0 = to_eigen(c0);
   if (st.fast->singular())
-    setup->mode = ConstantMode{row_sums(boundary.B_gamma()), row_sums(boundary.C_gamma()),
-                               row_sums(boundary.B_Gamma()), st.load_total};
+    setup->mode = ConstantMode{row_sums(boundary.B_gamma()), row_sums(boundary.C_gamma()), row_sums(boundary.B_Gamma()),
+                               st.load_total};
   clock.mark("geometry");
   setup->schur = schur_blocks(st, boundary, options, clock);
   st.setup = std::move(setup);
@@ -187,9 +198,12 @@ std::vector<double> obstacle(const ContactData& data, const BoundaryDiscretizati
     data.g_vectorized(m, x.data(), y.data(), g.data());
   }
   for (int i = 0; i < m; ++i) {
-    if (data.g_along_curve) g[i] = data.g_along_curve(p[i].x, p[i].y, boundary.arc_positions()[i]);
-    else if (!data.g_vectorized) g[i] = data.g(p[i].x, p[i].y);
-    if (!std::isfinite(g[i])) throw std::invalid_argument("data.g: not finite at the collocation point " + format_point(p[i]));
+    if (data.g_along_curve)
+      g[i] = data.g_along_curve(p[i].x, p[i].y, boundary.arc_positions()[i]);
+    else if (!data.g_vectorized)
+      g[i] = data.g(p[i].x, p[i].y);
+    if (!std::isfinite(g[i]))
+      throw std::invalid_argument("data.g: not finite at the collocation point " + format_point(p[i]));
   }
   return g;
 }
@@ -302,16 +316,16 @@ Solution FictitiousDomainSolver::solve(const ContactData& data, SolverOptions op
   PhaseClock clock(sol.timings);
   std::size_t fast_solves = 0;
 
-  load_and_u0(st, clock, fast_solves);                                                       // 0
-  const CurveSetup& setup = curve_setup(st, data, options, clock, sol.reused_curve);        // 1–3
+  load_and_u0(st, clock, fast_solves);                                                // 0
+  const CurveSetup& setup = curve_setup(st, data, options, clock, sol.reused_curve);  // 1–3
   const CurveDiscretization& boundary = *setup.boundary;
   sol.collocation = boundary.collocation();
   sol.Gamma = boundary.Gamma();
   sol.delta = boundary.delta();
-  sol.g = obstacle(data, boundary);                                                          // 4
-  newton(setup, options, sol, fast_solves);                                                  // 5
+  sol.g = obstacle(data, boundary);          // 4
+  newton(setup, options, sol, fast_solves);  // 5
   clock.mark("newton");
-  if (compute_field) {                                                                       // 6
+  if (compute_field) {  // 6
     field(st, boundary, sol, fast_solves);
     clock.mark("final_solve");
   } else {
@@ -320,9 +334,9 @@ Solution FictitiousDomainSolver::solve(const ContactData& data, SolverOptions op
                                  sol.newton.normal_derivative.data() + sol.newton.normal_derivative.size());
   }
   sol.fast_solves = fast_solves;
-  signorini_checks(boundary, sol);                                                           // 7
+  signorini_checks(boundary, sol);  // 7
   if (compute_field) clock.mark("check");
-  if ((data.exact || data.exact_vectorized) && compute_field) {                              // 8
+  if ((data.exact || data.exact_vectorized) && compute_field) {  // 8
     sol.point_errors = point_errors(data, boundary, st.grid, sol);
     sol.errors = boundary.errors(sol.u, data, options.error_quadrature, st.execution);
     clock.mark("errors");
@@ -333,7 +347,8 @@ Solution FictitiousDomainSolver::solve(const ContactData& data, SolverOptions op
 }
 
 std::string describe_newton_failure(const Solution& s) {
-  std::string line = "solver.max_newton: Newton did not converge: " + s.newton.failure + "; history (active points, residual):";
+  std::string line =
+      "solver.max_newton: Newton did not converge: " + s.newton.failure + "; history (active points, residual):";
   for (const NewtonStep& step : s.newton.history) {
     char buffer[64];
     std::snprintf(buffer, sizeof buffer, " (%d, %.2e)", step.n_active, step.residual);

@@ -21,14 +21,14 @@ constexpr double two_pi = 2.0 * std::numbers::pi;
 /// The point of the curve nearest to x (Newton on (p(t) − x)·p′(t) = 0 from t0, a few steps:
 /// x is within a cell or two of the curve) and the kink function q(d)⁺ there.
 struct Kink {
-  double t = 0.0;      // parameter of the nearest point, in [0, 2π)
-  double d = 0.0;      // signed distance, > 0 outside ω
-  double kappa = 0.0;  // curvature there
-  Point2 normal;        // outward unit normal there
-  Point2 foot;          // the nearest point itself
-  double q() const { return d - 0.5 * kappa * d * d; }                // ψ outside ω, extended smoothly inside
-  double psi() const { return d > 0 ? q() : 0.0; }                    // q(d)⁺
-  Point2 grad_q() const { return (1.0 - kappa * d) * normal; }          // ∇q (d small)
+  double t = 0.0;                                               // parameter of the nearest point, in [0, 2π)
+  double d = 0.0;                                               // signed distance, > 0 outside ω
+  double kappa = 0.0;                                           // curvature there
+  Point2 normal;                                                // outward unit normal there
+  Point2 foot;                                                  // the nearest point itself
+  double q() const { return d - 0.5 * kappa * d * d; }          // ψ outside ω, extended smoothly inside
+  double psi() const { return d > 0 ? q() : 0.0; }              // q(d)⁺
+  Point2 grad_q() const { return (1.0 - kappa * d) * normal; }  // ∇q (d small)
 };
 
 double wrap(double t) {
@@ -152,8 +152,9 @@ class NodeKinks {
   void build(std::vector<std::pair<std::size_t, int>> nodes, const std::vector<Kink>& centres,
              const std::vector<double>& speeds, const Execution& execution) {
     std::stable_sort(nodes.begin(), nodes.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    nodes.erase(std::unique(nodes.begin(), nodes.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
-                nodes.end());
+    nodes.erase(
+        std::unique(nodes.begin(), nodes.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
+        nodes.end());
     keys_.resize(nodes.size());
     kinks_.resize(nodes.size());
     const std::size_t width = std::size_t(grid_.nx() + 5);
@@ -215,7 +216,8 @@ SparseRows merge_rows(const std::vector<std::vector<RowEntry>>& by_cell, int m, 
       double value = 0.0;
       for (; e < entries.size() && entries[e].arc == arc && entries[e].i == first.i && entries[e].j == first.j; ++e)
         value += entries[e].value;
-      if (grid.has_unknown(first.i, first.j)) rows.entries.push_back({grid.index(first.i, first.j), first.i, first.j, value});
+      if (grid.has_unknown(first.i, first.j))
+        rows.entries.push_back({grid.index(first.i, first.j), first.i, first.j, value});
     }
     rows.row_begin.push_back(rows.entries.size());
   }
@@ -232,8 +234,10 @@ SparseRows add_rows(const SparseRows& a, const SparseRows& b) {
     for (std::size_t k = b.row_begin[r]; k < b.row_begin[r + 1]; ++k) {
       const auto& e = b.entries[k];
       auto same = std::find_if(row.begin(), row.end(), [&](const SparseRows::Entry& x) { return x.index == e.index; });
-      if (same != row.end()) same->value += e.value;
-      else row.push_back(e);
+      if (same != row.end())
+        same->value += e.value;
+      else
+        row.push_back(e);
     }
     out.entries.insert(out.entries.end(), row.begin(), row.end());
     out.row_begin.push_back(out.entries.size());
@@ -242,7 +246,8 @@ SparseRows add_rows(const SparseRows& a, const SparseRows& b) {
 }
 
 struct KinkCorrection::State {
-  State(const CurveGridIntersection& g, const Collocation& a) : gamma(g), arcs(a), arc_of(a), nodes(g.curve(), g.grid()) {}
+  State(const CurveGridIntersection& g, const Collocation& a)
+      : gamma(g), arcs(a), arc_of(a), nodes(g.curve(), g.grid()) {}
   const CurveGridIntersection& gamma;
   const Collocation& arcs;
   ArcIndex arc_of;

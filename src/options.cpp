@@ -28,7 +28,8 @@ std::string format_number(double v) {
 
 std::string quoted_list(const std::vector<std::string>& names) {
   std::string text;
-  for (std::size_t k = 0; k < names.size(); ++k) text += (k ? (k + 1 == names.size() ? " or " : ", ") : "") + ("\"" + names[k] + "\"");
+  for (std::size_t k = 0; k < names.size(); ++k)
+    text += (k ? (k + 1 == names.size() ? " or " : ", ") : "") + ("\"" + names[k] + "\"");
   return text;
 }
 
@@ -42,17 +43,25 @@ OptionSpec member(std::string section, std::string key, OptionType type, T Owner
   spec.meaning = std::move(meaning);
   spec.get = [field](const Problem& p, const SolverOptions& o) -> OptionValue {
     const Owner* owner;
-    if constexpr (std::is_same_v<Owner, Problem>) owner = &p, (void)o;
-    else owner = &o, (void)p;
-    if constexpr (std::is_same_v<T, int>) return std::int64_t(owner->*field);
-    else return owner->*field;
+    if constexpr (std::is_same_v<Owner, Problem>)
+      owner = &p, (void)o;
+    else
+      owner = &o, (void)p;
+    if constexpr (std::is_same_v<T, int>)
+      return std::int64_t(owner->*field);
+    else
+      return owner->*field;
   };
   spec.set = [field](Problem& p, SolverOptions& o, const OptionValue& v) {
     Owner* owner;
-    if constexpr (std::is_same_v<Owner, Problem>) owner = &p, (void)o;
-    else owner = &o, (void)p;
-    if constexpr (std::is_same_v<T, int>) owner->*field = int(std::get<std::int64_t>(v));
-    else owner->*field = std::get<T>(v);
+    if constexpr (std::is_same_v<Owner, Problem>)
+      owner = &p, (void)o;
+    else
+      owner = &o, (void)p;
+    if constexpr (std::is_same_v<T, int>)
+      owner->*field = int(std::get<std::int64_t>(v));
+    else
+      owner->*field = std::get<T>(v);
   };
   return spec;
 }
@@ -63,8 +72,9 @@ OptionSpec integer(std::string section, std::string key, int SolverOptions::*fie
   s.rule = "in " + std::to_string(lo) + " … " + std::to_string(hi);
   s.violation = [lo, hi](const OptionValue& v) {
     const std::int64_t i = std::get<std::int64_t>(v);
-    return i < lo || i > hi ? "must be in " + std::to_string(lo) + " … " + std::to_string(hi) + ", got " + std::to_string(i)
-                            : std::string();
+    return i < lo || i > hi
+               ? "must be in " + std::to_string(lo) + " … " + std::to_string(hi) + ", got " + std::to_string(i)
+               : std::string();
   };
   return s;
 }
@@ -75,8 +85,10 @@ OptionSpec number(std::string section, std::string key, double Owner::*field, do
                   bool open_high, std::string meaning) {
   OptionSpec s = member(std::move(section), std::move(key), OptionType::number, field, std::move(meaning));
   const std::string lo_text = format_number(lo), hi_text = std::isinf(hi) ? "∞" : format_number(hi);
-  if (std::isinf(hi)) s.rule = open_low ? "> " + lo_text : ">= " + lo_text;
-  else s.rule = std::string("in ") + (open_low ? "(" : "[") + lo_text + ", " + hi_text + (open_high ? ")" : "]");
+  if (std::isinf(hi))
+    s.rule = open_low ? "> " + lo_text : ">= " + lo_text;
+  else
+    s.rule = std::string("in ") + (open_low ? "(" : "[") + lo_text + ", " + hi_text + (open_high ? ")" : "]");
   const std::string rule = s.rule;
   s.violation = [=](const OptionValue& v) {
     const double x = std::get<double>(v);
@@ -98,16 +110,20 @@ OptionSpec choice(std::string section, std::string key, Enum Owner::*field, std:
   s.choices = names;
   s.get = [=](const Problem& p, const SolverOptions& o) -> OptionValue {
     Enum e;
-    if constexpr (std::is_same_v<Owner, Problem>) e = p.*field, (void)o;
-    else e = o.*field, (void)p;
+    if constexpr (std::is_same_v<Owner, Problem>)
+      e = p.*field, (void)o;
+    else
+      e = o.*field, (void)p;
     for (std::size_t k = 0; k < values.size(); ++k)
       if (values[k] == e) return names[k];
     return std::string("?");
   };
   s.set = [=](Problem& p, SolverOptions& o, const OptionValue& v) {
     const auto k = std::size_t(std::find(names.begin(), names.end(), std::get<std::string>(v)) - names.begin());
-    if constexpr (std::is_same_v<Owner, Problem>) p.*field = values[k], (void)o;
-    else o.*field = values[k], (void)p;
+    if constexpr (std::is_same_v<Owner, Problem>)
+      p.*field = values[k], (void)o;
+    else
+      o.*field = values[k], (void)p;
   };
   s.violation = [](const OptionValue&) { return std::string(); };  // the names are checked by checked()
   std::vector<std::string> canonical;  // the first name of each value; later ones are other spellings
@@ -156,7 +172,8 @@ std::vector<OptionSpec> make_specs() {
                          "conditions on ∂Ω: u = 0, or periodic (even cell counts; c = 0 allowed)"));
   // [formulation]
   specs.push_back(choice(std::string("formulation"), std::string("variant"), &SolverOptions::variant,
-                         {to_string(Variant::smooth), to_string(Variant::nonsmooth), "non-smooth"}, {Variant::smooth, Variant::nonsmooth, Variant::nonsmooth},
+                         {to_string(Variant::smooth), to_string(Variant::nonsmooth), "non-smooth"},
+                         {Variant::smooth, Variant::nonsmooth, Variant::nonsmooth},
                          "smooth: controls λ on the offset curve Γ outside ω; nonsmooth: multipliers on γ"));
   {
     OptionSpec m = integer("formulation", "multipliers", &SolverOptions::multipliers, 0, 1000000,
@@ -181,10 +198,10 @@ std::vector<OptionSpec> make_specs() {
   // [data]
   specs.push_back(number("data", "c", &Problem::c, 0.0, false, 1e12, false, "reaction coefficient of −Δu + c·u = f"));
   // [solver]
-  specs.push_back(choice(std::string("solver"), std::string("schur"), &SolverOptions::inner,
-                         {to_string(InnerSolver::green), to_string(InnerSolver::krylov)},
-                         {InnerSolver::green, InnerSolver::krylov},
-                         "green: explicit Schur complement, dense LU; krylov: GMRES on the implicit one (the paper's)"));
+  specs.push_back(
+      choice(std::string("solver"), std::string("schur"), &SolverOptions::inner,
+             {to_string(InnerSolver::green), to_string(InnerSolver::krylov)}, {InnerSolver::green, InnerSolver::krylov},
+             "green: explicit Schur complement, dense LU; krylov: GMRES on the implicit one (the paper's)"));
   {
     OptionSpec s = number("solver", "krylov_tolerance", &SolverOptions::krylov_tolerance, 0.0, true, 1.0, true,
                           "relative GMRES residual");
@@ -208,7 +225,9 @@ std::vector<OptionSpec> make_specs() {
     start.get = [](const Problem&, const SolverOptions& o) -> OptionValue {
       return std::string(o.start_all_active ? "all" : "zero");
     };
-    start.set = [](Problem&, SolverOptions& o, const OptionValue& v) { o.start_all_active = std::get<std::string>(v) == "all"; };
+    start.set = [](Problem&, SolverOptions& o, const OptionValue& v) {
+      o.start_all_active = std::get<std::string>(v) == "all";
+    };
     start.violation = [](const OptionValue&) { return std::string(); };
     specs.push_back(start);
   }
@@ -218,9 +237,9 @@ std::vector<OptionSpec> make_specs() {
     t.rule = "in 1 … 4 × the hardware threads";
     t.violation = [](const OptionValue& v) {
       const std::int64_t n = std::get<std::int64_t>(v);
-      return n < 1 || n > max_threads()
-                 ? "must be in 1 … " + std::to_string(max_threads()) + " (4 × the hardware threads), got " + std::to_string(n)
-                 : std::string();
+      return n < 1 || n > max_threads() ? "must be in 1 … " + std::to_string(max_threads()) +
+                                              " (4 × the hardware threads), got " + std::to_string(n)
+                                        : std::string();
     };
     specs.push_back(t);
   }
@@ -246,11 +265,16 @@ std::vector<OptionSpec> make_specs() {
 
 const char* type_words(OptionType t) {
   switch (t) {
-    case OptionType::boolean: return "true or false";
-    case OptionType::integer: return "an integer";
-    case OptionType::number: return "a number";
-    case OptionType::choice: return "a string";
-    case OptionType::numbers: return "an array of numbers";
+    case OptionType::boolean:
+      return "true or false";
+    case OptionType::integer:
+      return "an integer";
+    case OptionType::number:
+      return "a number";
+    case OptionType::choice:
+      return "a string";
+    case OptionType::numbers:
+      return "an array of numbers";
   }
   return "";
 }
@@ -288,7 +312,8 @@ OptionValue checked(const OptionSpec& spec, OptionValue value) {
                           (spec.type == OptionType::choice && std::holds_alternative<std::string>(value)) ||
                           (spec.type == OptionType::numbers && std::holds_alternative<std::vector<double>>(value));
   if (!right_type) fail(spec, std::string("expected ") + type_words(spec.type));
-  if (spec.type == OptionType::number && !std::isfinite(std::get<double>(value))) fail(spec, "must be finite (NaN or Inf given)");
+  if (spec.type == OptionType::number && !std::isfinite(std::get<double>(value)))
+    fail(spec, "must be finite (NaN or Inf given)");
   if (spec.type == OptionType::choice) {
     const std::string& text = std::get<std::string>(value);
     if (std::find(spec.choices.begin(), spec.choices.end(), text) == spec.choices.end())
@@ -332,8 +357,10 @@ OptionValue parse_option_text(const OptionSpec& spec, const std::string& text) {
       if (used == 0 || used != text.size()) fail(spec, "expected an integer, got \"" + text.substr(0, 40) + "\"");
       return checked(spec, std::int64_t(v));
     }
-    case OptionType::number: return checked(spec, as_number(text));
-    case OptionType::choice: return checked(spec, text);
+    case OptionType::number:
+      return checked(spec, as_number(text));
+    case OptionType::choice:
+      return checked(spec, text);
     case OptionType::numbers: {
       std::vector<double> list;
       std::stringstream in(text);
@@ -353,10 +380,14 @@ std::string option_text(const OptionSpec& spec, const OptionValue& value) {
   return std::visit(
       [](const auto& v) -> std::string {
         using T = std::decay_t<decltype(v)>;
-        if constexpr (std::is_same_v<T, bool>) return v ? "true" : "false";
-        else if constexpr (std::is_same_v<T, std::int64_t>) return std::to_string(v);
-        else if constexpr (std::is_same_v<T, double>) return format_number(v);
-        else if constexpr (std::is_same_v<T, std::string>) return "\"" + v + "\"";
+        if constexpr (std::is_same_v<T, bool>)
+          return v ? "true" : "false";
+        else if constexpr (std::is_same_v<T, std::int64_t>)
+          return std::to_string(v);
+        else if constexpr (std::is_same_v<T, double>)
+          return format_number(v);
+        else if constexpr (std::is_same_v<T, std::string>)
+          return "\"" + v + "\"";
         else {
           std::string text = "[";
           for (std::size_t k = 0; k < v.size(); ++k) text += (k ? ", " : "") + format_number(v[k]);
@@ -383,7 +414,8 @@ std::string options_markdown() {
   for (const OptionSpec& s : option_specs()) {
     if (s.section != section) {
       section = s.section;
-      text += (text.empty() ? "" : "\n") + std::string("[") + section + "]\n\n| key | default | allowed | meaning |\n|---|---|---|---|\n";
+      text += (text.empty() ? "" : "\n") + std::string("[") + section +
+              "]\n\n| key | default | allowed | meaning |\n|---|---|---|---|\n";
     }
     text += "| `" + s.key + "` | `" + option_text(s, s.default_value()) + "` | " + s.rule + " | " + s.meaning + " |\n";
   }

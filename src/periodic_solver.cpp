@@ -36,8 +36,10 @@ void PeriodicSolver<dim>::transform(GridVector& v, bool inverse) const {
     std::complex<double>* row = spectrum_.data() + std::size_t(r) * std::size_t(row_length);
     for (int p = 0; p < row_length; ++p) {
       const double lambda = symbol_(p, factors);
-      if (inverse) row[p] *= lambda > 0 ? norm / lambda : 0.0;  // λ = 0 only for the constants at c = 0
-      else row[p] *= norm * lambda;
+      if (inverse)
+        row[p] *= lambda > 0 ? norm / lambda : 0.0;  // λ = 0 only for the constants at c = 0
+      else
+        row[p] *= norm * lambda;
     }
   }
   dft_->backward(spectrum_.data(), v.data());

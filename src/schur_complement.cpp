@@ -8,8 +8,13 @@ namespace fictus {
 
 ImplicitSchur::ImplicitSchur(const FastSolver<2>& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
                              const SparseRows& loads, const GmresOptions& options, DirectTerms direct)
-    : solver_(solver), B_gamma_(B_gamma), C_gamma_(C_gamma), B_Gamma_(loads), options_(options),
-      direct_(std::move(direct)), work_(solver.grid().n_unknowns()) {}
+    : solver_(solver),
+      B_gamma_(B_gamma),
+      C_gamma_(C_gamma),
+      B_Gamma_(loads),
+      options_(options),
+      direct_(std::move(direct)),
+      work_(solver.grid().n_unknowns()) {}
 
 void ImplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const {
   lambda_.assign(lambda.data(), lambda.data() + lambda.size());
@@ -51,7 +56,8 @@ LinearSolveReport ImplicitSchur::solve(const ActiveSet& active, const Eigen::Vec
   return {g.iterations, g.relative_residual, g.converged};
 }
 
-Eigen::MatrixXd green_block(const GreenTable<2>& green, const SparseRows& R, const SparseRows& Q, const Execution& execution) {
+Eigen::MatrixXd green_block(const GreenTable<2>& green, const SparseRows& R, const SparseRows& Q,
+                            const Execution& execution) {
   return green_blocks(green, {&R}, Q, execution).front();
 }
 

@@ -5,9 +5,8 @@
 
 namespace fictus {
 
-NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::VectorXd& b0,
-                                     const Eigen::VectorXd& c0, const Eigen::VectorXd& g,
-                                     const NewtonOptions& options, const ConstantMode* mode) {
+NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::VectorXd& b0, const Eigen::VectorXd& c0,
+                                     const Eigen::VectorXd& g, const NewtonOptions& options, const ConstantMode* mode) {
   if (!(options.rho > 0)) throw std::invalid_argument("formulation.rho: must be > 0");
   if (options.max_iterations < 1) throw std::invalid_argument("solver.max_newton: must be >= 1");
   const int m = schur.size();
@@ -40,8 +39,8 @@ NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::
     const Eigen::VectorXd shifted = c - rho * (b - g);
     const Eigen::VectorXd F = c - shifted.cwiseMax(0.0);
     result.residual = F.lpNorm<Eigen::Infinity>();
-    const double scale = std::max({b.lpNorm<Eigen::Infinity>(), c.lpNorm<Eigen::Infinity>(),
-                                   g.lpNorm<Eigen::Infinity>(), 1e-300});
+    const double scale =
+        std::max({b.lpNorm<Eigen::Infinity>(), c.lpNorm<Eigen::Infinity>(), g.lpNorm<Eigen::Infinity>(), 1e-300});
 
     // 3. New active set.
     ActiveSet next(m);
@@ -50,8 +49,8 @@ NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::
       next[i] = shifted(i) > 0;
       changed += next[i] != active[i];
     }
-    result.history.push_back({int(std::count(active.begin(), active.end(), 1)), linear.inner_iterations,
-                              result.residual, changed});
+    result.history.push_back(
+        {int(std::count(active.begin(), active.end(), 1)), linear.inner_iterations, result.residual, changed});
 
     // 4. Stopping test.
     if (changed == 0) {

@@ -83,7 +83,8 @@ Point2 ExpressionCurve::second_derivative(double t) const {
   return (1.0 / (e * e)) * (position(t + e) - 2.0 * position(t) + position(t - e));
 }
 
-ParametricCurve::ParametricCurve(std::function<double(double)> x, std::function<double(double)> y) : x_(std::move(x)), y_(std::move(y)) {
+ParametricCurve::ParametricCurve(std::function<double(double)> x, std::function<double(double)> y)
+    : x_(std::move(x)), y_(std::move(y)) {
   center_ = centroid(*this);
 }
 
@@ -161,7 +162,8 @@ void check_simple(const Curve& curve, const std::string& what, int samples) {
   const std::size_t n = p.size();
   // Bucket the segments on a coarse grid so the check stays near-linear.
   double x0 = p[0].x, x1 = x0, y0 = p[0].y, y1 = y0;
-  for (const Point2& q : p) x0 = std::min(x0, q.x), x1 = std::max(x1, q.x), y0 = std::min(y0, q.y), y1 = std::max(y1, q.y);
+  for (const Point2& q : p)
+    x0 = std::min(x0, q.x), x1 = std::max(x1, q.x), y0 = std::min(y0, q.y), y1 = std::max(y1, q.y);
   const int cells = 64;
   const double wx = (x1 - x0) / cells + 1e-300, wy = (y1 - y0) / cells + 1e-300;
   std::vector<std::vector<std::size_t>> bucket(cells * cells);
@@ -169,7 +171,8 @@ void check_simple(const Curve& curve, const std::string& what, int samples) {
   for (std::size_t k = 0; k < n; ++k) {
     const Point2 a = p[k], b = p[(k + 1) % n];
     for (int i = cell(std::min(a.x, b.x), x0, wx); i <= cell(std::max(a.x, b.x), x0, wx); ++i)
-      for (int j = cell(std::min(a.y, b.y), y0, wy); j <= cell(std::max(a.y, b.y), y0, wy); ++j) bucket[j * cells + i].push_back(k);
+      for (int j = cell(std::min(a.y, b.y), y0, wy); j <= cell(std::max(a.y, b.y), y0, wy); ++j)
+        bucket[j * cells + i].push_back(k);
   }
   for (const auto& segs : bucket)
     for (std::size_t u = 0; u < segs.size(); ++u)
@@ -194,7 +197,8 @@ void check_inside_box(const Curve& curve, const Box2& box, double margin, const 
       msg << what << ": the curve is not finite at t = " << s;
       throw std::invalid_argument(msg.str());
     }
-    if (p.x - box.lower.x < margin || box.upper.x - p.x < margin || p.y - box.lower.y < margin || box.upper.y - p.y < margin) {
+    if (p.x - box.lower.x < margin || box.upper.x - p.x < margin || p.y - box.lower.y < margin ||
+        box.upper.y - p.y < margin) {
       std::ostringstream msg;
       msg << what << ": the curve comes within " << margin << " of the box boundary (or leaves it) at (" << p.x << ", "
           << p.y << ")";

@@ -111,7 +111,8 @@ LagrangeBasis lagrange_basis(int first, int p, double xi) {
 SparseRows normal_derivative_rows_centered(const Grid2& grid, const std::vector<Point2>& points,
                                            const std::vector<Point2>& normals, int degree) {
   if (points.size() != normals.size()) throw std::invalid_argument("normal_derivative_rows: size mismatch");
-  if (degree < 1 || degree > 3) throw std::invalid_argument("normal_derivative_rows_centered: degree must be 1, 2 or 3");
+  if (degree < 1 || degree > 3)
+    throw std::invalid_argument("normal_derivative_rows_centered: degree must be 1, 2 or 3");
   SparseRows rows;
   RowBuilder builder(grid, rows);
   const double h = grid.h();

@@ -23,7 +23,9 @@ struct AlignedAllocator {
   T* allocate(std::size_t n) { return static_cast<T*>(detail::aligned_allocate(n * sizeof(T))); }
   void deallocate(T* p, std::size_t) noexcept { detail::aligned_free(p); }
   template <class U>
-  bool operator==(const AlignedAllocator<U>&) const noexcept { return true; }
+  bool operator==(const AlignedAllocator<U>&) const noexcept {
+    return true;
+  }
 };
 
 template <class T>

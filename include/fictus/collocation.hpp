@@ -13,10 +13,10 @@ struct Collocation {
   double length = 0.0;   // L = |γ|
   double spacing = 0.0;  // s = L/m
   double phase = 0.5;
-  std::vector<double> s;                     // arc length of point i
-  std::vector<double> t;                     // parameter of point i
-  std::vector<double> arc_begin, arc_end;    // parameters bounding arc i, arc_begin[0] = 0
-  std::vector<Point2> point, normal;          // x_i and the outward unit normal n_i
+  std::vector<double> s;                   // arc length of point i
+  std::vector<double> t;                   // parameter of point i
+  std::vector<double> arc_begin, arc_end;  // parameters bounding arc i, arc_begin[0] = 0
+  std::vector<Point2> point, normal;       // x_i and the outward unit normal n_i
 
   int n_points() const { return m; }
 };

@@ -24,8 +24,7 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
                           const GradientField& exact_gradient, int q = 3, const Execution& execution = Execution{});
 
 /// ∇u on many points at once: (gx[k], gy[k]) = ∇u(x[k], y[k]).
-using VectorizedGradient =
-    std::function<void(std::size_t n, const double* x, const double* y, double* gx, double* gy)>;
+using VectorizedGradient = std::function<void(std::size_t n, const double* x, const double* y, double* gx, double* gy)>;
 
 /// The same for an exact solution evaluated in batches (one per cell row, one along γ). Without a
 /// gradient, ∇u by central differences (step 1e-6·box width): four more batches.

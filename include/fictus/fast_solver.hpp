@@ -32,7 +32,8 @@ class FastSolver {
 
 /// The solver for the grid's boundary conditions.
 template <int dim>
-std::unique_ptr<FastSolver<dim>> make_fast_solver(const Grid<dim>& grid, double c, const Execution& execution = Execution{});
+std::unique_ptr<FastSolver<dim>> make_fast_solver(const Grid<dim>& grid, double c,
+                                                  const Execution& execution = Execution{});
 
 namespace detail {
 class RealDft;

@@ -38,17 +38,17 @@ struct SignoriniCheck {
 /// The Signorini conditions once more with a normal derivative D_γ û from another stencil than the
 /// solve's C_γ (docs/math.md, "Checks"): where C_γ is wrong, D_γ û − C_γ û shows it.
 struct IndependentCheck {
-  std::string rule;                   // the stencil of D_γ
-  double min_normal_derivative = 0;   // min_i (D_γ û)_i
-  double max_complementarity = 0;     // max_i |(D_γ û)_i (B_γ û − g)_i|
-  double max_difference = 0;          // max_i |D_γ û − C_γ û|_i
-  double rms_difference = 0;          // root mean square of the same
+  std::string rule;                  // the stencil of D_γ
+  double min_normal_derivative = 0;  // min_i (D_γ û)_i
+  double max_complementarity = 0;    // max_i |(D_γ û)_i (B_γ û − g)_i|
+  double max_difference = 0;         // max_i |D_γ û − C_γ û|_i
+  double rms_difference = 0;         // root mean square of the same
 };
 
 /// Errors at the collocation points against an exact solution.
 struct PointErrors {
-  double max_trace = 0;               // max_i |(B_γ û)_i − u(x_i)|
-  double max_normal_derivative = 0;   // max_i |(C_γ û)_i − ∂u/∂n(x_i)|
+  double max_trace = 0;              // max_i |(B_γ û)_i − u(x_i)|
+  double max_normal_derivative = 0;  // max_i |(C_γ û)_i − ∂u/∂n(x_i)|
 };
 
 struct Timings {
@@ -60,24 +60,24 @@ struct Timings {
 struct Solution {
   explicit Solution(const Grid2& g) : grid(g) {}
   Grid2 grid;
-  SolverOptions options;                // in effect (m resolved)
-  GridVector u;                         // û at the unknowns (empty when the field was not asked for)
-  Collocation collocation;              // points on γ
-  std::shared_ptr<const Curve> Gamma;   // the curve carrying λ (γ itself in the non-smooth variant)
-  double delta = 0;                     // distance of Γ from γ
+  SolverOptions options;               // in effect (m resolved)
+  GridVector u;                        // û at the unknowns (empty when the field was not asked for)
+  Collocation collocation;             // points on γ
+  std::shared_ptr<const Curve> Gamma;  // the curve carrying λ (γ itself in the non-smooth variant)
+  double delta = 0;                    // distance of Γ from γ
   std::vector<double> lambda, g, trace, normal_derivative;  // per point: λ, g, B_γû, C_γû
-  double alpha = 0;                     // constant added to û (singular A: periodic box, c = 0)
+  double alpha = 0;                                         // constant added to û (singular A: periodic box, c = 0)
   NewtonResult newton;
-  std::size_t fast_solves = 0;          // applications of A⁻¹ in this solve (the paper's it₁)
-  int inner_iterations = 0;             // Krylov iterations over all Newton steps
-  bool reused_curve = false;            // trace rows and Schur blocks came from the previous solve
+  std::size_t fast_solves = 0;  // applications of A⁻¹ in this solve (the paper's it₁)
+  int inner_iterations = 0;     // Krylov iterations over all Newton steps
+  bool reused_curve = false;    // trace rows and Schur blocks came from the previous solve
   std::optional<double> condition_number;
   SignoriniCheck signorini;
   std::optional<IndependentCheck> check;  // with the field only
   std::optional<ErrorNorms> errors;
   std::optional<PointErrors> point_errors;
   Timings timings;
-  std::size_t peak_memory_bytes = 0;    // of the process so far (VmHWM; set by the caller, 0 if unknown)
+  std::size_t peak_memory_bytes = 0;  // of the process so far (VmHWM; set by the caller, 0 if unknown)
 };
 
 class FictitiousDomainSolver {
@@ -109,6 +109,5 @@ std::string describe_newton_failure(const Solution& solution);
 
 /// One problem, one call (a thin wrapper over FictitiousDomainSolver).
 Solution solve(const Problem& problem, SolverOptions options);
-
 
 }  // namespace fictus

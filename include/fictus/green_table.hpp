@@ -84,7 +84,7 @@ class GreenTable {
   Grid<dim> grid_;
   double c_;
   bool periodic_;
-  std::array<int, dim> period_;       // of T along each axis
+  std::array<int, dim> period_;        // of T along each axis
   std::array<std::size_t, dim> size_;  // table entries along each axis: period/2 + 1
   AlignedVector<double> table_;
 };

@@ -32,7 +32,8 @@ class Grid {
   /// n_d ≥ 2; a periodic box needs even n_d (the Green's table uses the half period).
   Grid(const Box<dim>& box, int n0, Boundary boundary = Boundary::dirichlet) : box_(box), boundary_(boundary) {
     for (int d = 0; d < dim; ++d)
-      if (!(box.upper[d] > box.lower[d])) throw std::invalid_argument("domain.box: need lower < upper along every axis");
+      if (!(box.upper[d] > box.lower[d]))
+        throw std::invalid_argument("domain.box: need lower < upper along every axis");
     if (n0 < 2) throw std::invalid_argument("domain.N: need at least 2 cells, got " + std::to_string(n0));
     h_ = box.width(0) / n0;
     n_[0] = n0;

@@ -21,8 +21,8 @@ using OptionValue = std::variant<bool, std::int64_t, double, std::string, std::v
 enum class OptionType { boolean, integer, number, choice, numbers };
 
 struct OptionSpec {
-  std::string section;               // "domain", "formulation", "data" or "solver"
-  std::string key;                   // e.g. "newton_tolerance"
+  std::string section;  // "domain", "formulation", "data" or "solver"
+  std::string key;      // e.g. "newton_tolerance"
   OptionType type = OptionType::number;
   std::string meaning;               // one line: unit and meaning (help text, docs)
   std::string rule;                  // the allowed values in words, e.g. "in (0, 1)"

@@ -23,34 +23,34 @@ namespace fictus {
 
 /// The Newton part of SolverOptions (its defaults).
 struct NewtonOptions {
-  double rho = SolverOptions{}.rho;                       // ρ > 0 of the projection
-  int max_iterations = SolverOptions{}.max_newton;        // linear solves
+  double rho = SolverOptions{}.rho;                 // ρ > 0 of the projection
+  int max_iterations = SolverOptions{}.max_newton;  // linear solves
   bool start_all_active = SolverOptions{}.start_all_active;
-  double tolerance = SolverOptions{}.newton_tolerance;    // ‖F‖∞ ≤ tolerance · max(‖b‖∞, ‖c‖∞, ‖g‖∞)
+  double tolerance = SolverOptions{}.newton_tolerance;  // ‖F‖∞ ≤ tolerance · max(‖b‖∞, ‖c‖∞, ‖g‖∞)
 };
 
 struct NewtonStep {
-  int n_active = 0;           // |𝒜| used in this step's linear solve
-  int inner_iterations = 0;   // Krylov applications in this step
-  double residual = 0.0;      // ‖F(λ)‖∞ after the step
-  int n_changed = 0;          // points whose status changed after the step
+  int n_active = 0;          // |𝒜| used in this step's linear solve
+  int inner_iterations = 0;  // Krylov applications in this step
+  double residual = 0.0;     // ‖F(λ)‖∞ after the step
+  int n_changed = 0;         // points whose status changed after the step
 };
 
 struct NewtonResult {
   Eigen::VectorXd lambda;
-  double alpha = 0.0;         // the constant added to u (singular A only)
+  double alpha = 0.0;                        // the constant added to u (singular A only)
   Eigen::VectorXd trace, normal_derivative;  // B_γu and C_γu at the final λ (from the Schur blocks)
   ActiveSet active;
-  int iterations = 0;         // linear solves (the paper's it₀)
+  int iterations = 0;  // linear solves (the paper's it₀)
   bool converged = false;
-  std::string failure;        // why not, when not converged
+  std::string failure;  // why not, when not converged
   double residual = 0.0;
   std::vector<NewtonStep> history;
 };
 
 /// `mode`: bordering for a singular A (see ConstantMode); nullptr otherwise.
-NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::VectorXd& b0,
-                                     const Eigen::VectorXd& c0, const Eigen::VectorXd& g,
-                                     const NewtonOptions& options, const ConstantMode* mode = nullptr);
+NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::VectorXd& b0, const Eigen::VectorXd& c0,
+                                     const Eigen::VectorXd& g, const NewtonOptions& options,
+                                     const ConstantMode* mode = nullptr);
 
 }  // namespace fictus

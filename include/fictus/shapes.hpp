@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "fictus/curve.hpp"
 #include <functional>
+#include "fictus/curve.hpp"
 
 namespace fictus {
 

@@ -17,20 +17,20 @@ const char* to_string(NormalDerivative d);
 
 struct SolverOptions {
   Variant variant = Variant::smooth;
-  int multipliers = 0;            // m; 0: default_multipliers()
-  double offset = 1.5;            // smooth variant: δ = offset · s, s = L/m (spacing of the points)
-  double rho = 1.0;               // ρ > 0
+  int multipliers = 0;  // m; 0: default_multipliers()
+  double offset = 1.5;  // smooth variant: δ = offset · s, s = L/m (spacing of the points)
+  double rho = 1.0;     // ρ > 0
   NormalDerivative normal_derivative = NormalDerivative::reconstructed;
-  double normal_shift = 1.0;      // shifted rule only: C_γ taken at x_i − normal_shift·h·n_i
-  bool start_all_active = true;   // Newton start: all points active, else λ = 0
+  double normal_shift = 1.0;     // shifted rule only: C_γ taken at x_i − normal_shift·h·n_i
+  bool start_all_active = true;  // Newton start: all points active, else λ = 0
   InnerSolver inner = InnerSolver::green;
   double krylov_tolerance = 1e-10;  // relative GMRES residual
   int krylov_max_iterations = 5000;
-  double newton_tolerance = 1e-9;   // relative ‖F‖∞
+  double newton_tolerance = 1e-9;  // relative ‖F‖∞
   int max_newton = 50;
-  int load_quadrature = 2;        // Gauss points per direction per cell for the load vector
-  int error_quadrature = 3;       // Gauss points per direction for the error integrals (exact for |∇e|²)
-  bool condition_number = true;   // of the final Newton matrix (green path only)
+  int load_quadrature = 2;       // Gauss points per direction per cell for the load vector
+  int error_quadrature = 3;      // Gauss points per direction for the error integrals (exact for |∇e|²)
+  bool condition_number = true;  // of the final Newton matrix (green path only)
   int threads = 1;
 
   /// Throws std::invalid_argument naming the option when a value breaks its rule (options.hpp).

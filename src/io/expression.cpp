@@ -61,7 +61,8 @@ std::string unassigned_local(const std::string& text, const std::vector<std::str
     std::size_t next = at == std::string::npos ? at : at + name.size();
     while (next < text.size() && static_cast<unsigned char>(text[next]) <= 0x20) ++next;  // muParser's blanks
     if (next == text.size()) next = std::string::npos;
-    const bool assigned = next != std::string::npos && text[next] == '=' && (next + 1 == text.size() || text[next + 1] != '=');
+    const bool assigned =
+        next != std::string::npos && text[next] == '=' && (next + 1 == text.size() || text[next + 1] != '=');
     if (!assigned) return name;
   }
   return "";
@@ -82,8 +83,8 @@ Expression::Expression(std::string text, std::vector<std::string> variables, std
     c->parser.Eval();  // reports syntax errors
     const std::string unknown = unassigned_local(shared->text, c->local_names);
     if (!unknown.empty())
-      throw std::invalid_argument(shared->key + ": cannot parse \"" + shared->text + "\": unknown variable \"" + unknown +
-                                  "\" (a local name must be assigned first: \"" + unknown + " = …, …\")");
+      throw std::invalid_argument(shared->key + ": cannot parse \"" + shared->text + "\": unknown variable \"" +
+                                  unknown + "\" (a local name must be assigned first: \"" + unknown + " = …, …\")");
   } catch (const mu::Parser::exception_type& e) {
     throw std::invalid_argument(shared->key + ": cannot parse \"" + shared->text + "\": " + e.GetMsg());
   }
@@ -106,7 +107,8 @@ double Expression::operator()(const double* values) const {
 }
 
 double Expression::operator()(std::initializer_list<double> values) const {
-  if (values.size() != shared_->variables.size()) throw std::invalid_argument(shared_->key + ": wrong number of values");
+  if (values.size() != shared_->variables.size())
+    throw std::invalid_argument(shared_->key + ": wrong number of values");
   return (*this)(values.begin());
 }
 

@@ -17,7 +17,9 @@ namespace fictus {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& key, const std::string& reason) { throw std::invalid_argument(key + ": " + reason); }
+[[noreturn]] void fail(const std::string& key, const std::string& reason) {
+  throw std::invalid_argument(key + ": " + reason);
+}
 
 /// Reads the keys of one table, remembering which were used so that unknown keys are reported.
 class TableReader {
@@ -30,7 +32,8 @@ class TableReader {
   double number(const std::string& k, double fallback) {
     const toml::node* n = node(k);
     if (!n) return fallback;
-    std::optional<double> v = n->is_integer() ? std::optional<double>(double(*n->value<int64_t>())) : n->value<double>();
+    std::optional<double> v =
+        n->is_integer() ? std::optional<double>(double(*n->value<int64_t>())) : n->value<double>();
     if (!v || n->is_boolean()) fail(key(k), std::string("expected a number, got ") + type_name(*n));
     if (!std::isfinite(*v)) fail(key(k), "must be finite (NaN or Inf given)");
     return *v;
@@ -109,7 +112,8 @@ class TableReader {
     if (const toml::array* a = n.as_array()) {
       std::vector<double> list;
       for (const toml::node& e : *a) {
-        if (!e.is_number()) fail(spec.name(), std::string("expected an array of numbers, got ") + type_name(e) + " in it");
+        if (!e.is_number())
+          fail(spec.name(), std::string("expected an array of numbers, got ") + type_name(e) + " in it");
         list.push_back(*e.value<double>());
       }
       return list;
@@ -118,13 +122,20 @@ class TableReader {
   }
   static const char* type_name(const toml::node& n) {
     switch (n.type()) {
-      case toml::node_type::string: return "a string";
-      case toml::node_type::integer: return "an integer";
-      case toml::node_type::floating_point: return "a number";
-      case toml::node_type::boolean: return "a boolean";
-      case toml::node_type::array: return "an array";
-      case toml::node_type::table: return "a table";
-      default: return "a date or time";
+      case toml::node_type::string:
+        return "a string";
+      case toml::node_type::integer:
+        return "an integer";
+      case toml::node_type::floating_point:
+        return "a number";
+      case toml::node_type::boolean:
+        return "a boolean";
+      case toml::node_type::array:
+        return "an array";
+      case toml::node_type::table:
+        return "a table";
+      default:
+        return "a date or time";
     }
   }
   const toml::table* table_;
@@ -210,7 +221,8 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
   }
   for (const auto& [k, v] : root) {
     const std::string name(k.str());
-    if (name != "domain" && name != "geometry" && name != "formulation" && name != "data" && name != "solver" && name != "output")
+    if (name != "domain" && name != "geometry" && name != "formulation" && name != "data" && name != "solver" &&
+        name != "output")
       fail(name, "unknown section (domain, geometry, formulation, data, solver, output)");
   }
   ProblemSpec spec;
@@ -257,7 +269,8 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
     spec.output.files.clear();
     for (const toml::node& f : *files) {
       const auto name = f.value<std::string>();
-      if (!name || std::find(output_file_names().begin(), output_file_names().end(), *name) == output_file_names().end())
+      if (!name ||
+          std::find(output_file_names().begin(), output_file_names().end(), *name) == output_file_names().end())
         fail("output.files", "expected names from results.json, points.csv, solution.vti, curves.vtp");
       spec.output.files.push_back(*name);
     }

@@ -14,8 +14,8 @@
 
 #include "fictus/convergence_table.hpp"
 #include "fictus/error_norms.hpp"
-#include "fictus/io/expression.hpp"
 #include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/io/expression.hpp"
 #include "fictus/quadrature.hpp"
 
 namespace reference {
@@ -27,9 +27,9 @@ struct Reference {
   fictus::Point2 center;
   std::function<double(double)> radius;  // r_b(θ), θ the polar angle about the center
   int n_theta = 0, n_rho = 0;
-  std::vector<double> u, ux, uy;          // interior samples, index j·n_rho + k
-  std::vector<double> trace_u, trace_g;   // on γ at θ_j = 2πj/n
-  std::vector<double> ends;               // θ of the ends of the contact intervals
+  std::vector<double> u, ux, uy;         // interior samples, index j·n_rho + k
+  std::vector<double> trace_u, trace_g;  // on γ at θ_j = 2πj/n
+  std::vector<double> ends;              // θ of the ends of the contact intervals
   double l2_omega = 0, h1semi_omega = 0, l2_gamma = 0;
 };
 
@@ -62,8 +62,8 @@ inline fictus::Point2 boundary_point(const Reference& r, double theta) {
 }
 
 struct Comparison {
-  fictus::LevelResult level;       // relative errors against the reference
-  double end_error_spacings = 0;   // largest distance of a reference contact end to fictus's, in s = L/m
+  fictus::LevelResult level;      // relative errors against the reference
+  double end_error_spacings = 0;  // largest distance of a reference contact end to fictus's, in s = L/m
 };
 
 inline Comparison compare(const Reference& r, const fictus::Solution& s) {
@@ -88,10 +88,16 @@ inline Comparison compare(const Reference& r, const fictus::Solution& s) {
   for (int j = 0; j < n; ++j) {
     const double theta = two_pi * j / n, d = 1e-6;
     const double rb = r.radius(theta), drb = (r.radius(theta + d) - r.radius(theta - d)) / (2 * d);
-    eg += two_pi / n * std::hypot(rb, drb) * std::pow(fictus::evaluate_q1(grid, s.u, boundary_point(r, theta)) - r.trace_u[j], 2);
+    eg += two_pi / n * std::hypot(rb, drb) *
+          std::pow(fictus::evaluate_q1(grid, s.u, boundary_point(r, theta)) - r.trace_u[j], 2);
   }
   Comparison c;
-  c.level = {grid.nx(), grid.n_nodes(), s.collocation.m, s.newton.iterations, s.fast_solves, s.timings.total,
+  c.level = {grid.nx(),
+             grid.n_nodes(),
+             s.collocation.m,
+             s.newton.iterations,
+             s.fast_solves,
+             s.timings.total,
              std::sqrt(e0) / r.l2_omega,
              std::sqrt(e0 + e1) / std::hypot(r.l2_omega, r.h1semi_omega),
              std::sqrt(eg) / r.l2_gamma};

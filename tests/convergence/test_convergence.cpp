@@ -15,11 +15,12 @@
 namespace {
 
 fictus::LevelResult level_of(const fictus::Solution& s) {
-  return {s.grid.nx(), s.grid.n_nodes(), s.collocation.m, s.newton.iterations, s.fast_solves, s.timings.total,
-          s.errors->rel_l2_omega, s.errors->rel_h1_omega, s.errors->rel_l2_gamma};
+  return {s.grid.nx(),     s.grid.n_nodes(),       s.collocation.m,        s.newton.iterations,   s.fast_solves,
+          s.timings.total, s.errors->rel_l2_omega, s.errors->rel_h1_omega, s.errors->rel_l2_gamma};
 }
 
-std::vector<fictus::LevelResult> run_paper(fictus::Variant variant, fictus::NormalDerivative rule, int first, int last) {
+std::vector<fictus::LevelResult> run_paper(fictus::Variant variant, fictus::NormalDerivative rule, int first,
+                                           int last) {
   std::vector<fictus::LevelResult> rows;
   for (int level = first; level <= last; ++level) {
     const int N = 1 << level;
@@ -30,9 +31,8 @@ std::vector<fictus::LevelResult> run_paper(fictus::Variant variant, fictus::Norm
     EXPECT_TRUE(s.newton.converged) << "N = " << N << ": " << s.newton.failure;
     rows.push_back(level_of(s));
   }
-  std::cout << fictus::format_convergence_table(std::string("variant ") + fictus::to_string(variant) + ", " +
-                                                    fictus::to_string(rule) + " traces",
-                                                rows, variant);
+  std::cout << fictus::format_convergence_table(
+      std::string("variant ") + fictus::to_string(variant) + ", " + fictus::to_string(rule) + " traces", rows, variant);
   return rows;
 }
 

@@ -25,7 +25,8 @@ TEST_P(References, ConvergeToTheFittedMeshSolution) {
   std::vector<fictus::LevelResult> rows;
   std::vector<double> end_errors;
   for (int N = 256; N <= 2048; N *= 2) {
-    fictus::ProblemSpec spec = fictus::read_problem_file(std::string(FICTUS_SOURCE_DIR) + "/tests/references/" + c.name + ".toml");
+    fictus::ProblemSpec spec =
+        fictus::read_problem_file(std::string(FICTUS_SOURCE_DIR) + "/tests/references/" + c.name + ".toml");
     spec.problem.N = N;
     spec.options.variant = c.variant;
     spec.options.condition_number = false;
@@ -36,8 +37,8 @@ TEST_P(References, ConvergeToTheFittedMeshSolution) {
     rows.push_back(cmp.level);
     end_errors.push_back(cmp.end_error_spacings);
   }
-  std::cout << fictus::format_convergence_table(c.name + " against its fitted-mesh reference, " + fictus::to_string(c.variant),
-                                                rows, std::nullopt);
+  std::cout << fictus::format_convergence_table(
+      c.name + " against its fitted-mesh reference, " + fictus::to_string(c.variant), rows, std::nullopt);
   std::cout << "contact ends, largest distance to the reference's in spacings s = L/m:";
   for (double e : end_errors) std::cout << ' ' << e;
   std::cout << '\n';

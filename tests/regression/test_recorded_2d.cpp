@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/paper_problem.hpp"
 #include "fictus/io/problem_file.hpp"
+#include "fictus/paper_problem.hpp"
 
 namespace {
 
@@ -90,8 +90,8 @@ std::vector<Case> cases() {
   list.push_back({"paper_krylov_nonsmooth", [] {
                     return paper(256, Variant::nonsmooth, [](auto& o) { o.inner = fictus::InnerSolver::krylov; });
                   }});
-  list.push_back({"paper_periodic_c0_smooth",
-                  [] { return paper(256, Variant::smooth, {}, 0.0, fictus::Boundary::periodic); }});
+  list.push_back(
+      {"paper_periodic_c0_smooth", [] { return paper(256, Variant::smooth, {}, 0.0, fictus::Boundary::periodic); }});
   std::vector<std::filesystem::path> examples;
   for (const auto& entry : std::filesystem::directory_iterator(source_dir + "/examples"))
     if (entry.path().extension() == ".toml") examples.push_back(entry.path());
@@ -155,7 +155,8 @@ TEST(Recorded2d, AnswersEqualTheRecordedValues) {
               << name << ".check[" << k << "]: recorded " << value[k] << ", now " << actual[k];
       } else if (value.is_array() && value.size() == 3) {
         for (std::size_t k = 0; k < 3; ++k)
-          compare(value[k], actual[k], name + "." + key + "[" + std::to_string(k) + "]", k == 1 ? 2 * tolerance : tolerance);
+          compare(value[k], actual[k], name + "." + key + "[" + std::to_string(k) + "]",
+                  k == 1 ? 2 * tolerance : tolerance);
       } else {
         compare(value, actual, name + "." + key, tolerance);
       }

@@ -5,8 +5,8 @@
 #include <numbers>
 
 #include "fictus/collocation.hpp"
-#include "fictus/paper_problem.hpp"
 #include "fictus/curve.hpp"
+#include "fictus/paper_problem.hpp"
 
 namespace {
 
@@ -25,8 +25,7 @@ TEST(Curve, EllipsePerimeterMatchesEllipticIntegral) {
 TEST(Curve, ArcLengthInverse) {
   const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2);
   const fictus::ArcLengthTable table(e);
-  for (double t : {0.0, 0.1, 1.0, 2.5, 4.0, 6.2})
-    EXPECT_NEAR(table.t_of_s(table.s_of_t(t)), t, 1e-12);
+  for (double t : {0.0, 0.1, 1.0, 2.5, 4.0, 6.2}) EXPECT_NEAR(table.t_of_s(table.s_of_t(t)), t, 1e-12);
 }
 
 TEST(Curve, OutwardNormalAndCurvature) {
@@ -60,7 +59,8 @@ TEST(Collocation, DefaultRuleKeepsTheSpacingInCells) {
   const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2);
   const double L = fictus::ArcLengthTable(e).length();
   for (int N = 128; N <= 4096; N *= 2) {
-    EXPECT_NEAR(L / fictus::default_multipliers(L, 1.0 / N) * N, 8.0, 0.3) << "N = " << N;  // m rounded (m ≈ 20 at N = 128)
+    EXPECT_NEAR(L / fictus::default_multipliers(L, 1.0 / N) * N, 8.0, 0.3)
+        << "N = " << N;  // m rounded (m ≈ 20 at N = 128)
     EXPECT_NEAR(L / fictus::default_multipliers(L, 1.0 / N, fictus::default_spacing_cells_nonsmooth) * N, 12.0, 0.3)
         << "N = " << N;
   }

@@ -96,9 +96,11 @@ TEST_P(FastSolver3d, GreenTableMatchesColumnsOfInverse) {
 }
 
 INSTANTIATE_TEST_SUITE_P(BoundariesAndReactions, FastSolver3d,
-                         ::testing::Values(Case{fictus::Boundary::dirichlet, 0.0}, Case{fictus::Boundary::dirichlet, 1.0},
-                                           Case{fictus::Boundary::dirichlet, 100.0}, Case{fictus::Boundary::periodic, 0.0},
-                                           Case{fictus::Boundary::periodic, 1.0}, Case{fictus::Boundary::periodic, 100.0}));
+                         ::testing::Values(Case{fictus::Boundary::dirichlet, 0.0},
+                                           Case{fictus::Boundary::dirichlet, 1.0},
+                                           Case{fictus::Boundary::dirichlet, 100.0},
+                                           Case{fictus::Boundary::periodic, 0.0}, Case{fictus::Boundary::periodic, 1.0},
+                                           Case{fictus::Boundary::periodic, 100.0}));
 
 TEST(FastSolver3d, GenericGreenLookupEqualsTheWrittenOut2dForm) {
   const fictus::Grid2 grid(fictus::Box2{{0.0, 0.0}, {1.0, 0.75}}, 16);

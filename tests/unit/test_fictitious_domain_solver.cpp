@@ -75,7 +75,8 @@ TEST_P(SingularPeriodic, GreenAndKrylovAgree) {
   EXPECT_NEAR(green.alpha, krylov.alpha, 1e-7 * (1 + std::abs(green.alpha)));
 }
 
-INSTANTIATE_TEST_SUITE_P(Variants, SingularPeriodic, ::testing::Values(fictus::Variant::nonsmooth, fictus::Variant::smooth),
+INSTANTIATE_TEST_SUITE_P(Variants, SingularPeriodic,
+                         ::testing::Values(fictus::Variant::nonsmooth, fictus::Variant::smooth),
                          [](const auto& info) { return std::string(fictus::to_string(info.param)); });
 
 TEST(Reuse, NewObstacleReusesTheCurveAndMatchesAFreshSolve) {

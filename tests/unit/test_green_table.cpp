@@ -36,8 +36,10 @@ TEST_P(GreenTableTest, MatchesColumnsOfInverse) {
 }
 
 INSTANTIATE_TEST_SUITE_P(BoundariesAndReactions, GreenTableTest,
-                         ::testing::Values(Case{fictus::Boundary::dirichlet, 0.0}, Case{fictus::Boundary::dirichlet, 1.0},
-                                           Case{fictus::Boundary::dirichlet, 100.0}, Case{fictus::Boundary::periodic, 0.0},
-                                           Case{fictus::Boundary::periodic, 1.0}, Case{fictus::Boundary::periodic, 100.0}));
+                         ::testing::Values(Case{fictus::Boundary::dirichlet, 0.0},
+                                           Case{fictus::Boundary::dirichlet, 1.0},
+                                           Case{fictus::Boundary::dirichlet, 100.0},
+                                           Case{fictus::Boundary::periodic, 0.0}, Case{fictus::Boundary::periodic, 1.0},
+                                           Case{fictus::Boundary::periodic, 100.0}));
 
 }  // namespace

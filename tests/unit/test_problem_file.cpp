@@ -33,11 +33,13 @@ TEST(Expression, UnknownOrUnassignedNamesAreErrors) {
 }
 
 TEST(ProblemFile, NormalDerivativeOption) {
-  const std::string base = "[geometry]\nshape = \"circle\"\ncenter = [0.5, 0.5]\nradius = 0.3\n"
-                           "[data]\nf = \"1\"\ng = \"0\"\n";
+  const std::string base =
+      "[geometry]\nshape = \"circle\"\ncenter = [0.5, 0.5]\nradius = 0.3\n"
+      "[data]\nf = \"1\"\ng = \"0\"\n";
   EXPECT_EQ(fictus::parse_problem_text(base).options.normal_derivative, fictus::NormalDerivative::reconstructed);
-  EXPECT_EQ(fictus::parse_problem_text(base + "[formulation]\nnormal_derivative = \"shifted\"\n").options.normal_derivative,
-            fictus::NormalDerivative::shifted);
+  EXPECT_EQ(
+      fictus::parse_problem_text(base + "[formulation]\nnormal_derivative = \"shifted\"\n").options.normal_derivative,
+      fictus::NormalDerivative::shifted);
   try {
     fictus::parse_problem_text(base + "[formulation]\nnormal_derivative = \"bicubic\"\n");
     FAIL() << "accepted a bad value";

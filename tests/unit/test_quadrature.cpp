@@ -31,14 +31,14 @@ TEST_P(DomainQuadrature, AreaMomentsAndPerimeterOfEllipse) {
   EXPECT_NEAR(moments[1] / (area * cx), 1.0, 1e-12);
   EXPECT_NEAR(moments[2] / (area * (a * a + b * b) / 4), 1.0, 1e-12);  // polar moment, any rotation
 
-  const auto length = fictus::integrate_along_curve<1>(geometry, 6, [](int, int, double, fictus::Point2) {
-    return std::array<double, 1>{1.0};
-  });
+  const auto length = fictus::integrate_along_curve<1>(
+      geometry, 6, [](int, int, double, fictus::Point2) { return std::array<double, 1>{1.0}; });
   EXPECT_NEAR(length[0], 4 * a * std::comp_ellint_2(std::sqrt(1 - b * b / (a * a))), 1e-12);
 }
 
 INSTANTIATE_TEST_SUITE_P(Grids, DomainQuadrature,
-                         ::testing::Values(Case{16, 0.0}, Case{64, 0.0}, Case{128, 0.0}, Case{50, 0.7}, Case{256, 2.1}));
+                         ::testing::Values(Case{16, 0.0}, Case{64, 0.0}, Case{128, 0.0}, Case{50, 0.7},
+                                           Case{256, 2.1}));
 
 TEST(CurveGridIntersection, InsideTestMatchesEllipseEquation) {
   const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2, 0.4);

@@ -109,7 +109,9 @@ TEST(TraceOperators, CenteredRowsReproducePolynomialsOfTheirDegree) {
   const EllipseFixture s;
   // Biquadratic rows are exact on x²y², bicubic rows on x³y³ (tensor-product interpolation).
   auto quadratic = [](double x, double y) { return 1 + x - 2 * y + 3 * x * x * y * y - x * y; };
-  auto quadratic_grad = [](double x, double y) { return fictus::Point2{1 + 6 * x * y * y - y, -2 + 6 * x * x * y - x}; };
+  auto quadratic_grad = [](double x, double y) {
+    return fictus::Point2{1 + 6 * x * y * y - y, -2 + 6 * x * x * y - x};
+  };
   auto cubic = [](double x, double y) { return x * x * x * y * y * y - 2 * x * x * y; };
   auto cubic_grad = [](double x, double y) {
     return fictus::Point2{3 * x * x * y * y * y - 4 * x * y, 3 * x * x * x * y * y - 2 * x * x};
@@ -124,14 +126,17 @@ TEST(TraceOperators, CenteredRowsReproducePolynomialsOfTheirDegree) {
 TEST(TraceOperators, CenteredRowsAreSecondOrderWhereTheShiftedOnesAreNot) {
   auto u = [](double x, double y) { return std::sin(2 * x + 1) * std::cos(3 * y) + x * x * y; };
   auto grad = [](double x, double y) {
-    return fictus::Point2{2 * std::cos(2 * x + 1) * std::cos(3 * y) + 2 * x * y, -3 * std::sin(2 * x + 1) * std::sin(3 * y) + x * x};
+    return fictus::Point2{2 * std::cos(2 * x + 1) * std::cos(3 * y) + 2 * x * y,
+                          -3 * std::sin(2 * x + 1) * std::sin(3 * y) + x * x};
   };
   double centered[2], shifted[2];
   for (int k = 0; k < 2; ++k) {
     EllipseFixture s;
     s.grid = fictus::Grid2(fictus::Box2{}, 128 << k);
-    centered[k] = max_normal_derivative_error(s, fictus::normal_derivative_rows_centered(s.grid, s.points.point, s.points.normal, 2), u, grad);
-    shifted[k] = max_normal_derivative_error(s, fictus::normal_derivative_rows(s.grid, s.points.point, s.points.normal, s.grid.h()), u, grad);
+    centered[k] = max_normal_derivative_error(
+        s, fictus::normal_derivative_rows_centered(s.grid, s.points.point, s.points.normal, 2), u, grad);
+    shifted[k] = max_normal_derivative_error(
+        s, fictus::normal_derivative_rows(s.grid, s.points.point, s.points.normal, s.grid.h()), u, grad);
   }
   EXPECT_NEAR(std::log2(centered[0] / centered[1]), 2.0, 0.3);  // O(h²)
   EXPECT_NEAR(std::log2(shifted[0] / shifted[1]), 1.0, 0.3);    // O(h): ∂u/∂n one cell inside
@@ -140,7 +145,8 @@ TEST(TraceOperators, CenteredRowsAreSecondOrderWhereTheShiftedOnesAreNot) {
 TEST(TraceOperators, OneSidedRowsUseNodesOfOmegaOnlyAndReproduceQuadratics) {
   const EllipseFixture s;
   const fictus::CurveGridIntersection geometry(*s.gamma, s.grid);
-  const auto D = fictus::one_sided_rows(geometry, s.points.point, s.points.normal, fictus::OneSidedTrace::normal_derivative, 2);
+  const auto D =
+      fictus::one_sided_rows(geometry, s.points.point, s.points.normal, fictus::OneSidedTrace::normal_derivative, 2);
   const auto V = fictus::one_sided_rows(geometry, s.points.point, s.points.normal, fictus::OneSidedTrace::value, 2);
   for (const auto& e : D.entries) EXPECT_TRUE(geometry.node_inside(e.i, e.j));
   // Outside ω the values are arbitrary (here: a kink); inside they are a quadratic.
@@ -167,7 +173,9 @@ TEST(KinkCorrection, TracesOfAKinkedFieldAreThoseOfItsSmoothPart) {
   const fictus::CurveGridIntersection geometry(*s.gamma, s.grid);
   const fictus::KinkCorrection kink(geometry, s.points, 1.0);
   auto w = [](double x, double y) { return std::cos(3 * x - y) + x * y; };
-  auto grad_w = [](double x, double y) { return fictus::Point2{-3 * std::sin(3 * x - y) + y, std::sin(3 * x - y) + x}; };
+  auto grad_w = [](double x, double y) {
+    return fictus::Point2{-3 * std::sin(3 * x - y) + y, std::sin(3 * x - y) + x};
+  };
   const double lambda = 2.5;
   std::vector<double> lambdas(s.points.m, lambda);
   // I_h(w − λψ): start from I_h w, subtract λψ at the nodes of the band (add_kinks adds +λψ).
@@ -220,7 +228,8 @@ TEST(KinkCorrection, KinkValuesOfAPolygonFollowTheDistanceToEdgesAndCorners) {
   const auto square = std::make_shared<fictus::PolygonCurve>(
       std::vector<fictus::Point2>{{0.3, 0.3}, {0.7, 0.32}, {0.68, 0.7}, {0.31, 0.69}});
   const fictus::ArcLengthTable arc(*square);
-  const fictus::Collocation points = fictus::make_collocation(*square, arc, 24, fictus::phase_off_corners(*square, arc, 24));
+  const fictus::Collocation points =
+      fictus::make_collocation(*square, arc, 24, fictus::phase_off_corners(*square, arc, 24));
   const fictus::CurveGridIntersection geometry(*square, grid);
   const fictus::KinkCorrection kink(geometry, points, 1.0);
   fictus::GridVector psi(grid.n_unknowns(), 0.0);
