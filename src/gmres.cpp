@@ -21,7 +21,8 @@ GmresReport gmres(const LinearOperator& apply, const Eigen::VectorXd& b, Eigen::
   Eigen::MatrixXd V(n, restart + 1), H = Eigen::MatrixXd::Zero(restart + 1, restart);
   Eigen::VectorXd cs(restart), sn(restart), e(restart + 1);
   double previous_cycle = std::numeric_limits<double>::infinity();
-  while (report.iterations < options.max_iterations) {
+  // One application of the cap is kept for the true residual of the final iterate.
+  while (report.iterations + 1 < options.max_iterations) {
     apply(x, w);
     ++report.iterations;
     r = b - w;
@@ -39,7 +40,7 @@ GmresReport gmres(const LinearOperator& apply, const Eigen::VectorXd& b, Eigen::
     e(0) = beta;
     H.setZero();
     int k = 0;
-    for (; k < restart && report.iterations < options.max_iterations; ++k) {
+    for (; k < restart && report.iterations + 1 < options.max_iterations; ++k) {
       apply(V.col(k), w);
       ++report.iterations;
       for (int j = 0; j <= k; ++j) {  // modified Gram–Schmidt, twice for stability

@@ -13,7 +13,7 @@ namespace fictus {
 
 struct GmresOptions {
   double relative_tolerance = SolverOptions{}.krylov_tolerance;  // ‖b − Ax‖ ≤ tol·‖b‖
-  int max_iterations = SolverOptions{}.krylov_max_iterations;    // operator applications
+  int max_iterations = SolverOptions{}.krylov_max_iterations;    // operator applications, at most
   int restart = 400;
 };
 

@@ -73,3 +73,42 @@ TEST(Solve, RejectsBadOptions) {
 }
 
 }  // namespace
+
+namespace {
+
+// A small variational inequality with a known answer, built backwards: pick λ*, the contact set 𝒜
+// and the traces b* = B_γu, c* = C_γu with b* = g, c* > 0 on 𝒜 and c* = 0, b* > g off it; then
+// b₀ = b* − S_Bλ*, c₀ = c* − S_Cλ*. The blocks are diagonally dominant (a P-matrix problem: the
+// answer is unique), so Newton must return exactly (λ*, 𝒜).
+TEST(SemismoothNewton, SolvesASmallVariationalInequalityWithAKnownAnswer) {
+  const int m = 8;
+  const fictus::ActiveSet contact = {1, 0, 1, 1, 0, 0, 1, 0};
+  Eigen::MatrixXd S_B(m, m), S_C(m, m);
+  Eigen::VectorXd lambda(m), g(m), b(m), c(m);
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j < m; ++j) {
+      S_B(i, j) = (i == j ? 1.0 : 0.0) + 0.05 * std::sin(1.3 * i + 0.7 * j);
+      S_C(i, j) = (i == j ? 2.0 : 0.0) + 0.05 * std::cos(0.9 * i - 1.1 * j);
+    }
+    lambda(i) = 0.5 + 0.1 * i;
+    g(i) = std::sin(0.8 * i);
+    b(i) = contact[i] ? g(i) : g(i) + 0.2 + 0.05 * i;
+    c(i) = contact[i] ? 0.3 + 0.07 * i : 0.0;
+  }
+  const Eigen::VectorXd b0 = b - S_B * lambda, c0 = c - S_C * lambda;
+  const fictus::ExplicitSchur schur(S_B, S_C);
+  for (bool all_active : {true, false}) {
+    fictus::NewtonOptions options;
+    options.start_all_active = all_active;
+    options.tolerance = 1e-13;
+    const fictus::NewtonResult r = fictus::solve_semismooth_newton(schur, b0, c0, g, options);
+    ASSERT_TRUE(r.converged) << r.failure;
+    EXPECT_EQ(r.active, contact);
+    EXPECT_LE((r.lambda - lambda).cwiseAbs().maxCoeff(), 1e-13);  // dense LU of an 8 × 8, cond ≈ 3
+    EXPECT_LE((r.trace - b).cwiseAbs().maxCoeff(), 1e-13);
+    EXPECT_LE((r.normal_derivative - c).cwiseAbs().maxCoeff(), 1e-13);
+    EXPECT_LE(r.iterations, 6);  // finite termination: a few active-set changes
+  }
+}
+
+}  // namespace
