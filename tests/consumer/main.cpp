@@ -1,8 +1,7 @@
 // Solves the paper's problem through the installed library and checks the answer.
 #include <cstdio>
 
-#include <fictus/fictitious_domain_solver.hpp>
-#include <fictus/paper_problem.hpp>
+#include <fictus/fictus.hpp>
 
 int main() {
   const fictus::SolverOptions options = fictus::paper_options(128, fictus::Variant::nonsmooth);
