@@ -1,5 +1,6 @@
 #include "fictus/error_norms.hpp"
 
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -15,17 +16,12 @@ GradientField numerical_gradient(ScalarField u, double scale) {
 }
 
 Q1Sample sample_q1(const Grid2& grid, const GridVector& u_h, int ix, int iy, double x, double y) {
+  auto node = [&](int i, int j) { return grid.has_unknown(i, j) ? u_h[grid.index(i, j)] : 0.0; };
   const double h = grid.h();
-  const Q1Element<2> element({(x - grid.x(ix)) / h, (y - grid.y(iy)) / h}, h);
-  Q1Sample sample{0.0, {0.0, 0.0}};
-  for (int k = 0; k < Q1Element<2>::n_nodes; ++k) {
-    const int i = ix + Q1Element<2>::offset(k, 0), j = iy + Q1Element<2>::offset(k, 1);
-    if (!grid.has_unknown(i, j)) continue;
-    const double u = u_h[grid.index(i, j)];
-    sample.value += u * element.value[k];
-    sample.gradient = sample.gradient + u * element.gradient[k];
-  }
-  return sample;
+  const Q1Element<2>::Sample s =
+      Q1Element<2>::interpolate(node(ix, iy), node(ix + 1, iy), node(ix, iy + 1), node(ix + 1, iy + 1),
+                                {(x - grid.x(ix)) / h, (y - grid.y(iy)) / h}, h);
+  return {s.value, s.gradient};
 }
 
 namespace {

@@ -22,6 +22,8 @@ GreenTable<dim>::GreenTable(const Grid<dim>& grid, double c, const Execution& ex
   for (int d = 0; d < dim; ++d) denominator *= grid.n(d);
   const double scale = 1.0 / denominator;
   const int shift = periodic_ ? 0 : 1, rows = int(entries / size_[0]), row_length = int(size_[0]);
+  const double* k0 = symbol.axis(0).stiffness.data();
+  const double* m0 = symbol.axis(0).mass.data();
 #pragma omp parallel for num_threads(execution.threads()) schedule(static)
   for (int r = 0; r < rows; ++r) {
     std::array<int, dim> slow{};
@@ -36,7 +38,7 @@ GreenTable<dim>::GreenTable(const Grid<dim>& grid, double c, const Execution& ex
     for (int p = 0; p < row_length; ++p) {
       const int ip = p - shift;
       if (ip < 0 || ip >= symbol.axis(0).size()) continue;
-      const double lambda = symbol(ip, factors);
+      const double lambda = Q1Symbol<dim>::lambda(k0[ip], m0[ip], c, factors);
       row[p] = lambda > 0 ? scale / lambda : 0.0;
     }
   }

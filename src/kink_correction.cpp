@@ -326,7 +326,7 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
         const double q = kink.q();
         const Point2 grad = kink.grad_q();
         std::array<double, 4>& v = sums_of(arc_of(kink.t));
-        for (int k = 0; k < 4; ++k) v[k] += w * (dot(grad, basis.gradient[k]) + c * q * basis.value[k]);
+        for (int k = 0; k < 4; ++k) v[k] += w * (dot(grad, basis.gradient(k)) + c * q * basis.value[k]);
       };
       for (std::size_t b = 0; b < rule.nodes.size(); ++b)
         for (std::size_t a = 0; a < rule.nodes.size(); ++a)

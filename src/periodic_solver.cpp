@@ -27,7 +27,9 @@ void PeriodicSolver<dim>::transform(GridVector& v, bool inverse) const {
   double denominator = 1.0;
   for (int d = 0; d < dim; ++d) denominator *= grid_.n(d);
   for (int d = 1; d < dim; ++d) rows *= grid_.n(d);
-  const double norm = 1.0 / denominator;
+  const double norm = 1.0 / denominator, c = symbol_.c();
+  const double* k0 = symbol_.axis(0).stiffness.data();
+  const double* m0 = symbol_.axis(0).mass.data();
 #pragma omp parallel for num_threads(threads_) schedule(static)
   for (int r = 0; r < rows; ++r) {
     std::array<int, dim> slow{};
@@ -35,7 +37,7 @@ void PeriodicSolver<dim>::transform(GridVector& v, bool inverse) const {
     const typename Q1Symbol<dim>::Row factors = symbol_.row(slow);
     std::complex<double>* row = spectrum_.data() + std::size_t(r) * std::size_t(row_length);
     for (int p = 0; p < row_length; ++p) {
-      const double lambda = symbol_(p, factors);
+      const double lambda = Q1Symbol<dim>::lambda(k0[p], m0[p], c, factors);
       if (inverse)
         row[p] *= lambda > 0 ? norm / lambda : 0.0;  // λ = 0 only for the constants at c = 0
       else

@@ -76,7 +76,7 @@ SparseRows normal_derivative_rows(const Grid2& grid, const std::vector<Point2>& 
     const Q1Cell2 cell = q1_cell(grid, p);  // n·∇u_h of the cell holding p
     for (int k = 0; k < Q1Element<2>::n_nodes; ++k)
       builder.add(cell.ix + Q1Element<2>::offset(k, 0), cell.iy + Q1Element<2>::offset(k, 1),
-                  dot(n, cell.element.gradient[k]));
+                  dot(n, cell.element.gradient(k)));
     builder.end_row();
   }
   return rows;

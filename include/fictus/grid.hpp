@@ -71,16 +71,18 @@ class Grid {
   /// Does node i, 0 ≤ i_d ≤ n_d, carry an unknown?
   bool has_unknown(const Index& i) const {
     if (periodic()) return true;
-    for (int d = 0; d < dim; ++d)
-      if (i[d] <= 0 || i[d] >= n_[d]) return false;
-    return true;
+    bool inside = true;
+    for (int d = 0; d < dim; ++d) inside = inside && i[d] > 0 && i[d] < n_[d];
+    return inside;
   }
   /// Storage index of node i; precondition has_unknown(i).
   std::size_t index(const Index& i) const {
     std::size_t k = 0;
-    for (int d = dim - 1; d >= 0; --d)
-      k = periodic() ? k * std::size_t(n_[d]) + std::size_t(wrap(i[d], n_[d]))
-                     : k * std::size_t(n_[d] - 1) + std::size_t(i[d] - 1);
+    if (periodic()) {
+      for (int d = dim - 1; d >= 0; --d) k = k * std::size_t(n_[d]) + std::size_t(wrap(i[d], n_[d]));
+    } else {
+      for (int d = dim - 1; d >= 0; --d) k = k * std::size_t(n_[d] - 1) + std::size_t(i[d] - 1);
+    }
     return k;
   }
   /// The cell along axis d containing coordinate x, clamped to the grid (NaN: 0); cells are half-open.
@@ -100,8 +102,14 @@ class Grid {
   int cell_x(double x) const { return cell(0, x); }
   int cell_y(double y) const requires(dim >= 2) { return cell(1, y); }
   int cell_z(double z) const requires(dim >= 3) { return cell(2, z); }
-  bool has_unknown(int i, int j) const requires(dim == 2) { return has_unknown(Index{i, j}); }
-  std::size_t index(int i, int j) const requires(dim == 2) { return index(Index{i, j}); }
+  // The same as has_unknown(Index)/index(Index), written out for the innermost 2-D loops.
+  bool has_unknown(int i, int j) const requires(dim == 2) {
+    return periodic() || (i > 0 && i < n_[0] && j > 0 && j < n_[1]);
+  }
+  std::size_t index(int i, int j) const requires(dim == 2) {
+    if (periodic()) return std::size_t(wrap(j, n_[1])) * std::size_t(n_[0]) + std::size_t(wrap(i, n_[0]));
+    return std::size_t(j - 1) * std::size_t(n_[0] - 1) + std::size_t(i - 1);
+  }
   bool has_unknown(int i, int j, int k) const requires(dim == 3) { return has_unknown(Index{i, j, k}); }
   std::size_t index(int i, int j, int k) const requires(dim == 3) { return index(Index{i, j, k}); }
 

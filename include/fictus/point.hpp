@@ -48,6 +48,11 @@ double dot(const Point<dim>& a, const Point<dim>& b) {
   for (int d = 1; d < dim; ++d) sum += a[d] * b[d];
   return sum;
 }
+// 2-D written out: these sit in the innermost loops of every 2-D solve.
+inline Point<2> operator+(Point<2> a, const Point<2>& b) { return {a.x + b.x, a.y + b.y}; }
+inline Point<2> operator-(Point<2> a, const Point<2>& b) { return {a.x - b.x, a.y - b.y}; }
+inline Point<2> operator*(double s, Point<2> a) { return {s * a.x, s * a.y}; }
+inline double dot(const Point<2>& a, const Point<2>& b) { return a.x * b.x + a.y * b.y; }
 inline double norm(const Point<2>& a) { return std::hypot(a.x, a.y); }
 inline double norm(const Point<3>& a) { return std::hypot(a.x, a.y, a.z); }
 

@@ -42,10 +42,9 @@ class Q1Symbol {
     }
     return r;
   }
-  double operator()(int p0, const Row& r) const {
-    const Spectrum1d& x = axes_[0];
-    return x.stiffness[p0] * r.M + x.mass[p0] * r.K + c_ * x.mass[p0] * r.M;
-  }
+  double operator()(int p0, const Row& r) const { return lambda(axes_[0].stiffness[p0], axes_[0].mass[p0], c_, r); }
+  /// λ from the first axis' k, m and a row's factors (loops hoist the first axis' arrays and call this).
+  static double lambda(double k0, double m0, double c, const Row& r) { return k0 * r.M + m0 * r.K + c * m0 * r.M; }
 
  private:
   std::vector<Spectrum1d> axes_;  // one per axis

@@ -1,0 +1,52 @@
+#!/usr/bin/env python3
+"""Times two builds of `fictus` on the same problems in one run, alternating, and prints the median
+of each phase (Markdown). Used to check that a change does not slow a solve down:
+
+    bench/compare_builds.py BEFORE_EXE AFTER_EXE [--N 4096] [--repeats 5] [--threads 2]
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import tempfile
+
+parser = argparse.ArgumentParser()
+parser.add_argument("before")
+parser.add_argument("after")
+parser.add_argument("--N", type=int, default=4096)
+parser.add_argument("--repeats", type=int, default=5)
+parser.add_argument("--threads", type=int, default=2)
+args = parser.parse_args()
+
+PHASES = ["load", "u0", "geometry", "green_table", "schur", "newton", "final_solve", "check", "errors", "total"]
+
+
+def run(exe, variant, out):
+    subprocess.run([exe, "solve", "--N", str(args.N), "--variant", variant, "--threads", str(args.threads),
+                    "--no-condition", "--files", "results.json", "--out", out], check=True, capture_output=True)
+    with open(os.path.join(out, "results.json")) as f:
+        r = json.load(f)
+    return r["timings"], r["errors"]["rel_l2_omega"]
+
+
+print(f"| variant | build | " + " | ".join(PHASES) + " | rel. L2(ω) |")
+print("|---|---|" + "---|" * (len(PHASES) + 1))
+with tempfile.TemporaryDirectory() as tmp:
+    for variant in ["nonsmooth", "smooth"]:
+        times = {"before": [], "after": []}
+        errors = {}
+        for _ in range(args.repeats):
+            for name in ["before", "after"]:  # alternating: both see the same machine state
+                t, e = run(getattr(args, name), variant, os.path.join(tmp, name))
+                times[name].append(t)
+                errors[name] = e
+        medians = {name: {p: statistics.median(t.get(p, 0.0) for t in times[name]) for p in PHASES}
+                   for name in times}
+        for name in ["before", "after"]:
+            print(f"| {variant} | {name} | " + " | ".join(f"{medians[name][p]:.3f}" for p in PHASES)
+                  + f" | {errors[name]:.6e} |")
+        ratio = medians["after"]["total"] / medians["before"]["total"]
+        print(f"| {variant} | after/before | " + " | ".join(
+            f"{medians['after'][p] / medians['before'][p]:.3f}" if medians['before'][p] > 0 else "–" for p in PHASES)
+              + " | |")
