@@ -273,10 +273,7 @@ int main(int argc, char** argv) {
       options.multipliers = 0;  // the paper's m at the sweep's N (run_sweep)
       options.condition_number = false;
       sweep_flags.apply(problem, options);
-      sweep_args.N = problem.N;
-      sweep_args.c = problem.c;
-      sweep_args.boundary = problem.boundary;
-      return fictus::cli::run_sweep(sweep_args, options);
+      return fictus::cli::run_sweep(sweep_args, problem, options);
     }
     if (*options_cmd) {
       if (markdown) {

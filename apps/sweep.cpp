@@ -42,7 +42,7 @@ std::vector<double> parse_values(const std::string& text, const std::string& opt
   return values;
 }
 
-int run_sweep(const SweepArguments& args, SolverOptions options) {
+int run_sweep(const SweepArguments& args, const Problem& domain, SolverOptions options) {
   const int kinds = !args.g_scale.empty() + !args.rotate.empty() + !args.move.empty();
   if (kinds != 1) throw std::invalid_argument("sweep: give exactly one of --g-scale, --rotate, --move");
   const std::string parameter = !args.g_scale.empty() ? "g_scale" : !args.rotate.empty() ? "rotate" : "move";
@@ -51,8 +51,8 @@ int run_sweep(const SweepArguments& args, SolverOptions options) {
                                                                          : args.move,
                                                   "--" + parameter);
 
-  const Problem base = paper_problem(args.N, args.c, args.boundary);
-  if (options.multipliers == 0) options.multipliers = paper_multipliers(args.N);
+  const Problem base = paper_problem(domain.N, domain.c, domain.boundary);
+  if (options.multipliers == 0) options.multipliers = paper_multipliers(domain.N);
   FictitiousDomainSolver solver(base, options);
   std::ostringstream csv;
   csv.precision(12);

@@ -404,8 +404,7 @@ void SolverOptions::validate() const {
 
 void validate_options(const Problem& problem, const SolverOptions& options) {
   for (const OptionSpec& spec : option_specs()) checked(spec, spec.get(problem, options));
-  if (problem.boundary == Boundary::periodic && problem.N % 2 != 0)
-    throw std::invalid_argument("domain.N: a periodic box needs an even N, got " + std::to_string(problem.N));
+  (void)Grid2(problem.box, problem.N, problem.boundary);  // the box must hold whole cells; periodic: even counts
 }
 
 std::string options_markdown() {

@@ -4,6 +4,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "fictus/options.hpp"
+
 namespace fictus {
 
 Spectrum1d::Spectrum1d(int n_cells, double h, Boundary boundary) {
@@ -21,7 +23,7 @@ Spectrum1d::Spectrum1d(int n_cells, double h, Boundary boundary) {
 
 template <int dim>
 Q1Symbol<dim>::Q1Symbol(const Grid<dim>& grid, double c) : c_(c) {
-  if (!(c >= 0.0) || !std::isfinite(c)) throw std::invalid_argument("data.c: must be finite and >= 0");
+  checked(*find_option("c"), c);  // the rule of data.c, written once in options.cpp
   for (int d = 0; d < dim; ++d) axes_.emplace_back(grid.n(d), grid.h(), grid.boundary());
 }
 

@@ -55,7 +55,8 @@ OptionValue parse_option_text(const OptionSpec& spec, const std::string& text);
 void set_option(const OptionSpec& spec, Problem& problem, SolverOptions& options, OptionValue value);
 /// The value as text: what `fictus options`, the help and the docs print ("1e-09", "\"smooth\"").
 std::string option_text(const OptionSpec& spec, const OptionValue& value);
-/// Checks every option of (problem, options) against its rule; throws naming the first one broken.
+/// Checks every option of (problem, options) against its rule, and that the box and N make a grid
+/// (whole cells, even counts on a periodic box); throws naming the first one broken.
 void validate_options(const Problem& problem, const SolverOptions& options);
 /// The largest `threads` accepted: 4 × the hardware threads (at least 4).
 int max_threads();

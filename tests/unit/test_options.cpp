@@ -62,7 +62,9 @@ TEST(Options, BadValuesAreRejectedNamingTheKey) {
   fictus::Problem p;
   p.boundary = fictus::Boundary::periodic;
   p.N = 129;
-  EXPECT_NE(error_of([&] { fictus::validate_options(p, fictus::SolverOptions{}); }).find("domain.N: a periodic box"),
+  EXPECT_NE(error_of([&] {
+              fictus::validate_options(p, fictus::SolverOptions{});
+            }).find("domain.N: a periodic box needs an even"),
             std::string::npos);
 }
 
