@@ -107,7 +107,9 @@ std::vector<Case> cases() {
   return list;
 }
 
-/// Every number of `expected` against `actual`, to `tolerance` relative (1e-14 absolute near zero).
+/// Every number of `expected` against `actual`, to `tolerance` relative, or 1e-14 absolute: the
+/// round-off of quantities of order one or smaller that are formed by cancellation (the relative error
+/// norms, u_h − u over |u| ≈ 1e-4 … 1e-7, move by ~1e-15 when u_h does; gaps at round-off).
 void compare(const json& expected, const json& actual, const std::string& where, double tolerance) {
   if (expected.is_number()) {
     ASSERT_TRUE(actual.is_number()) << where;
