@@ -9,7 +9,7 @@ DEBIAN_PACKAGES = cmake g++ make pkg-config libfftw3-dev libeigen3-dev libcli11-
                   libmuparser-dev libtomlplusplus-dev python3 python3-dev python3-numpy python3-matplotlib \
                   python3-vtk9 python3-pytest pybind11-dev clang-format
 
-.PHONY: deps configure build run test bench references manufactured format clean
+.PHONY: deps configure build run test bench references manufactured format options-table clean
 
 deps:
 	@missing=""; for p in $(DEBIAN_PACKAGES); do \
@@ -49,6 +49,12 @@ manufactured:
 FORMAT_FILES = $(shell find src include apps python tests bench -name '*.[ch]pp' ! -name manufactured_solutions.hpp)
 format:
 	clang-format -i $(FORMAT_FILES)
+
+# Rewrite the options table of docs/problem_files.md from `fictus options --markdown` (a ctest compares them).
+options-table: build
+	$(BUILD_DIR)/apps/fictus options --markdown > $(BUILD_DIR)/options.md
+	sed -i -e '/<!-- options table: generated/,/<!-- end of the options table -->/{//!d}' \
+	       -e '/<!-- options table: generated/r $(BUILD_DIR)/options.md' docs/problem_files.md
 
 clean:
 	rm -rf $(BUILD_DIR)

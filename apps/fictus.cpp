@@ -63,7 +63,7 @@ std::pair<int, int> parse_levels(const std::string& text) {
   std::smatch match;
   if (!std::regex_match(text, match, pattern)) throw std::invalid_argument("--levels: expected A-B, e.g. 7-10");
   const int a = std::stoi(match[1]), b = match[2].matched ? std::stoi(match[2]) : a;
-  if (a < 3 || b > 15 || a > b) throw std::invalid_argument("--levels: need 3 <= A <= B <= 15 (h = 2^-level)");
+  if (a < 3 || b > 14 || a > b) throw std::invalid_argument("--levels: need 3 <= A <= B <= 14 (h = 2^-level)");
   return {a, b};
 }
 
@@ -94,24 +94,28 @@ int run_solve(const std::string& problem_path, const fictus::cli::OptionFlags& f
   for (const std::string& w : spec.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
 
   const fictus::Problem& problem = spec.problem;
+  if (!spec.output.dir.empty()) fictus::cli::check_output_folder(spec.output.dir, spec.output.files);
+  fictus::check_memory(problem, spec.options);
   fictus::Solution solution = fictus::solve(problem, spec.options);
   solution.peak_memory_bytes = fictus::peak_memory_bytes();
   if (!solution.newton.converged) throw std::runtime_error(fictus::describe_newton_failure(solution));
   print_summary(solution);
   if (!spec.output.dir.empty()) {
     const fs::path dir = spec.output.dir;
-    fs::create_directories(dir);
+    std::vector<fictus::cli::OutputFile> files;
     for (const std::string& name : spec.output.files) {
       if (name == "results.json")
-        fictus::cli::write_atomically(dir / name, fictus::cli::solution_to_json(problem, solution).dump(2) + "\n");
+        files.push_back({name, [&](std::ostream& out) {
+                           out << fictus::cli::solution_to_json(problem, solution).dump(2) << "\n";
+                         }});
       else if (name == "points.csv")
-        fictus::cli::write_atomically(dir / name, fictus::cli::points_csv(solution));
+        files.push_back({name, [&](std::ostream& out) { out << fictus::cli::points_csv(solution); }});
       else if (name == "solution.vti")
-        fictus::cli::write_atomically(dir / name,
-                                      [&](std::ostream& out) { fictus::cli::write_vti(out, problem, solution); });
+        files.push_back({name, [&](std::ostream& out) { fictus::cli::write_vti(out, problem, solution); }});
       else if (name == "curves.vtp")
-        fictus::cli::write_atomically(dir / name, [&](std::ostream& out) { fictus::cli::write_vtp(out, solution); });
+        files.push_back({name, [&](std::ostream& out) { fictus::cli::write_vtp(out, solution); }});
     }
+    fictus::cli::write_output_set(dir, files);
     std::printf("wrote %zu files to %s/\n", spec.output.files.size(), spec.output.dir.c_str());
   }
   return 0;
@@ -137,6 +141,7 @@ int run_plot(const std::string& folder) {
 int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out, const std::string& table,
                   const std::string& levels_text) {
   const auto [first, last] = parse_levels(levels_text);
+  if (!out.empty()) fictus::cli::check_output_folder(out, {"table1.json", "table1.csv", "table2.json", "table2.csv"});
   std::vector<fictus::Variant> variants;
   if (table == "1" || table == "both") variants.push_back(fictus::Variant::nonsmooth);
   if (table == "2" || table == "both") variants.push_back(fictus::Variant::smooth);
@@ -153,6 +158,7 @@ int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out,
       fictus::Problem problem = fictus::paper_problem(N);
       fictus::SolverOptions options = fictus::paper_options(N, variant);  // the paper's m and δ
       flags.apply(problem, options);
+      fictus::check_memory(problem, options);
       fictus::Solution s = fictus::solve(problem, options);
       s.peak_memory_bytes = fictus::peak_memory_bytes();
       if (!s.newton.converged) {
@@ -178,8 +184,9 @@ int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out,
     files.emplace_back("table" + std::to_string(number) + ".csv", fictus::cli::levels_csv(rows));
   }
   if (!out.empty()) {
-    fs::create_directories(out);
-    for (const auto& [name, text] : files) fictus::cli::write_atomically(fs::path(out) / name, text);
+    std::vector<fictus::cli::OutputFile> set;
+    for (const auto& [name, text] : files) set.push_back({name, [&text](std::ostream& o) { o << text; }});
+    fictus::cli::write_output_set(out, set);
     std::printf("wrote %zu files to %s/\n", files.size(), out.c_str());
   }
   return status;

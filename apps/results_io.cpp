@@ -1,7 +1,10 @@
 #include "results_io.hpp"
 
 #include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -110,23 +113,74 @@ LevelResult level_result(const Solution& s) {
   return r;
 }
 
-void write_atomically(const std::filesystem::path& path, const std::string& text) {
-  write_atomically(path, [&](std::ostream& out) { out << text; });
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The nearest existing folder at or above `dir` ("." for a relative path with none).
+fs::path existing_ancestor(const fs::path& dir) {
+  fs::path p = dir;
+  std::error_code error;
+  while (!p.empty() && !fs::exists(p, error)) p = p.parent_path();
+  return p.empty() ? fs::path(".") : p;
 }
 
-void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& writer) {
-  const std::filesystem::path tmp = path.string() + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw std::runtime_error("output: cannot write " + tmp.string());
-    writer(out);
-    out.flush();
-    if (!out) {
-      std::filesystem::remove(tmp);
-      throw std::runtime_error("output: cannot write " + tmp.string());
+std::string reason(const std::error_code& error) { return error ? error.message() : std::string("unknown error"); }
+
+}  // namespace
+
+void check_output_folder(const fs::path& dir, const std::vector<std::string>& names) {
+  std::error_code error;
+  const std::string shown = dir.string().substr(0, 120);
+  if (fs::exists(dir, error) && !fs::is_directory(dir, error))
+    throw std::invalid_argument("output.dir: " + shown + " exists and is not a folder");
+  const fs::path base = existing_ancestor(dir);
+  if (!fs::is_directory(base, error)) throw std::invalid_argument("output.dir: " + base.string() + " is not a folder");
+  if (::access(base.c_str(), W_OK | X_OK) != 0)
+    throw std::invalid_argument("output.dir: cannot write in " + base.string().substr(0, 120) + " (" +
+                                std::strerror(errno) + ")");
+  // The temporary folder goes beside `dir`: its parent must be writable too once `dir` exists.
+  const fs::path parent = existing_ancestor(dir.has_parent_path() ? dir.parent_path() : fs::path("."));
+  if (::access(parent.c_str(), W_OK | X_OK) != 0)
+    throw std::invalid_argument("output.dir: cannot write in " + parent.string().substr(0, 120) + " (" +
+                                std::strerror(errno) + ")");
+  for (const std::string& name : names)
+    if (fs::is_directory(dir / name, error))
+      throw std::invalid_argument("output.dir: " + (dir / name).string().substr(0, 120) + " is a folder, not a file");
+}
+
+void write_output_set(const fs::path& dir, const std::vector<OutputFile>& files) {
+  std::vector<std::string> names;
+  for (const OutputFile& f : files) names.push_back(f.name);
+  check_output_folder(dir, names);
+  const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
+  std::string hidden = dir.filename().string();  // ".<dir>.tmp-<pid>", built up (GCC 12 warns on "." + s)
+  hidden.insert(hidden.begin(), '.');
+  hidden += ".tmp-";
+  hidden += std::to_string(::getpid());
+  const fs::path tmp = parent / hidden;
+  std::error_code error;
+  try {
+    fs::create_directories(parent);
+    fs::remove_all(tmp, error);
+    if (!fs::create_directory(tmp, error))
+      throw std::runtime_error("output: cannot make a temporary folder: " + reason(error));
+    for (const OutputFile& f : files) {  // 1. every file into the temporary folder
+      std::ofstream out(tmp / f.name, std::ios::binary);
+      if (out) f.write(out);
+      if (out) out.flush();
+      if (!out) throw std::runtime_error("output: cannot write " + f.name + ": " + std::strerror(errno));
     }
+    fs::create_directories(dir);  // 2. all written: move them into place
+    for (const OutputFile& f : files) {
+      fs::rename(tmp / f.name, dir / f.name, error);
+      if (error) throw std::runtime_error("output: cannot move " + f.name + " into place: " + reason(error));
+    }
+    fs::remove_all(tmp, error);
+  } catch (...) {
+    fs::remove_all(tmp, error);
+    throw;
   }
-  std::filesystem::rename(tmp, path);
 }
 
 std::string points_csv(const Solution& s) {

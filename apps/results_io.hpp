@@ -20,10 +20,20 @@ nlohmann::json options_schema_json();
 nlohmann::json solution_to_json(const Problem& problem, const Solution& solution);
 LevelResult level_result(const Solution& solution);
 
-/// Writes `text` to `path` through a temporary file in the same folder and a rename, so a reader
-/// never sees a half-written file and an old file survives a failed write.
-void write_atomically(const std::filesystem::path& path, const std::string& text);
-void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& writer);
+/// A file of an output set: its name in the folder and what writes it.
+struct OutputFile {
+  std::string name;
+  std::function<void(std::ostream&)> write;
+};
+
+/// Throws "output.dir: …" unless `dir` is (or can be made as) a writable folder whose listed files
+/// can be replaced. Called before any work, so that a long solve does not end in a folder error.
+void check_output_folder(const std::filesystem::path& dir, const std::vector<std::string>& names);
+
+/// Writes the files as one set: all into a temporary folder beside `dir`, then moved into `dir`
+/// only when every write succeeded; on any failure nothing in `dir` changes and the temporary
+/// folder is removed. Throws std::runtime_error "output: cannot write <name>: <reason>".
+void write_output_set(const std::filesystem::path& dir, const std::vector<OutputFile>& files);
 
 std::string points_csv(const Solution& solution);
 std::string levels_csv(const std::vector<LevelResult>& rows);

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/io/process.hpp"
 #include "fictus/paper_problem.hpp"
 #include "results_io.hpp"
 
@@ -51,8 +52,10 @@ int run_sweep(const SweepArguments& args, const Problem& domain, SolverOptions o
                                                                          : args.move,
                                                   "--" + parameter);
 
+  if (!args.out.empty()) check_output_folder(args.out, {"sweep.csv"});
   const Problem base = paper_problem(domain.N, domain.c, domain.boundary);
   if (options.multipliers == 0) options.multipliers = paper_multipliers(domain.N);
+  check_memory(base, options);
   FictitiousDomainSolver solver(base, options);
   std::ostringstream csv;
   csv.precision(12);
@@ -84,8 +87,7 @@ int run_sweep(const SweepArguments& args, const Problem& domain, SolverOptions o
   else
     std::printf("\n");
   if (!args.out.empty()) {
-    std::filesystem::create_directories(args.out);
-    write_atomically(std::filesystem::path(args.out) / "sweep.csv", csv.str());
+    write_output_set(args.out, {{"sweep.csv", [&](std::ostream& out) { out << csv.str(); }}});
     std::printf("wrote %s/sweep.csv\n", args.out.c_str());
   }
   if (failures) {

@@ -24,6 +24,7 @@ PySolution PyProblem::solve(bool field) {
     errors_->message.clear();
   }
   std::shared_ptr<const Solution> solution;
+  check_memory(spec.problem, spec.options);
   try {
     py::gil_scoped_release release;
     if (field) {

@@ -64,6 +64,30 @@ bool same_curve_options(const SolverOptions& a, const SolverOptions& b) {
          a.krylov_tolerance == b.krylov_tolerance && a.krylov_max_iterations == b.krylov_max_iterations;
 }
 
+/// The largest |u₀|, |g|, |λ| a solve accepts: the Newton residuals, the LU and the norms square
+/// these values, which must stay far from the overflow at 1.8e308.
+constexpr double largest_scale = 1e100;
+
+template <class Vector>
+bool all_finite(const Vector& v) {
+  for (double x : v)
+    if (!std::isfinite(x)) return false;
+  return true;
+}
+
+template <class Vector>
+double max_abs(const Vector& v) {
+  double m = 0;
+  for (double x : v) m = std::max(m, std::abs(x));
+  return m;
+}
+
+std::string format_number(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3g", v);
+  return buffer;
+}
+
 std::string format_point(Point2 p) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "(%.6g, %.6g)", p.x, p.y);
@@ -135,8 +159,13 @@ void load_and_u0(State& st, PhaseClock& clock, std::size_t& fast_solves) {
     st.load_total += v;
   }
   clock.mark("load");
+  const double largest_load = max_abs(st.u0);
   st.fast->solve_in_place(st.u0);
   ++fast_solves;
+  if (!all_finite(st.u0) || max_abs(st.u0) > largest_scale)
+    throw std::invalid_argument("data.f: u0 = A^-1 f reaches " + format_number(max_abs(st.u0)) +
+                                " (load entries up to " + format_number(largest_load) + "), beyond " +
+                                format_number(largest_scale) + ": rescale the problem (u, f and g by one factor)");
   st.have_u0 = true;
   clock.mark("u0");
 }
@@ -204,6 +233,9 @@ std::vector<double> obstacle(const ContactData& data, const BoundaryDiscretizati
       g[i] = data.g(p[i].x, p[i].y);
     if (!std::isfinite(g[i]))
       throw std::invalid_argument("data.g: not finite at the collocation point " + format_point(p[i]));
+    if (std::abs(g[i]) > largest_scale)
+      throw std::invalid_argument("data.g: " + format_number(g[i]) + " at " + format_point(p[i]) + " is beyond " +
+                                  format_number(largest_scale) + ": rescale the problem (u, f and g by one factor)");
   }
   return g;
 }
@@ -223,6 +255,10 @@ void newton(const CurveSetup& setup, const SolverOptions& options, Solution& sol
   if (options.condition_number) sol.condition_number = setup.schur->condition_number(sol.newton.active);
   sol.lambda.assign(sol.newton.lambda.data(), sol.newton.lambda.data() + sol.newton.lambda.size());
   sol.alpha = sol.newton.alpha;
+  if (!all_finite(sol.lambda) || !std::isfinite(sol.alpha) || max_abs(sol.lambda) > largest_scale)
+    throw std::invalid_argument("data.g: the multipliers reach " + format_number(max_abs(sol.lambda)) + " (|g| up to " +
+                                format_number(max_abs(sol.g)) + "), beyond " + format_number(largest_scale) +
+                                ": rescale the problem (u, f and g by one factor)");
 }
 
 /// Step 6: û = u₀ + A⁻¹ loadsᵀλ + α, finished by the boundary (the kink-corrected field I_h w in the
@@ -234,6 +270,8 @@ void field(const State& st, const BoundaryDiscretization& boundary, Solution& so
   ++fast_solves;
   for (std::size_t k = 0; k < u.size(); ++k) u[k] += st.u0[k] + sol.alpha;
   boundary.finish_field(sol.lambda, u);
+  if (!all_finite(u))
+    throw std::invalid_argument("data: the field u is not finite: the data are too large for double precision");
   sol.u = std::move(u);
   boundary.B_gamma().multiply(sol.u, sol.trace);
   boundary.C_gamma().multiply(sol.u, sol.normal_derivative);
@@ -339,11 +377,30 @@ Solution FictitiousDomainSolver::solve(const ContactData& data, SolverOptions op
   if ((data.exact || data.exact_vectorized) && compute_field) {  // 8
     sol.point_errors = point_errors(data, boundary, st.grid, sol);
     sol.errors = boundary.errors(sol.u, data, options.error_quadrature, st.execution);
+    const ErrorNorms& e = *sol.errors;
+    for (double v : {e.l2_omega, e.h1semi_omega, e.l2_gamma, e.rel_l2_omega, e.rel_h1_omega, e.rel_l2_gamma})
+      if (!std::isfinite(v))
+        throw std::invalid_argument("data.exact: not finite somewhere in omega or on gamma (or its gradient is not)");
     clock.mark("errors");
   }
   sol.options = options;
   sol.options.multipliers = boundary.collocation().m;
   return sol;
+}
+
+std::size_t estimated_peak_bytes(const Problem& problem, const SolverOptions& options) {
+  const double h = problem.box.width(0) / problem.N;
+  const double nodes = (double(problem.N) + 1) * (std::floor(problem.box.width(1) / h + 0.5) + 1);
+  double m = options.multipliers;
+  if (m == 0) {
+    const double L = problem.gamma ? ArcLengthTable(*problem.gamma, 256).length()
+                                   : 2 * (problem.box.width(0) + problem.box.width(1));
+    const double cells =
+        options.variant == Variant::smooth ? default_spacing_cells_smooth : default_spacing_cells_nonsmooth;
+    m = std::max(double(minimum_multipliers), L / (cells * h));
+  }
+  const double bytes = 3 * 8 * nodes + 4 * 8 * m * m + 32.0 * (1 << 20);
+  return bytes > 1.8e19 ? std::size_t(1.8e19) : std::size_t(bytes);
 }
 
 std::string describe_newton_failure(const Solution& s) {

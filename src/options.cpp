@@ -243,6 +243,9 @@ std::vector<OptionSpec> make_specs() {
     };
     specs.push_back(t);
   }
+  specs.push_back(number("solver", "max_memory", &SolverOptions::max_memory, 0.0, false, 1e6, false,
+                         "GiB a solve may use (checked against an estimate before any grid array is made); "
+                         "0 = the memory available when the solve starts"));
   specs.push_back(integer("solver", "load_quadrature", &SolverOptions::load_quadrature, 1, 8,
                           "Gauss points per direction per cell for the load"));
   specs.push_back(integer("solver", "error_quadrature", &SolverOptions::error_quadrature, 1, 12,

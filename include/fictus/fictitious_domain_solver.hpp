@@ -104,6 +104,12 @@ class FictitiousDomainSolver {
   std::unique_ptr<State> state_;
 };
 
+/// The peak memory of a solve, estimated before anything is allocated: three grid arrays (u₀, the
+/// field, and the Green's table or the Krylov work vector) of 8 bytes per node, four dense m×m blocks
+/// (S_B, S_C, the Newton matrix and its LU), and 32 MiB for the rest. m is the one the solve will use
+/// (the default rule, with the curve's length). Measured peaks at h = 1/1024 … 1/4096 are within 10 %.
+std::size_t estimated_peak_bytes(const Problem& problem, const SolverOptions& options);
+
 /// The one-line report of a Newton failure, with its history (what the CLI and the bindings print).
 std::string describe_newton_failure(const Solution& solution);
 

@@ -32,6 +32,7 @@ struct SolverOptions {
   int error_quadrature = 3;      // Gauss points per direction for the error integrals (exact for |∇e|²)
   bool condition_number = true;  // of the final Newton matrix (green path only)
   int threads = 1;
+  double max_memory = 0;  // GiB a solve may use; 0: the memory available when it starts
 
   /// Throws std::invalid_argument naming the option when a value breaks its rule (options.hpp).
   void validate() const;

@@ -40,6 +40,7 @@ WALK = {
     "max_newton": 40,
     "start": "zero",
     "threads": 2,
+    "max_memory": 16.0,
     "load_quadrature": 3,
     "error_quadrature": 4,
     "condition_number": False,

@@ -2,9 +2,19 @@
 // What the operating system says about this process (Linux /proc), for reports.
 #include <cstddef>
 
+#include "fictus/problem.hpp"
+
 namespace fictus {
 
 /// Peak resident memory of this process in bytes (VmHWM; 0 where unknown).
 std::size_t peak_memory_bytes();
+
+/// Memory the system can give without swapping (MemAvailable; 0 where unknown).
+std::size_t available_memory_bytes();
+
+/// Refuses a solve whose estimated peak (estimated_peak_bytes) exceeds options.max_memory GiB, or the
+/// available memory when that is 0: throws std::invalid_argument naming domain.N, the estimate and
+/// the limit. Call it before the solver is made.
+void check_memory(const Problem& problem, const SolverOptions& options);
 
 }  // namespace fictus
