@@ -31,6 +31,23 @@ using nlohmann::json;
 
 namespace {
 
+// Exit codes, one per class of failure (docs/usage.md).
+constexpr int exit_bad_input = 1, exit_newton = 2, exit_output = 3, exit_internal = 4;
+
+/// Newton did not converge (exit code 2).
+struct NewtonFailure : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// The one error line: "fictus: error: <message>", at most 240 characters, on stderr.
+int report(const std::string& message, int code) {
+  std::string line = message.size() > 232 ? message.substr(0, 229) + "..." : message;
+  for (char& c : line)
+    if (c == '\n' || c == '\r') c = ' ';
+  std::fprintf(stderr, "fictus: error: %s\n", line.c_str());
+  return code;
+}
+
 bool formulation_or_solver(const fictus::OptionSpec& s) { return s.section == "formulation" || s.section == "solver"; }
 
 void print_summary(const fictus::Solution& s) {
@@ -98,7 +115,7 @@ int run_solve(const std::string& problem_path, const fictus::cli::OptionFlags& f
   fictus::check_memory(problem, spec.options);
   fictus::Solution solution = fictus::solve(problem, spec.options);
   solution.peak_memory_bytes = fictus::peak_memory_bytes();
-  if (!solution.newton.converged) throw std::runtime_error(fictus::describe_newton_failure(solution));
+  if (!solution.newton.converged) throw NewtonFailure(fictus::describe_newton_failure(solution));
   print_summary(solution);
   if (!spec.output.dir.empty()) {
     const fs::path dir = spec.output.dir;
@@ -267,8 +284,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::Success& e) {
     return app.exit(e);  // --version
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "fictus: error: %s (see fictus --help)\n", e.what());
-    return 1;
+    return report(std::string(e.what()) + " (see fictus --help)", exit_bad_input);
   }
   try {
     if (*solve_cmd) return run_solve(problem_path, solve_flags, out_option, out, files, files_option);
@@ -295,11 +311,15 @@ int main(int argc, char** argv) {
       return 0;
     }
   } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "fictus: error: %s\n", e.what());
-    return 1;
+    return report(e.what(), exit_bad_input);
+  } catch (const NewtonFailure& e) {
+    return report(e.what(), exit_newton);
+  } catch (const fictus::cli::OutputError& e) {
+    return report(e.what(), exit_output);
+  } catch (const std::bad_alloc&) {
+    return report("out of memory (a smaller N, or check solver.max_memory)", exit_internal);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "fictus: error: %s\n", e.what());
-    return 2;
+    return report(e.what(), exit_internal);
   }
   return 0;
 }

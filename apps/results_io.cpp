@@ -164,17 +164,17 @@ void write_output_set(const fs::path& dir, const std::vector<OutputFile>& files)
     fs::create_directories(parent);
     fs::remove_all(tmp, error);
     if (!fs::create_directory(tmp, error))
-      throw std::runtime_error("output: cannot make a temporary folder: " + reason(error));
+      throw OutputError("output: cannot make a temporary folder: " + reason(error));
     for (const OutputFile& f : files) {  // 1. every file into the temporary folder
       std::ofstream out(tmp / f.name, std::ios::binary);
       if (out) f.write(out);
       if (out) out.flush();
-      if (!out) throw std::runtime_error("output: cannot write " + f.name + ": " + std::strerror(errno));
+      if (!out) throw OutputError("output: cannot write " + f.name + ": " + std::strerror(errno));
     }
     fs::create_directories(dir);  // 2. all written: move them into place
     for (const OutputFile& f : files) {
       fs::rename(tmp / f.name, dir / f.name, error);
-      if (error) throw std::runtime_error("output: cannot move " + f.name + " into place: " + reason(error));
+      if (error) throw OutputError("output: cannot move " + f.name + " into place: " + reason(error));
     }
     fs::remove_all(tmp, error);
   } catch (...) {

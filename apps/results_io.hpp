@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <functional>
 #include <ostream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,11 @@ nlohmann::json options_schema_json();
 nlohmann::json solution_to_json(const Problem& problem, const Solution& solution);
 LevelResult level_result(const Solution& solution);
 
+/// An output file could not be written (exit code 3).
+struct OutputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 /// A file of an output set: its name in the folder and what writes it.
 struct OutputFile {
   std::string name;
@@ -32,7 +38,7 @@ void check_output_folder(const std::filesystem::path& dir, const std::vector<std
 
 /// Writes the files as one set: all into a temporary folder beside `dir`, then moved into `dir`
 /// only when every write succeeded; on any failure nothing in `dir` changes and the temporary
-/// folder is removed. Throws std::runtime_error "output: cannot write <name>: <reason>".
+/// folder is removed. Throws OutputError "output: cannot write <name>: <reason>".
 void write_output_set(const std::filesystem::path& dir, const std::vector<OutputFile>& files);
 
 std::string points_csv(const Solution& solution);

@@ -33,19 +33,25 @@ const char* section_of(const std::string& key) {
   return spec ? spec->section.c_str() : nullptr;
 }
 
-void insert(toml::table& table, const std::string& key, py::handle value, const std::string& where);
+/// Deeper than any problem description: a self-referential or absurdly nested value stops here.
+constexpr int max_depth = 16;
 
-toml::array to_array(py::handle list, const std::string& where) {
+void insert(toml::table& table, const std::string& key, py::handle value, const std::string& where, int depth = 0);
+
+toml::array to_array(py::handle list, const std::string& where, int depth) {
   toml::array a;
   for (py::handle item : list) {
     toml::table wrapper;
-    insert(wrapper, "v", item, where);
+    insert(wrapper, "v", item, where, depth + 1);
     a.push_back(*wrapper.get("v"));
   }
   return a;
 }
 
-void insert(toml::table& table, const std::string& key, py::handle value, const std::string& where) {
+void insert(toml::table& table, const std::string& key, py::handle value, const std::string& where, int depth) {
+  if (depth > max_depth)
+    throw std::invalid_argument(where.substr(0, 80) + ": nested more than " + std::to_string(max_depth) +
+                                " levels deep (or it contains itself)");
   if (py::isinstance<py::bool_>(value))
     table.insert_or_assign(key, value.cast<bool>());
   else if (py::isinstance<py::int_>(value))
@@ -56,12 +62,13 @@ void insert(toml::table& table, const std::string& key, py::handle value, const 
     table.insert_or_assign(key, value.cast<std::string>());
   else if (py::isinstance<py::dict>(value)) {
     toml::table sub;
-    for (auto [k, v] : value.cast<py::dict>()) insert(sub, py::str(k), v, where + "." + std::string(py::str(k)));
+    for (auto [k, v] : value.cast<py::dict>())
+      insert(sub, py::str(k), v, where + "." + std::string(py::str(k)).substr(0, 40), depth + 1);
     table.insert_or_assign(key, std::move(sub));
   } else if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value) || py::isinstance<py::array>(value)) {
     const py::object items =
         py::isinstance<py::array>(value) ? value.attr("tolist")() : py::reinterpret_borrow<py::object>(value);
-    table.insert_or_assign(key, to_array(items, where));
+    table.insert_or_assign(key, to_array(items, where, depth));
   } else {
     throw std::invalid_argument(where + ": unsupported value of type " +
                                 std::string(py::str(value.get_type().attr("__name__"))));
@@ -70,37 +77,61 @@ void insert(toml::table& table, const std::string& key, py::handle value, const 
 
 }  // namespace
 
-VectorizedField PyProblem::wrap(py::function fn, const std::string& key) {
+VectorizedField PyProblem::wrap(py::function fn, const std::string& key, std::shared_ptr<CallbackErrors> errors) {
   // The callable is released under the GIL whenever the last copy of the field goes.
   std::shared_ptr<py::function> holder(new py::function(std::move(fn)), [](py::function* f) {
     py::gil_scoped_acquire gil;
     delete f;
   });
-  auto errors = errors_;
   return [holder, key, errors](std::size_t n, const double* x, const double* y, double* out) {
     // Called from solver threads: never throw through them; record the error, return NaN.
     py::gil_scoped_acquire gil;
+    std::string failure;
     try {
       py::array_t<double> xs(n), ys(n);
       std::copy(x, x + n, xs.mutable_data());
       std::copy(y, y + n, ys.mutable_data());
-      const auto values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure((*holder)(xs, ys));
+      const py::array result = py::array::ensure((*holder)(xs, ys));
+      const char kind = result ? result.dtype().kind() : 'O';
+      if (kind != 'f' && kind != 'i' && kind != 'u')
+        throw std::invalid_argument("the callable must return real numbers (got " +
+                                    (result ? std::string(py::str(result.dtype())) : std::string("no array")) + ")");
+      const auto values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(result);
       if (!values || (values.size() != py::ssize_t(n) && values.size() != 1))
-        throw std::invalid_argument(key + ": the callable must return one number per point (an array of " +
-                                    std::to_string(n) + ")");
+        throw std::invalid_argument("the callable must return one number per point (an array of " + std::to_string(n) +
+                                    ")");
       for (std::size_t k = 0; k < n; ++k) out[k] = values.data()[values.size() == 1 ? 0 : k];
+      return;
+    } catch (py::error_already_set& e) {
+      if (e.matches(PyExc_KeyboardInterrupt)) {
+        std::lock_guard lock(errors->mutex);
+        errors->interrupted = true;
+      }
+      failure = e.what();
     } catch (const std::exception& e) {
-      std::lock_guard lock(errors->mutex);
-      if (errors->message.empty()) errors->message = key + ": the callable failed: " + e.what();
-      std::fill(out, out + n, std::nan(""));
+      failure = e.what();
     }
+    std::lock_guard lock(errors->mutex);
+    if (errors->message.empty()) errors->message = (key + ": the callable failed: " + failure).substr(0, 300);
+    std::fill(out, out + n, std::nan(""));
   };
+}
+
+Problem PyProblem::bound(const std::shared_ptr<CallbackErrors>& errors) const {
+  Problem problem = spec.problem;
+  for (const auto& [key, fn] : callables) {
+    VectorizedField field = wrap(fn, "data." + key, errors);
+    if (key == "f") problem.f = nullptr, problem.f_vectorized = field;
+    if (key == "g") problem.g = nullptr, problem.g_along_curve = nullptr, problem.g_vectorized = field;
+    if (key == "exact") problem.exact = nullptr, problem.exact_vectorized = field;
+  }
+  return problem;
 }
 
 PyProblem PyProblem::from_config(py::dict config) {
   PyProblem p;
   py::dict sections;
-  std::map<std::string, py::function> callables;
+  std::map<std::string, py::function>& callables = p.callables;
   auto section = [&](const std::string& name) -> py::dict {  // created on first use, shared handle
     if (!sections.contains(name)) sections[py::str(name)] = py::dict();
     return sections[py::str(name)];
@@ -133,13 +164,6 @@ PyProblem PyProblem::from_config(py::dict config) {
   std::ostringstream text;
   text << root;
   p.spec = parse_problem_text(text.str(), "problem");
-  Problem& problem = p.spec.problem;
-  for (auto& [key, fn] : callables) {
-    VectorizedField field = p.wrap(fn, "data." + key);
-    if (key == "f") problem.f = nullptr, problem.f_vectorized = field;
-    if (key == "g") problem.g = nullptr, problem.g_along_curve = nullptr, problem.g_vectorized = field;
-    if (key == "exact") problem.exact = nullptr, problem.exact_vectorized = field;
-  }
   return p;
 }
 

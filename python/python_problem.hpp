@@ -13,9 +13,11 @@
 namespace fictus::python {
 
 /// Errors raised inside Python callables while the solver ran (they cannot cross its threads).
+/// One per solve, so that two solves of one Problem (two threads) never see each other's errors.
 struct CallbackErrors {
   std::mutex mutex;
   std::string message;
+  bool interrupted = false;  // Ctrl-C (KeyboardInterrupt) inside a callable
 };
 
 /// A solved problem, as Python sees it.
@@ -46,11 +48,13 @@ class PySolution {
 
 struct PyProblem {
   ProblemSpec spec;
-  std::shared_ptr<CallbackErrors> errors_ = std::make_shared<CallbackErrors>();
+  std::map<std::string, pybind11::function> callables;  // data key ("f", "g", "exact") → numpy callable
 
   static PyProblem from_config(pybind11::dict config);
   static PyProblem paper(int N, double c, const std::string& boundary, pybind11::dict options);
-  VectorizedField wrap(pybind11::function fn, const std::string& key);
+  /// The problem with the callables bound to this solve's error slot.
+  Problem bound(const std::shared_ptr<CallbackErrors>& errors) const;
+  static VectorizedField wrap(pybind11::function fn, const std::string& key, std::shared_ptr<CallbackErrors> errors);
   PySolution solve(bool field);
 };
 

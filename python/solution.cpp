@@ -19,42 +19,54 @@ namespace py = pybind11;
 namespace fictus::python {
 
 PySolution PyProblem::solve(bool field) {
-  {
-    std::lock_guard lock(errors_->mutex);
-    errors_->message.clear();
-  }
+  const auto errors = std::make_shared<CallbackErrors>();  // this solve's own slot
+  const Problem problem = bound(errors);
+  check_memory(problem, spec.options);
   std::shared_ptr<const Solution> solution;
-  check_memory(spec.problem, spec.options);
+  auto raise_callback_error = [&] {
+    std::lock_guard lock(errors->mutex);
+    if (errors->interrupted) {
+      PyErr_SetNone(PyExc_KeyboardInterrupt);
+      throw py::error_already_set();
+    }
+    if (!errors->message.empty()) throw std::invalid_argument(errors->message);
+  };
   try {
     py::gil_scoped_release release;
     if (field) {
-      solution = std::make_shared<const Solution>(fictus::solve(spec.problem, spec.options));
+      solution = std::make_shared<const Solution>(fictus::solve(problem, spec.options));
     } else {
-      FictitiousDomainSolver solver(spec.problem, spec.options);
-      solution = std::make_shared<const Solution>(solver.solve(spec.problem, spec.options, false));
+      FictitiousDomainSolver solver(problem, spec.options);
+      solution = std::make_shared<const Solution>(solver.solve(problem, spec.options, false));
     }
   } catch (const std::invalid_argument&) {
-    std::lock_guard lock(errors_->mutex);
-    if (!errors_->message.empty()) throw std::invalid_argument(errors_->message);
+    raise_callback_error();  // a NaN from a failed callable: report the callable, not the NaN
     throw;
   }
-  if (!errors_->message.empty()) throw std::invalid_argument(errors_->message);
+  raise_callback_error();
   std::const_pointer_cast<Solution>(solution)->peak_memory_bytes = peak_memory_bytes();
   if (!solution->newton.converged) throw std::runtime_error(describe_newton_failure(*solution));
-  return PySolution(solution, spec.problem);
+  return PySolution(solution, problem);
 }
 
 namespace {
 
 /// A 1-D view of a vector owned by the Solution object `owner` (no copy).
+py::array_t<double> read_only(py::array_t<double> a) {
+  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return a;
+}
+
+/// A read-only 1-D view of a vector owned by the Solution object `owner` (no copy).
 py::array_t<double> view(const std::vector<double>& v, py::handle owner) {
-  return py::array_t<double>({py::ssize_t(v.size())}, {py::ssize_t(sizeof(double))}, v.data(), owner);
+  return read_only(py::array_t<double>({py::ssize_t(v.size())}, {py::ssize_t(sizeof(double))}, v.data(), owner));
 }
 
 /// An (n, 2) view of interleaved pairs owned by `owner` (no copy).
 py::array_t<double> pairs_view(const std::vector<double>& v, py::handle owner) {
-  return py::array_t<double>({py::ssize_t(v.size() / 2), py::ssize_t(2)},
-                             {py::ssize_t(2 * sizeof(double)), py::ssize_t(sizeof(double))}, v.data(), owner);
+  return read_only(py::array_t<double>({py::ssize_t(v.size() / 2), py::ssize_t(2)},
+                                       {py::ssize_t(2 * sizeof(double)), py::ssize_t(sizeof(double))}, v.data(),
+                                       owner));
 }
 
 /// Every option of options.hpp in effect, by key (as results.json's `options`).
@@ -73,12 +85,14 @@ void bind_solution(py::module_& m) {
                              [](const PySolution& p) {
                                // û at all (ny+1) × (nx+1) nodes, row j = y_j (zero on a Dirichlet boundary).
                                const Solution& s = p.s();
+                               if (s.u.empty())
+                                 throw std::invalid_argument("u: the field was not computed (solve(field=True))");
                                const Grid2& g = s.grid;
                                py::array_t<double> u({g.ny() + 1, g.nx() + 1});
                                auto a = u.mutable_unchecked<2>();
                                for (int j = 0; j <= g.ny(); ++j)
                                  for (int i = 0; i <= g.nx(); ++i)
-                                   a(j, i) = g.has_unknown(i, j) && !s.u.empty() ? s.u[g.index(i, j)] : 0.0;
+                                   a(j, i) = g.has_unknown(i, j) ? s.u[g.index(i, j)] : 0.0;
                                return u;
                              })
       .def_property_readonly("x",

@@ -137,3 +137,65 @@ def test_trace_rule_and_independent_check():
         assert check["max_difference"] >= check["rms_difference"] >= 0
     assert "kink-corrected" in new.signorini["check"]["rule"]
     assert new.errors["max_normal_derivative_at_points"] < old.errors["max_normal_derivative_at_points"]
+
+
+# ---- hostile input: each raises a clean error naming what is wrong ----
+
+SMALL = dict(N=64, geometry=dict(shape="circle", center=[0.5, 0.5], radius=0.25), variant="nonsmooth")
+
+
+def test_absurd_thread_counts_are_rejected():
+    with pytest.raises(ValueError, match="solver.threads: must be in 1"):
+        fictus.Problem(**SMALL, f="1", g="0", threads=10**6).solve()
+
+
+def test_deep_or_self_referential_values_are_rejected():
+    deep = {}
+    node = deep
+    for _ in range(200000):
+        node["a"] = {}
+        node = node["a"]
+    with pytest.raises(ValueError, match="nested more than"):
+        fictus.Problem(**SMALL, f="1", g="0", domain=deep)
+    looped = {}
+    looped["self"] = looped
+    with pytest.raises(ValueError, match="nested more than"):
+        fictus.Problem(**SMALL, f="1", g="0", solver=looped)
+
+
+@pytest.mark.parametrize("bad", [lambda x, y: x + 1j * y, lambda x, y: np.array(["a"] * len(x))])
+def test_callables_must_return_real_numbers(bad):
+    with pytest.raises(ValueError, match="data.g: the callable failed: the callable must return real numbers"):
+        fictus.Problem(**SMALL, f="1", g=bad).solve()
+
+
+def test_keyboard_interrupt_in_a_callable_stays_a_keyboard_interrupt():
+    def g(x, y):
+        raise KeyboardInterrupt
+    with pytest.raises(KeyboardInterrupt):
+        fictus.Problem(**SMALL, f="1", g=g).solve()
+
+
+def test_result_views_are_read_only_and_a_missing_field_is_an_error():
+    s = fictus.Problem(**SMALL, f="1", g="0").solve(field=False)
+    for name in ["lambda_", "g", "u_gamma", "dudn", "s", "points", "normals"]:
+        array = getattr(s, name)
+        assert not array.flags.writeable, name
+        with pytest.raises(ValueError):
+            array[0] = 1.0
+    with pytest.raises(ValueError, match="the field was not computed"):
+        s.u
+
+
+def test_each_solve_has_its_own_callable_errors():
+    calls = {"n": 0}
+
+    def g(x, y):  # fails on its first call only
+        calls["n"] += 1
+        if calls["n"] == 1:
+            raise RuntimeError("first call fails")
+        return 0 * x
+    p = fictus.Problem(**SMALL, f="1", g=g)
+    with pytest.raises(ValueError, match="first call fails"):
+        p.solve()
+    assert p.solve().converged  # the earlier solve's error does not leak into this one

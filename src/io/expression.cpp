@@ -18,6 +18,16 @@ struct Expression::Shared {
 };
 
 namespace {
+/// An expression as an error message shows it: at most 60 characters, one line.
+std::string shown(const std::string& text) {
+  std::string s = text.size() > 60 ? text.substr(0, 57) + "..." : text;
+  for (char& c : s)
+    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+  return s;
+}
+}  // namespace
+
+namespace {
 
 std::atomic<std::uint64_t> next_id{1};
 
@@ -81,12 +91,13 @@ Expression::Expression(std::string text, std::vector<std::string> variables, std
   try {
     auto c = compile(shared->text, shared->variables);
     c->parser.Eval();  // reports syntax errors
-    const std::string unknown = unassigned_local(shared->text, c->local_names);
+    const std::string unknown = unassigned_local(shared->text, c->local_names).substr(0, 40);
     if (!unknown.empty())
-      throw std::invalid_argument(shared->key + ": cannot parse \"" + shared->text + "\": unknown variable \"" +
+      throw std::invalid_argument(shared->key + ": cannot parse \"" + shown(shared->text) + "\": unknown variable \"" +
                                   unknown + "\" (a local name must be assigned first: \"" + unknown + " = …, …\")");
   } catch (const mu::Parser::exception_type& e) {
-    throw std::invalid_argument(shared->key + ": cannot parse \"" + shared->text + "\": " + e.GetMsg());
+    throw std::invalid_argument(shared->key + ": cannot parse \"" + shown(shared->text) +
+                                "\": " + e.GetMsg().substr(0, 80));
   }
   shared_ = std::move(shared);
 }
