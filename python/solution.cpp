@@ -32,13 +32,18 @@ PySolution PyProblem::solve(bool field) {
     if (!errors->message.empty()) throw std::invalid_argument(errors->message);
   };
   try {
+    FictitiousDomainSolver solver(problem, spec.options);
+    // Ctrl-C: Python's handler runs in PyErr_CheckSignals (this thread, under the GIL) and leaves
+    // KeyboardInterrupt set; the solve stops at its next check.
+    solver.set_interrupt_check([] {
+      py::gil_scoped_acquire gil;
+      return PyErr_CheckSignals() != 0;
+    });
     py::gil_scoped_release release;
-    if (field) {
-      solution = std::make_shared<const Solution>(fictus::solve(problem, spec.options));
-    } else {
-      FictitiousDomainSolver solver(problem, spec.options);
-      solution = std::make_shared<const Solution>(solver.solve(problem, spec.options, false));
-    }
+    solution = std::make_shared<const Solution>(solver.solve(problem, spec.options, field));
+  } catch (const Interrupted&) {
+    if (!PyErr_Occurred()) PyErr_SetNone(PyExc_KeyboardInterrupt);
+    throw py::error_already_set();
   } catch (const std::invalid_argument&) {
     raise_callback_error();  // a NaN from a failed callable: report the callable, not the NaN
     throw;

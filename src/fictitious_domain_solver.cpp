@@ -144,6 +144,10 @@ FictitiousDomainSolver::~FictitiousDomainSolver() = default;
 
 const Grid2& FictitiousDomainSolver::grid() const { return state_->grid; }
 
+void FictitiousDomainSolver::set_interrupt_check(std::function<bool()> check) {
+  state_->execution.set_interrupt_check(std::move(check));
+}
+
 namespace {
 
 using State = FictitiousDomainSolver::State;
@@ -159,6 +163,7 @@ void load_and_u0(State& st, PhaseClock& clock, std::size_t& fast_solves) {
     st.load_total += v;
   }
   clock.mark("load");
+  st.execution.throw_if_interrupted();
   const double largest_load = max_abs(st.u0);
   st.fast->solve_in_place(st.u0);
   ++fast_solves;
@@ -178,6 +183,7 @@ std::unique_ptr<SchurComplement> schur_blocks(State& st, const BoundaryDiscretiz
     gmres.relative_tolerance = options.krylov_tolerance;
     gmres.max_iterations = options.krylov_max_iterations;
     gmres.restart = boundary.n_points() + 1;
+    gmres.between_iterations = [&execution = st.execution] { execution.throw_if_interrupted(); };
     return std::make_unique<ImplicitSchur>(*st.fast, boundary.B_gamma(), boundary.C_gamma(), boundary.loads(), gmres,
                                            boundary.direct());
   }
@@ -241,8 +247,10 @@ std::vector<double> obstacle(const ContactData& data, const BoundaryDiscretizati
 }
 
 /// Step 5: semismooth Newton on λ with the Schur blocks.
-void newton(const CurveSetup& setup, const SolverOptions& options, Solution& sol, std::size_t& fast_solves) {
+void newton(const CurveSetup& setup, const SolverOptions& options, const Execution& execution, Solution& sol,
+            std::size_t& fast_solves) {
   NewtonOptions newton_options;
+  newton_options.between_steps = [&execution] { execution.throw_if_interrupted(); };
   newton_options.rho = options.rho;
   newton_options.max_iterations = options.max_newton;
   newton_options.start_all_active = options.start_all_active;
@@ -354,18 +362,23 @@ Solution FictitiousDomainSolver::solve(const ContactData& data, SolverOptions op
   PhaseClock clock(sol.timings);
   std::size_t fast_solves = 0;
 
-  load_and_u0(st, clock, fast_solves);                                                // 0
+  const Execution& execution = st.execution;
+  load_and_u0(st, clock, fast_solves);  // 0
+  execution.throw_if_interrupted();
   const CurveSetup& setup = curve_setup(st, data, options, clock, sol.reused_curve);  // 1–3
+  execution.throw_if_interrupted();
   const CurveDiscretization& boundary = *setup.boundary;
   sol.collocation = boundary.collocation();
   sol.Gamma = boundary.Gamma();
   sol.delta = boundary.delta();
-  sol.g = obstacle(data, boundary);          // 4
-  newton(setup, options, sol, fast_solves);  // 5
+  sol.g = obstacle(data, boundary);                     // 4
+  newton(setup, options, execution, sol, fast_solves);  // 5
   clock.mark("newton");
+  execution.throw_if_interrupted();
   if (compute_field) {  // 6
     field(st, boundary, sol, fast_solves);
     clock.mark("final_solve");
+    execution.throw_if_interrupted();
   } else {
     sol.trace.assign(sol.newton.trace.data(), sol.newton.trace.data() + sol.newton.trace.size());
     sol.normal_derivative.assign(sol.newton.normal_derivative.data(),

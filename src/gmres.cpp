@@ -23,6 +23,7 @@ GmresReport gmres(const LinearOperator& apply, const Eigen::VectorXd& b, Eigen::
   double previous_cycle = std::numeric_limits<double>::infinity();
   // One application of the cap is kept for the true residual of the final iterate.
   while (report.iterations + 1 < options.max_iterations) {
+    if (options.between_iterations) options.between_iterations();
     apply(x, w);
     ++report.iterations;
     r = b - w;
@@ -41,6 +42,7 @@ GmresReport gmres(const LinearOperator& apply, const Eigen::VectorXd& b, Eigen::
     H.setZero();
     int k = 0;
     for (; k < restart && report.iterations + 1 < options.max_iterations; ++k) {
+      if (options.between_iterations) options.between_iterations();
       apply(V.col(k), w);
       ++report.iterations;
       for (int j = 0; j <= k; ++j) {  // modified Gram–Schmidt, twice for stability

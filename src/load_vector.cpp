@@ -1,6 +1,9 @@
 #include "fictus/load_vector.hpp"
 
+#include <omp.h>
+
 #include <array>
+#include <atomic>
 #include <stdexcept>
 #include <vector>
 
@@ -28,12 +31,15 @@ GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q, con
   for (int b = 0; b < q; ++b)
     for (int a = 0; a < q; ++a) elements.emplace_back(Point2{rule.nodes[a], rule.nodes[b]}, h);
   // Cell rows of one parity write to disjoint node rows {iy, iy+1}: two parallel sweeps.
+  std::atomic<bool> stop = false;  // an interruption seen by thread 0 (the caller's) ends every thread's work
   for (int parity = 0; parity < 2; ++parity) {
 #pragma omp parallel num_threads(execution.threads())
     {
       std::vector<double> xs(std::size_t(nx) * qq), ys(xs.size()), values(xs.size());
 #pragma omp for schedule(dynamic, 4)
       for (int iy = parity; iy < ny; iy += 2) {
+        if (omp_get_thread_num() == 0 && iy % 64 < 2 && execution.interrupt_requested()) stop = true;
+        if (stop) continue;
         for (int ix = 0, k = 0; ix < nx; ++ix)  // the row's quadrature points, cell by cell
           for (int b = 0; b < q; ++b)
             for (int a = 0; a < q; ++a, ++k) {
@@ -57,6 +63,7 @@ GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q, con
       }
     }
   }
+  if (stop) throw Interrupted();
   return load;
 }
 

@@ -1,5 +1,9 @@
 #include "fictus/schur_complement.hpp"
 
+#include <omp.h>
+
+#include <atomic>
+
 #include <algorithm>
 #include <unordered_map>
 #include <utility>
@@ -77,11 +81,14 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>& green, const std:
   }
   std::vector<Eigen::MatrixXd> blocks;
   for (const SparseRows* R : row_sets) blocks.emplace_back(R->n_rows(), Q.n_rows());
+  std::atomic<bool> stop = false;  // an interruption seen by thread 0 (the caller's) ends every thread's work
 #pragma omp parallel num_threads(execution.threads())
   {
     std::vector<double> column(nodes.size());  // (G Qᵀ)(node, col) for the nodes of the rows
 #pragma omp for schedule(dynamic, 4)
     for (int col = 0; col < Q.n_rows(); ++col) {
+      if (omp_get_thread_num() == 0 && col % 8 == 0 && execution.interrupt_requested()) stop = true;
+      if (stop) continue;
       for (std::size_t u = 0; u < nodes.size(); ++u) {
         double sum = 0.0;
         for (std::size_t b = Q.row_begin[col]; b < Q.row_begin[col + 1]; ++b) {
@@ -102,6 +109,7 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>& green, const std:
       }
     }
   }
+  if (stop) throw Interrupted();
   return blocks;
 }
 

@@ -22,6 +22,7 @@ NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::
 
   Eigen::VectorXd d(m), sb, sc;
   for (int k = 0; k < options.max_iterations; ++k) {
+    if (options.between_steps) options.between_steps();
     // 1. Linear solve for the current active set.
     for (int i = 0; i < m; ++i) d(i) = active[i] ? g(i) - b0(i) : -c0(i);
     const LinearSolveReport linear = schur.solve(active, d, mode, result.lambda, result.alpha);

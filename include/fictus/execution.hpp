@@ -1,10 +1,16 @@
 #pragma once
 // Where grid-level work runs: the number of threads (and, for a distributed run, the communicator
 // that will join it). Made once from the options and passed to the objects that do the work.
+#include <functional>
 #include <stdexcept>
 #include <string>
 
 namespace fictus {
+
+/// Thrown when the interruption check of an Execution says stop (e.g. Ctrl-C in Python).
+struct Interrupted : std::runtime_error {
+  Interrupted() : std::runtime_error("interrupted") {}
+};
 
 class Execution {
  public:
@@ -14,8 +20,18 @@ class Execution {
   }
   int threads() const { return threads_; }
 
+  /// A check for a request to stop, polled between the steps of a solve, in Newton and GMRES
+  /// iterations and in the long assembly loops, always on the thread that called solve (OpenMP's
+  /// thread 0). It returns true to stop; the work then ends with Interrupted.
+  void set_interrupt_check(std::function<bool()> check) { interrupt_check_ = std::move(check); }
+  bool interrupt_requested() const { return interrupt_check_ && interrupt_check_(); }
+  void throw_if_interrupted() const {
+    if (interrupt_requested()) throw Interrupted();
+  }
+
  private:
   int threads_;
+  std::function<bool()> interrupt_check_;
 };
 
 }  // namespace fictus

@@ -14,6 +14,7 @@
 //     7. Signorini checks, with an independent ∂u/∂n;
 //     8. errors against an exact solution.
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -91,6 +92,11 @@ class FictitiousDomainSolver {
   FictitiousDomainSolver& operator=(const FictitiousDomainSolver&) = delete;
 
   const Grid2& grid() const;
+
+  /// A check polled on the calling thread between the steps of a solve, in Newton and GMRES
+  /// iterations and in the Schur assembly; when it returns true the solve ends with Interrupted
+  /// (execution.hpp) within about one fast solve. The bindings use it for Ctrl-C.
+  void set_interrupt_check(std::function<bool()> check);
 
   /// Solves with the curve, obstacle and exact solution of `data` and the per-solve options
   /// (options.threads and options.load_quadrature must be the constructor's: they shaped the

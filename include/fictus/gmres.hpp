@@ -15,6 +15,7 @@ struct GmresOptions {
   double relative_tolerance = SolverOptions{}.krylov_tolerance;  // ‖b − Ax‖ ≤ tol·‖b‖
   int max_iterations = SolverOptions{}.krylov_max_iterations;    // operator applications, at most
   int restart = 400;
+  std::function<void()> between_iterations;  // called before each operator application (may throw)
 };
 
 struct GmresReport {

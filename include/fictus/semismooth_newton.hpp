@@ -11,6 +11,7 @@
 //   4. Stop when 𝒜' = 𝒜 and ‖F‖∞ ≤ tol·scale (finite termination); fail when 𝒜' repeats an
 //      older set (cycling) or after max_iterations.
 // λ is not sign-constrained: the B/C rows carry the Signorini conditions.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,7 @@ struct NewtonOptions {
   int max_iterations = SolverOptions{}.max_newton;  // linear solves
   bool start_all_active = SolverOptions{}.start_all_active;
   double tolerance = SolverOptions{}.newton_tolerance;  // ‖F‖∞ ≤ tolerance · max(‖b‖∞, ‖c‖∞, ‖g‖∞)
+  std::function<void()> between_steps;                  // called before each linear solve (may throw)
 };
 
 struct NewtonStep {

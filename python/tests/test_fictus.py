@@ -199,3 +199,16 @@ def test_each_solve_has_its_own_callable_errors():
     with pytest.raises(ValueError, match="first call fails"):
         p.solve()
     assert p.solve().converged  # the earlier solve's error does not leak into this one
+
+
+@pytest.mark.parametrize("schur, N", [("green", 4096), ("krylov", 1024)])  # uninterrupted: ≈ 3 s and ≈ 10 s
+def test_ctrl_c_stops_a_solve_within_a_fraction_of_a_second(schur, N):
+    import signal
+    p = fictus.Problem.paper(N=N, variant="smooth", schur=schur, krylov_tolerance=1e-12)
+    start = time.perf_counter()
+    threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+    with pytest.raises(KeyboardInterrupt):
+        p.solve()
+    stopped = time.perf_counter() - start
+    assert stopped < 0.3 + 1.0, f"stopped {stopped:.2f} s after the start, the signal came at 0.3 s"
+    assert fictus.Problem.paper(N=128).solve().converged  # the module is still usable
