@@ -18,9 +18,9 @@ CurveDiscretization::CurveDiscretization(std::shared_ptr<const Curve> gamma, con
 void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options) {
   const Curve& gamma = *gamma_;
   const double h = grid.h();
+  check_simple(gamma, "geometry");
   if (signed_area(gamma) <= 0)
     throw std::invalid_argument("geometry: the curve must be counter-clockwise (ω on its left)");
-  check_simple(gamma, "geometry");
   check_inside_box(gamma, grid.box(), 2 * h, "geometry");
   gamma_geometry_ = std::make_unique<CurveGridIntersection>(gamma, grid, "geometry");
 

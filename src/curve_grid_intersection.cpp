@@ -53,7 +53,16 @@ CurveGridIntersection::CurveGridIntersection(const Curve& curve, const Grid2& gr
   const Box2& box = grid.box();
   double max_speed = 0.0;
   for (int k = 0; k < 4096; ++k) max_speed = std::max(max_speed, curve.speed(two_pi * k / 4096));
-  const int steps = std::max(256, int(std::ceil(two_pi * max_speed / (h / 8))));
+  // Steps of at most h/8 along the curve; a speed that is not finite, or so large that the walk
+  // would take more than 1e8 steps (a cusp, a blow-up), is not a curve fictus can follow.
+  const double wanted = std::ceil(two_pi * max_speed / (h / 8));
+  if (!(wanted <= 1e8)) {
+    std::ostringstream msg;
+    msg << what << ": the curve's speed |p'(t)| reaches " << max_speed
+        << " (not finite, or a cusp): too irregular to follow";
+    throw std::invalid_argument(msg.str());
+  }
+  const int steps = std::max(256, int(wanted));
   const double dt = two_pi / steps;
 
   auto check_inside_box = [&](Point2 p) {

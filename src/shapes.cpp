@@ -20,10 +20,27 @@ double wrap_parameter(double t) {
 
 double cross(Point2 a, Point2 b) { return a.x * b.y - a.y * b.x; }
 
-bool segments_cross(Point2 a, Point2 b, Point2 c, Point2 d) {
-  const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
-  const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
-  return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0)) && d1 != 0 && d2 != 0 && d3 != 0 && d4 != 0;
+/// The side of c relative to the line a→b: +1 left, −1 right, 0 within `tolerance` (an area) of it.
+int orientation(Point2 a, Point2 b, Point2 c, double tolerance) {
+  const double v = cross(b - a, c - a);
+  return v > tolerance ? 1 : v < -tolerance ? -1 : 0;
+}
+
+/// p, known to be on the line a→b, lies on the segment (ends included, to `slack`).
+bool within(Point2 a, Point2 b, Point2 p, double slack) {
+  return p.x >= std::min(a.x, b.x) - slack && p.x <= std::max(a.x, b.x) + slack && p.y >= std::min(a.y, b.y) - slack &&
+         p.y <= std::max(a.y, b.y) + slack;
+}
+
+/// Do the segments ab and cd meet: cross, touch (an end on the other segment) or overlap along a
+/// line? Orientations within `scale`·1e-12 (of the curve's size) count as collinear.
+bool segments_meet(Point2 a, Point2 b, Point2 c, Point2 d, double scale) {
+  const double area = 1e-12 * scale * scale, slack = 1e-12 * scale;
+  const int o1 = orientation(a, b, c, area), o2 = orientation(a, b, d, area);
+  const int o3 = orientation(c, d, a, area), o4 = orientation(c, d, b, area);
+  if (o1 * o2 < 0 && o3 * o4 < 0) return true;  // a proper crossing
+  return (o1 == 0 && within(a, b, c, slack)) || (o2 == 0 && within(a, b, d, slack)) ||
+         (o3 == 0 && within(c, d, a, slack)) || (o4 == 0 && within(c, d, b, slack));
 }
 }  // namespace
 
@@ -91,8 +108,8 @@ ParametricCurve::ParametricCurve(std::function<double(double)> x, std::function<
 Point2 ParametricCurve::position(double t) const { return {x_(t), y_(t)}; }
 
 StarCurve::StarCurve(Point2 center, std::function<double(double)> r) : center_(center), r_(std::move(r)) {
-  for (int k = 0; k < 1024; ++k) {
-    const double t = two_pi * k / 1024, r = r_(t);
+  for (int k = 0; k <= 65536; ++k) {  // dense: r < 0 or NaN between coarser samples would pass unseen
+    const double t = two_pi * k / 65536, r = r_(t);
     if (!(r > 0) || !std::isfinite(r))
       throw std::invalid_argument("geometry.r: must be positive and finite for all t (r(" + std::to_string(t) +
                                   ") = " + std::to_string(r) + ")");
@@ -158,12 +175,28 @@ void check_simple(const Curve& curve, const std::string& what, int samples) {
   std::sort(t.begin(), t.end());
   t.erase(std::unique(t.begin(), t.end()), t.end());
   std::vector<Point2> p;
-  for (double s : t) p.push_back(curve.position(s));
+  for (double s : t) {
+    p.push_back(curve.position(s));
+    if (!std::isfinite(p.back().x) || !std::isfinite(p.back().y)) {
+      std::ostringstream msg;
+      msg << what << ": the curve is not finite at t = " << s;
+      throw std::invalid_argument(msg.str());
+    }
+  }
   const std::size_t n = p.size();
   // Bucket the segments on a coarse grid so the check stays near-linear.
   double x0 = p[0].x, x1 = x0, y0 = p[0].y, y1 = y0;
   for (const Point2& q : p)
     x0 = std::min(x0, q.x), x1 = std::max(x1, q.x), y0 = std::min(y0, q.y), y1 = std::max(y1, q.y);
+  const double size = std::max(x1 - x0, y1 - y0);
+  {  // closed: p(2π) = p(0) (a jump of x(t), y(t) or r(t) at 2π is not a closed curve)
+    const Point2 gap = curve.position(two_pi) - curve.position(0.0);
+    if (!(norm(gap) <= 1e-9 * size)) {
+      std::ostringstream msg;
+      msg << what << ": the curve is not closed: p(2pi) - p(0) = (" << gap.x << ", " << gap.y << ")";
+      throw std::invalid_argument(msg.str());
+    }
+  }
   const int cells = 64;
   const double wx = (x1 - x0) / cells + 1e-300, wy = (y1 - y0) / cells + 1e-300;
   std::vector<std::vector<std::size_t>> bucket(cells * cells);
@@ -179,9 +212,9 @@ void check_simple(const Curve& curve, const std::string& what, int samples) {
       for (std::size_t v = u + 1; v < segs.size(); ++v) {
         const std::size_t a = segs[u], b = segs[v];
         if (a == b || (a + 1) % n == b || (b + 1) % n == a) continue;
-        if (segments_cross(p[a], p[(a + 1) % n], p[b], p[(b + 1) % n])) {
+        if (segments_meet(p[a], p[(a + 1) % n], p[b], p[(b + 1) % n], size)) {
           std::ostringstream msg;
-          msg << what << ": the curve intersects itself near (" << p[a].x << ", " << p[a].y << ")";
+          msg << what << ": the curve intersects or touches itself near (" << p[a].x << ", " << p[a].y << ")";
           throw std::invalid_argument(msg.str());
         }
       }
