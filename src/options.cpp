@@ -401,8 +401,9 @@ std::string option_text(const OptionSpec& spec, const OptionValue& value) {
 }
 
 void SolverOptions::validate() const {
+  const Problem defaults;  // the solver options do not read it
   for (const OptionSpec& spec : option_specs())
-    if (spec.section == "formulation" || spec.section == "solver") checked(spec, spec.get(Problem{}, *this));
+    if (spec.section == "formulation" || spec.section == "solver") checked(spec, spec.get(defaults, *this));
 }
 
 void validate_options(const Problem& problem, const SolverOptions& options) {

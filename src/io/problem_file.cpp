@@ -38,20 +38,6 @@ class TableReader {
     if (!std::isfinite(*v)) fail(key(k), "must be finite (NaN or Inf given)");
     return *v;
   }
-  int integer(const std::string& k, int fallback) {
-    const toml::node* n = node(k);
-    if (!n) return fallback;
-    if (!n->is_integer()) fail(key(k), std::string("expected an integer, got ") + type_name(*n));
-    const int64_t v = *n->value<int64_t>();
-    if (v < -1000000000 || v > 1000000000) fail(key(k), "out of range");
-    return int(v);
-  }
-  bool boolean(const std::string& k, bool fallback) {
-    const toml::node* n = node(k);
-    if (!n) return fallback;
-    if (!n->is_boolean()) fail(key(k), std::string("expected true or false, got ") + type_name(*n));
-    return *n->value<bool>();
-  }
   std::string string(const std::string& k, const std::string& fallback) {
     const toml::node* n = node(k);
     if (!n) return fallback;

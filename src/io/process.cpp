@@ -9,21 +9,22 @@
 
 namespace fictus {
 
-std::size_t peak_memory_bytes() {
-  std::ifstream status("/proc/self/status");
+namespace {
+
+/// The value of the line "<key> <n> kB" of a /proc file, in bytes (0 where there is none).
+std::size_t proc_kib(const char* file, const std::string& key) {
+  std::ifstream in(file);
   std::string line;
-  while (std::getline(status, line))
-    if (line.rfind("VmHWM:", 0) == 0) return std::size_t(std::stoull(line.substr(6))) * 1024;
+  while (std::getline(in, line))
+    if (line.rfind(key, 0) == 0) return std::size_t(std::stoull(line.substr(key.size()))) * 1024;
   return 0;
 }
 
-std::size_t available_memory_bytes() {
-  std::ifstream meminfo("/proc/meminfo");
-  std::string line;
-  while (std::getline(meminfo, line))
-    if (line.rfind("MemAvailable:", 0) == 0) return std::size_t(std::stoull(line.substr(13))) * 1024;
-  return 0;
-}
+}  // namespace
+
+std::size_t peak_memory_bytes() { return proc_kib("/proc/self/status", "VmHWM:"); }
+
+std::size_t available_memory_bytes() { return proc_kib("/proc/meminfo", "MemAvailable:"); }
 
 void check_memory(const Problem& problem, const SolverOptions& options) {
   const double gib = double(1 << 30);
