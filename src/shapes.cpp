@@ -20,29 +20,86 @@ double wrap_parameter(double t) {
 
 double cross(Point2 a, Point2 b) { return a.x * b.y - a.y * b.x; }
 
-/// The side of c relative to the line a→b: +1 left, −1 right, 0 within `tolerance` (an area) of it.
-int orientation(Point2 a, Point2 b, Point2 c, double tolerance) {
-  const double v = cross(b - a, c - a);
-  return v > tolerance ? 1 : v < -tolerance ? -1 : 0;
+/// p, known to be on the line a→b, lies on the closed segment ab (exact comparisons).
+bool within(Point2 a, Point2 b, Point2 p) {
+  return p.x >= std::min(a.x, b.x) && p.x <= std::max(a.x, b.x) && p.y >= std::min(a.y, b.y) &&
+         p.y <= std::max(a.y, b.y);
 }
 
-/// p, known to be on the line a→b, lies on the segment (ends included, to `slack`).
-bool within(Point2 a, Point2 b, Point2 p, double slack) {
-  return p.x >= std::min(a.x, b.x) - slack && p.x <= std::max(a.x, b.x) + slack && p.y >= std::min(a.y, b.y) - slack &&
-         p.y <= std::max(a.y, b.y) + slack;
+/// Distance from p to the closed segment ab.
+double distance_to_segment(Point2 p, Point2 a, Point2 b) {
+  const Point2 d = b - a;
+  const double dd = d.x * d.x + d.y * d.y;
+  const double t = dd > 0 ? std::clamp(((p.x - a.x) * d.x + (p.y - a.y) * d.y) / dd, 0.0, 1.0) : 0.0;
+  return norm(p - (a + t * d));
 }
 
-/// Do the segments ab and cd meet: cross, touch (an end on the other segment) or overlap along a
-/// line? Orientations within `scale`·1e-12 (of the curve's size) count as collinear.
-bool segments_meet(Point2 a, Point2 b, Point2 c, Point2 d, double scale) {
-  const double area = 1e-12 * scale * scale, slack = 1e-12 * scale;
-  const int o1 = orientation(a, b, c, area), o2 = orientation(a, b, d, area);
-  const int o3 = orientation(c, d, a, area), o4 = orientation(c, d, b, area);
-  if (o1 * o2 < 0 && o3 * o4 < 0) return true;  // a proper crossing
-  return (o1 == 0 && within(a, b, c, slack)) || (o2 == 0 && within(a, b, d, slack)) ||
-         (o3 == 0 && within(c, d, a, slack)) || (o4 == 0 && within(c, d, b, slack));
+/// Adds x to the non-overlapping expansion `partials` (increasing magnitude) exactly: Shewchuk's
+/// grow-expansion with zero elimination, as in Python's math.fsum.
+void grow_expansion(std::vector<double>& partials, double x) {
+  std::size_t kept = 0;
+  for (double y : partials) {
+    if (std::abs(x) < std::abs(y)) std::swap(x, y);
+    const double hi = x + y, lo = y - (hi - x);
+    if (lo != 0) partials[kept++] = lo;
+    x = hi;
+  }
+  partials.resize(kept);
+  partials.push_back(x);
+}
+
+/// The sign of the exact sum of `terms`: the sign of the largest component of their expansion.
+int exact_sign_of_sum(std::initializer_list<double> terms) {
+  std::vector<double> partials;
+  partials.reserve(terms.size());
+  for (double t : terms) grow_expansion(partials, t);
+  for (auto it = partials.rbegin(); it != partials.rend(); ++it)
+    if (*it != 0) return *it > 0 ? 1 : -1;
+  return 0;
 }
 }  // namespace
+
+int orientation(Point2 a, Point2 b, Point2 c) {
+  const double l = (b.x - a.x) * (c.y - a.y), r = (b.y - a.y) * (c.x - a.x), v = l - r;
+  // Shewchuk's first filter: beyond this bound the rounded determinant has the exact sign.
+  const double bound = 3.3306690738754716e-16 * (std::abs(l) + std::abs(r));
+  if (v > bound) return 1;
+  if (v < -bound) return -1;
+  // Exact: each difference is hi + lo (TwoDiff), each product of two doubles is p + e with
+  // e = fma(x, y, −p) (TwoProduct), and the 16 terms are summed exactly.
+  auto split = [](double x, double y) {  // x − y = hi + lo exactly (Knuth's TwoSum on x and −y)
+    const double hi = x - y, bv = hi - x, av = hi - bv;
+    return std::pair{hi, (x - av) + (-y - bv)};
+  };
+  const auto [bx, bxe] = split(b.x, a.x);
+  const auto [cy, cye] = split(c.y, a.y);
+  const auto [by, bye] = split(b.y, a.y);
+  const auto [cx, cxe] = split(c.x, a.x);
+  auto product = [&](double x, double y, double sign) {
+    const double p = x * y;
+    return std::pair{sign * p, sign * std::fma(x, y, -p)};
+  };
+  const std::pair<double, double> parts[] = {product(bx, cy, 1),   product(bx, cye, 1),  product(bxe, cy, 1),
+                                             product(bxe, cye, 1), product(by, cx, -1),  product(by, cxe, -1),
+                                             product(bye, cx, -1), product(bye, cxe, -1)};
+  return exact_sign_of_sum({parts[0].first, parts[0].second, parts[1].first, parts[1].second, parts[2].first,
+                            parts[2].second, parts[3].first, parts[3].second, parts[4].first, parts[4].second,
+                            parts[5].first, parts[5].second, parts[6].first, parts[6].second, parts[7].first,
+                            parts[7].second});
+}
+
+bool segments_meet(Point2 a, Point2 b, Point2 c, Point2 d, double closeness) {
+  const int o1 = orientation(a, b, c), o2 = orientation(a, b, d);
+  const int o3 = orientation(c, d, a), o4 = orientation(c, d, b);
+  if (o1 * o2 < 0 && o3 * o4 < 0) return true;  // a proper crossing
+  if ((o1 == 0 && within(a, b, c)) || (o2 == 0 && within(a, b, d)) || (o3 == 0 && within(c, d, a)) ||
+      (o4 == 0 && within(c, d, b)))
+    return true;  // an end on the other segment, or an overlap along a line
+  // Apart: closer than `closeness` still counts as touching (decimal input such as a vertex at
+  // (0.5, 0.3) on the edge (0, 0)–(1, 0.6) is not on it in binary).
+  return std::min({distance_to_segment(a, c, d), distance_to_segment(b, c, d), distance_to_segment(c, a, b),
+                   distance_to_segment(d, a, b)}) <= closeness;
+}
 
 PolygonCurve::PolygonCurve(std::vector<Point2> vertices) : vertices_(std::move(vertices)) {
   const std::size_t n = vertices_.size();
@@ -212,7 +269,7 @@ void check_simple(const Curve& curve, const std::string& what, int samples) {
       for (std::size_t v = u + 1; v < segs.size(); ++v) {
         const std::size_t a = segs[u], b = segs[v];
         if (a == b || (a + 1) % n == b || (b + 1) % n == a) continue;
-        if (segments_meet(p[a], p[(a + 1) % n], p[b], p[(b + 1) % n], size)) {
+        if (segments_meet(p[a], p[(a + 1) % n], p[b], p[(b + 1) % n], 1e-12 * size)) {
           std::ostringstream msg;
           msg << what << ": the curve intersects or touches itself near (" << p[a].x << ", " << p[a].y << ")";
           throw std::invalid_argument(msg.str());

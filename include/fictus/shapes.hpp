@@ -83,6 +83,15 @@ double signed_area(const Curve& curve);
 /// Area-weighted centroid of the region the curve encloses.
 Point2 centroid(const Curve& curve);
 
+/// The side of c relative to the line a→b: +1 left, −1 right, 0 exactly on it. Exact for all finite
+/// inputs whose coordinate differences multiply without underflow (a floating-point filter, then
+/// the exact sum of the TwoProduct expansion).
+int orientation(Point2 a, Point2 b, Point2 c);
+
+/// Do the closed segments ab and cd meet (cross, touch, overlap along a line; decided exactly) or
+/// come within `closeness` of each other?
+bool segments_meet(Point2 a, Point2 b, Point2 c, Point2 d, double closeness);
+
 /// Throws std::invalid_argument("<what>: the curve intersects itself near (x, y)") if the polyline
 /// through `samples` points of the curve (and all corners) crosses itself.
 void check_simple(const Curve& curve, const std::string& what, int samples = 4096);

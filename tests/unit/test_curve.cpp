@@ -7,6 +7,7 @@
 #include "fictus/collocation.hpp"
 #include "fictus/curve.hpp"
 #include "fictus/paper_problem.hpp"
+#include "fictus/shapes.hpp"
 
 namespace {
 
@@ -70,6 +71,51 @@ TEST(Collocation, DefaultRuleKeepsTheSpacingInCells) {
 TEST(Collocation, PaperRuleBeyondItsTable) {
   EXPECT_EQ(fictus::paper_multipliers(1024), 198);
   EXPECT_NEAR(fictus::paper_multipliers(8192), 34.0 * std::pow(64.0, 0.85), 1.0);  // 1/8192: m ∝ N^0.85
+}
+
+// The orientation sign is exact where rounding fails (Kettner et al.'s example): a = (0.5 + i u,
+// 0.5 + j u) with u = 2⁻⁵³ against b = (12, 12), c = (24, 24), compared with the exact determinant
+// in integers (all coordinates are whole multiples of u).
+TEST(Predicates, OrientationIsExactWhereRoundingFails) {
+  const double u = std::ldexp(1.0, -53);
+  const __int128 unit = __int128(1) << 53;
+  const __int128 bx = 12 * unit, cx = 24 * unit;
+  int rounded_wrong = 0;
+  for (int i = 0; i < 128; ++i)
+    for (int j = 0; j < 128; ++j) {
+      const fictus::Point2 a{0.5 + i * u, 0.5 + j * u}, b{12, 12}, c{24, 24};
+      const __int128 ax = unit / 2 + i, ay = unit / 2 + j;
+      const __int128 det = (bx - ax) * (cx - ay) - (bx - ay) * (cx - ax);
+      const int exact = det > 0 ? 1 : det < 0 ? -1 : 0;
+      ASSERT_EQ(fictus::orientation(a, b, c), exact) << i << ", " << j;
+      const double rounded = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+      rounded_wrong += (rounded > 0 ? 1 : rounded < 0 ? -1 : 0) != exact;
+    }
+  EXPECT_GT(rounded_wrong, 1000) << "the example must be one where the rounded determinant errs";
+  EXPECT_EQ(fictus::orientation({0, 0}, {1, 1}, {3, 3}), 0);
+  EXPECT_EQ(fictus::orientation({0.1, 0.1}, {0.2, 0.2}, {0.3, 0.3}),
+            -fictus::orientation({0.2, 0.2}, {0.1, 0.1}, {0.3, 0.3}));
+}
+
+// Segments that meet in every way, decided exactly; and ones that only come close.
+TEST(Predicates, SegmentsMeetCatchesTouchesOverlapsAndShallowCrossings) {
+  using fictus::Point2;
+  using fictus::segments_meet;
+  EXPECT_TRUE(segments_meet({0, 0}, {1, 1}, {0, 1}, {1, 0}, 0));             // crossing
+  EXPECT_TRUE(segments_meet({0, 0}, {1, 0}, {0.5, 0}, {0.5, 1}, 0));         // an end on the other
+  EXPECT_TRUE(segments_meet({0, 0}, {1, 0}, {0.5, 0}, {2, 0}, 0));           // collinear overlap
+  EXPECT_TRUE(segments_meet({0, 0}, {1, 0}, {1, 0}, {2, 1}, 0));             // shared end
+  EXPECT_FALSE(segments_meet({0, 0}, {1, 0}, {1.5, 0}, {2, 0}, 0));          // collinear, apart
+  EXPECT_FALSE(segments_meet({0, 0}, {1, 0}, {0, 1e-300}, {1, 1e-300}, 0));  // parallel, apart
+  // A shallow crossing (at x = 5e-4) of a short segment by a long one whose end lies 5e-10 off the
+  // short one's line, beyond its end: orientation areas of 1e-11 … 5e-13. A test that calls areas
+  // below 1e-12 collinear sees d "on the line but off the segment" and no crossing.
+  EXPECT_TRUE(segments_meet({0, 0}, {1e-3, 0}, {-0.1995, 1e-8}, {0.0105, -5e-10}, 0));
+  EXPECT_FALSE(segments_meet({0, 0}, {1e-3, 0}, {-0.1995, 1e-8}, {0.0105, 5e-10}, 1e-12));
+  // Decimal input: (0.5, 0.3) is on the edge (0, 0)–(1, 0.6) in decimal, not in binary. Exactly
+  // it does not touch; within the closeness it does.
+  EXPECT_TRUE(segments_meet({0, 0}, {1, 0.6}, {0.5, 0.3}, {0.5, 1}, 1e-12));
+  EXPECT_FALSE(segments_meet({0, 0}, {1, 0.6}, {0.5, 0.31}, {0.5, 1}, 1e-12));
 }
 
 }  // namespace
