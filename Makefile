@@ -1,6 +1,7 @@
 # The two commands of the README:
 #   make run   install missing Debian packages, build (Release), reproduce the paper's Tables 1 and 2
-#   make test  install missing Debian packages, build (Release), run every test with ctest
+#   make test  install missing Debian packages, build (Release), run every test with ctest, then the
+#              sanitizer build and its tests (make sanitize)
 BUILD_DIR ?= build
 JOBS ?= 2
 LEVELS ?= 7-12
@@ -9,7 +10,7 @@ DEBIAN_PACKAGES = cmake g++ make pkg-config libfftw3-dev libeigen3-dev libcli11-
                   libmuparser-dev libtomlplusplus-dev python3 python3-dev python3-numpy python3-matplotlib \
                   python3-vtk9 python3-pytest pybind11-dev clang-format
 
-.PHONY: deps configure build run test bench references manufactured format options-table clean
+.PHONY: deps configure build run test sanitize fuzz bench references manufactured format options-table clean
 
 deps:
 	@missing=""; for p in $(DEBIAN_PACKAGES); do \
@@ -30,7 +31,24 @@ run: build
 	$(BUILD_DIR)/apps/fictus reproduce --table both --levels $(LEVELS) --out results
 
 test: build
-	cd $(BUILD_DIR) && ctest --output-on-failure -LE slow
+	cd $(BUILD_DIR) && ctest --output-on-failure -LE slow -j $(JOBS)
+	$(MAKE) sanitize
+
+# The same code with AddressSanitizer and UndefinedBehaviorSanitizer (+float-cast-overflow), every
+# report fatal: the unit tests, the command-line and bad-input tests, the examples and the fuzz
+# corpus. (Not the Python module: an instrumented module needs the sanitizer runtime preloaded.)
+SANITIZE_DIR ?= build-sanitize
+sanitize: deps
+	cmake -S . -B $(SANITIZE_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFICTUS_SANITIZE=ON \
+	      -DFICTUS_BUILD_PYTHON=OFF -DFICTUS_BUILD_BENCH=OFF
+	cmake --build $(SANITIZE_DIR) -j $(JOBS)
+	cd $(SANITIZE_DIR) && ctest --output-on-failure -LE 'slow|convergence|regression' -E 'style|docs|plot' -j $(JOBS)
+
+# Ten minutes of the mutation fuzzer on the Release build (FUZZ_ARGS: e.g. --minutes 2 --seed 7);
+# new outcomes grow tests/fuzz/corpus, defects go to build/fuzz-findings.
+fuzz: build
+	/usr/bin/python3 tests/fuzz/fuzz.py run $(BUILD_DIR)/apps/fictus --grow tests/fuzz/corpus \
+	  --findings $(BUILD_DIR)/fuzz-findings $(FUZZ_ARGS)
 
 bench: build
 	$(BUILD_DIR)/bench/fictus_bench --out bench/results $(BENCH_ARGS)

@@ -11,6 +11,7 @@
 #include <functional>
 #include <iostream>
 #include <regex>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -39,13 +40,30 @@ struct NewtonFailure : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The one error line: "fictus: error: <message>", at most 240 characters, on stderr.
+/// The one error line: "fictus: error: <message>", at most 240 bytes, on stderr. A longer message is cut
+/// at a character boundary (never inside a UTF-8 sequence) and ends in "...".
 int report(const std::string& message, int code) {
-  std::string line = message.size() > 232 ? message.substr(0, 229) + "..." : message;
+  constexpr std::size_t max_message = 240 - std::char_traits<char>::length("fictus: error: ");
+  std::string line = message;
+  if (line.size() > max_message) {
+    std::size_t cut = max_message - 3;
+    while (cut > 0 && (static_cast<unsigned char>(line[cut]) & 0xC0) == 0x80) --cut;
+    line = line.substr(0, cut) + "...";
+  }
   for (char& c : line)
     if (c == '\n' || c == '\r') c = ' ';
   std::fprintf(stderr, "fictus: error: %s\n", line.c_str());
   return code;
+}
+
+/// CLI11's parse errors in the "<what>: <why>" form of every other error.
+std::string parse_error_line(const std::string& message) {
+  static const std::regex extras(R"(The following arguments? (?:was|were) not expected: (.*))");
+  std::smatch match;
+  if (std::regex_match(message, match, extras)) return match[1].str() + ": not expected";
+  const std::size_t colon = message.find(": ");
+  if (colon == std::string::npos || message.find(' ') < colon) return "command line: " + message;
+  return message;
 }
 
 bool formulation_or_solver(const fictus::OptionSpec& s) { return s.section == "formulation" || s.section == "solver"; }
@@ -113,6 +131,12 @@ int run_solve(const std::string& problem_path, const fictus::cli::OptionFlags& f
   const fictus::Problem& problem = spec.problem;
   if (!spec.output.dir.empty()) fictus::cli::check_output_folder(spec.output.dir, spec.output.files);
   fictus::check_memory(problem, spec.options);
+  const double seconds = fictus::estimated_seconds(problem, spec.options);
+  if (seconds >= 2) {  // long runs say what is coming before the work starts
+    std::fprintf(stderr, "fictus: solving N = %d: estimated %.2g GiB and %.2g s\n", problem.N,
+                 fictus::estimated_peak_bytes(problem, spec.options) / double(1 << 30), seconds);
+    std::fflush(stderr);
+  }
   fictus::Solution solution = fictus::solve(problem, spec.options);
   solution.peak_memory_bytes = fictus::peak_memory_bytes();
   if (!solution.newton.converged) throw NewtonFailure(fictus::describe_newton_failure(solution));
@@ -221,8 +245,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> files;
   fictus::cli::OptionFlags solve_flags;
   CLI::App* solve_cmd = app.add_subcommand("solve", "solve a problem file, or the paper's problem without one");
-  solve_cmd->add_option("problem", problem_path, "problem file (TOML, see docs/problem_files.md)")
-      ->check(CLI::ExistingFile);
+  // Existence is checked by the reader, after the parse: an unknown flag before a stray argument is
+  // reported as such, not as a missing file.
+  solve_cmd->add_option("problem", problem_path, "problem file (TOML, see docs/problem_files.md)");
   CLI::Option* out_option = solve_cmd->add_option("--out", out, "output.dir: folder for the output files (\"\": none)")
                                 ->capture_default_str();
   solve_cmd->add_option("--dir", out, "alias of --out")->group("");
@@ -275,6 +300,10 @@ int main(int argc, char** argv) {
   options_cmd->add_flag("--markdown", markdown, "as the Markdown table of docs/problem_files.md");
   options_cmd->add_flag("--json", as_json, "as JSON: section, key, type, default, allowed values, meaning, aliases");
 
+  const std::set<std::string> commands = {"solve", "plot", "reproduce", "sweep", "options"};
+  if (argc > 1 && argv[1][0] != '-' && !commands.count(argv[1]))
+    return report(std::string(argv[1]) + ": not a command (solve, plot, reproduce, sweep, options; see fictus --help)",
+                  exit_bad_input);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -284,7 +313,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::Success& e) {
     return app.exit(e);  // --version
   } catch (const CLI::ParseError& e) {
-    return report(std::string(e.what()) + " (see fictus --help)", exit_bad_input);
+    return report(parse_error_line(e.what()) + " (see fictus --help)", exit_bad_input);
   }
   try {
     if (*solve_cmd) return run_solve(problem_path, solve_flags, out_option, out, files, files_option);

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "fictus/curve_discretization.hpp"
 #include "fictus/execution.hpp"
@@ -401,7 +402,11 @@ Solution FictitiousDomainSolver::solve(const ContactData& data, SolverOptions op
   return sol;
 }
 
-std::size_t estimated_peak_bytes(const Problem& problem, const SolverOptions& options) {
+namespace {
+
+/// Grid nodes and the m a solve will use (the default rule, with the curve's length), before any
+/// array is made.
+std::pair<double, double> nodes_and_multipliers(const Problem& problem, const SolverOptions& options) {
   const double h = problem.box.width(0) / problem.N;
   const double nodes = (double(problem.N) + 1) * (std::floor(problem.box.width(1) / h + 0.5) + 1);
   double m = options.multipliers;
@@ -411,9 +416,33 @@ std::size_t estimated_peak_bytes(const Problem& problem, const SolverOptions& op
     const double cells =
         options.variant == Variant::smooth ? default_spacing_cells_smooth : default_spacing_cells_nonsmooth;
     m = std::max(double(minimum_multipliers), L / (cells * h));
+  } else if (problem.gamma) {
+    m = std::min(m, ArcLengthTable(*problem.gamma, 256).length() / (2 * h));  // the most a solve accepts
   }
+  return {nodes, m};
+}
+
+}  // namespace
+
+std::size_t estimated_peak_bytes(const Problem& problem, const SolverOptions& options) {
+  const auto [nodes, m] = nodes_and_multipliers(problem, options);
   const double bytes = 3 * 8 * nodes + 4 * 8 * m * m + 32.0 * (1 << 20);
   return bytes > 1.8e19 ? std::size_t(1.8e19) : std::size_t(bytes);
+}
+
+double estimated_seconds(const Problem& problem, const SolverOptions& options) {
+  const auto [nodes, m] = nodes_and_multipliers(problem, options);
+  const double n_log_n = nodes * std::log2(std::max(nodes, 2.0));
+  // Calibrated on the benchmark's 2-core machine (bench/results): the green solve costs about
+  // 7e-9 s per node·log2(nodes) with 2 threads, plus the m² Schur pairs and the m³ LU; GMRES about
+  // 2.5 m iterations of 2.5 fast solves of 2.3e-10 s per node·log2(nodes). Threads scale it
+  // linearly up to the cores there are.
+  const double threads =
+      std::clamp(double(options.threads), 1.0, double(std::max(1u, std::thread::hardware_concurrency())));
+  const double grid = 7e-9 * n_log_n, pairs = 2e-7 * m * m, dense = 1e-10 * m * m * m;
+  const double seconds =
+      options.inner == InnerSolver::green ? grid + pairs + dense : grid + 2.5 * m * 2.5 * 2.3e-10 * n_log_n;
+  return seconds * 2 / threads;
 }
 
 std::string describe_newton_failure(const Solution& s) {

@@ -116,6 +116,12 @@ class FictitiousDomainSolver {
 /// (the default rule, with the curve's length). Measured peaks at h = 1/1024 … 1/4096 are within 10 %.
 std::size_t estimated_peak_bytes(const Problem& problem, const SolverOptions& options);
 
+/// The wall time of a solve, estimated before anything is allocated from the grid's nodes and m, by a
+/// model calibrated on a 2-core machine (bench/results) and scaled by the threads. Rough: within a
+/// factor of about 2 there for the green solver, looser for GMRES (its iteration count depends on
+/// the problem). For a progress header, never a limit.
+double estimated_seconds(const Problem& problem, const SolverOptions& options);
+
 /// The one-line report of a Newton failure, with its history (what the CLI and the bindings print).
 std::string describe_newton_failure(const Solution& solution);
 

@@ -3,6 +3,7 @@
 #include <toml++/toml.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <set>
@@ -267,10 +268,18 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
 }
 
 ProblemSpec read_problem_file(const std::string& path) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error))
+    throw std::invalid_argument(path + ": is a folder, not a problem file");
   std::ifstream in(path);
   if (!in) throw std::invalid_argument(path + ": cannot open the problem file");
-  std::stringstream text;
-  text << in.rdbuf();
+  constexpr std::size_t limit = 64 << 20;  // a problem file is text; /dev/zero is not one
+  std::string content(limit + 1, '\0');
+  in.read(content.data(), std::streamsize(content.size()));
+  if (in.bad()) throw std::invalid_argument(path + ": cannot read the problem file");
+  content.resize(std::size_t(in.gcount()));
+  if (content.size() > limit) throw std::invalid_argument(path + ": larger than 64 MiB, not a problem file");
+  std::stringstream text(content);
   ProblemSpec spec = parse_problem_text(text.str(), path);
   std::string name = path.substr(path.find_last_of('/') + 1);
   spec.problem.name = name.substr(0, name.rfind(".toml"));
