@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -60,9 +61,13 @@ int report(const std::string& message, int code) {
 std::string parse_error_line(const std::string& message) {
   static const std::regex extras(R"(The following arguments? (?:was|were) not expected: (.*))");
   std::smatch match;
-  if (std::regex_match(message, match, extras)) return match[1].str() + ": not expected";
+  if (std::regex_match(message, match, extras)) {
+    const std::string what = match[1].str();
+    return what.find(' ') == std::string::npos && !what.empty() ? what + ": not expected"
+                                                                : "arguments: not expected: " + what;
+  }
   const std::size_t colon = message.find(": ");
-  if (colon == std::string::npos || message.find(' ') < colon) return "command line: " + message;
+  if (colon == std::string::npos || message.find(' ') < colon) return "arguments: " + message;
   return message;
 }
 
@@ -102,8 +107,31 @@ std::pair<int, int> parse_levels(const std::string& text) {
   return {a, b};
 }
 
-int run_solve(const std::string& problem_path, const fictus::cli::OptionFlags& flags, CLI::Option* out_option,
-              const std::string& out, const std::vector<std::string>& files, CLI::Option* files_option) {
+/// What `fictus solve` was given on the command line.
+struct SolveCommand {
+  std::string problem_path, out = "results/solve";
+  std::vector<std::string> files;
+  bool quiet = false;
+  fictus::cli::OptionFlags flags;
+  CLI::Option* out_option = nullptr;
+  CLI::Option* files_option = nullptr;
+};
+
+/// Progress on stderr, flushed (also when redirected): each step of a long solve as it ends, with
+/// the time since the start and the peak memory so far.
+void print_progress_lines(fictus::FictitiousDomainSolver& solver) {
+  const auto start = std::chrono::steady_clock::now();
+  solver.set_progress([start](const std::string& phase, double seconds) {
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "fictus:   %-12s %8.2f s   (elapsed %.1f s, peak memory %.2f GiB)\n", phase.c_str(), seconds,
+                 elapsed, fictus::peak_memory_bytes() / double(1 << 30));
+    std::fflush(stderr);
+  });
+}
+
+int run_solve(const SolveCommand& command) {
+  const std::string& problem_path = command.problem_path;
+  const fictus::cli::OptionFlags& flags = command.flags;
   fictus::ProblemSpec spec;
   if (!problem_path.empty()) {
     spec = fictus::read_problem_file(problem_path);
@@ -112,42 +140,54 @@ int run_solve(const std::string& problem_path, const fictus::cli::OptionFlags& f
     fictus::Problem given;
     fictus::SolverOptions options;
     flags.apply(given, options);
+    if (given.N % 2)
+      throw std::invalid_argument(
+          "domain.N: the paper's problem needs an even N (its data have kinks on x = 1/2 and "
+          "y = 1/2, which must be grid lines), got " +
+          std::to_string(given.N));
     spec.problem = fictus::paper_problem(given.N, given.c, given.boundary);
     spec.options = fictus::paper_options(given.N, options.variant);
   }
   flags.apply(spec.problem, spec.options);
   fictus::validate_options(spec.problem, spec.options);
-  if (out_option->count() > 0) spec.output.dir = out;
-  if (files_option->count() > 0) {
-    for (const std::string& f : files)
+  if (command.out_option->count() > 0) spec.output.dir = command.out;
+  if (command.files_option->count() > 0) {
+    for (const std::string& f : command.files)
       if (std::find(fictus::output_file_names().begin(), fictus::output_file_names().end(), f) ==
           fictus::output_file_names().end())
         throw std::invalid_argument("output.files: unknown file \"" + f +
                                     "\" (results.json, points.csv, solution.vti, curves.vtp)");
-    spec.output.files = files;
+    spec.output.files = command.files;
   }
   for (const std::string& w : spec.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
 
   const fictus::Problem& problem = spec.problem;
+  const json input = problem_path.empty()
+                         ? json{{"geometry", "the paper's ellipse (built in)"},
+                                {"data", "the paper's f, g and exact solution (built in; f follows c)"}}
+                         : json::parse(spec.input_json);
   if (!spec.output.dir.empty()) fictus::cli::check_output_folder(spec.output.dir, spec.output.files);
   fictus::check_memory(problem, spec.options);
   const double seconds = fictus::estimated_seconds(problem, spec.options);
-  if (seconds >= 2) {  // long runs say what is coming before the work starts
+  const bool long_run = seconds >= 2 && !command.quiet;
+  if (long_run) {  // long runs say what is coming before the work starts
     std::fprintf(stderr, "fictus: solving N = %d: estimated %.2g GiB and %.2g s\n", problem.N,
                  fictus::estimated_peak_bytes(problem, spec.options) / double(1 << 30), seconds);
     std::fflush(stderr);
   }
-  fictus::Solution solution = fictus::solve(problem, spec.options);
+  fictus::FictitiousDomainSolver solver(problem, spec.options);
+  if (long_run) print_progress_lines(solver);
+  fictus::Solution solution = solver.solve(problem, spec.options);
   solution.peak_memory_bytes = fictus::peak_memory_bytes();
   if (!solution.newton.converged) throw NewtonFailure(fictus::describe_newton_failure(solution));
-  print_summary(solution);
+  if (!command.quiet) print_summary(solution);
   if (!spec.output.dir.empty()) {
     const fs::path dir = spec.output.dir;
     std::vector<fictus::cli::OutputFile> files;
     for (const std::string& name : spec.output.files) {
       if (name == "results.json")
         files.push_back({name, [&](std::ostream& out) {
-                           out << fictus::cli::solution_to_json(problem, solution).dump(2) << "\n";
+                           out << fictus::cli::solution_to_json(problem, solution, input).dump(2) << "\n";
                          }});
       else if (name == "points.csv")
         files.push_back({name, [&](std::ostream& out) { out << fictus::cli::points_csv(solution); }});
@@ -157,7 +197,7 @@ int run_solve(const std::string& problem_path, const fictus::cli::OptionFlags& f
         files.push_back({name, [&](std::ostream& out) { fictus::cli::write_vtp(out, solution); }});
     }
     fictus::cli::write_output_set(dir, files);
-    std::printf("wrote %zu files to %s/\n", spec.output.files.size(), spec.output.dir.c_str());
+    if (!command.quiet) std::printf("wrote %zu files to %s/\n", spec.output.files.size(), spec.output.dir.c_str());
   }
   return 0;
 }
@@ -236,30 +276,30 @@ int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out,
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // a line at a time, also into a file or a pipe
   CLI::App app{"fictus: Signorini problems on curved domains by a fictitious domain method"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string(FICTUS_VERSION));
 
   // solve: every option of options.hpp as --key; without a file the paper's problem.
-  std::string problem_path, out = "results/solve";
-  std::vector<std::string> files;
-  fictus::cli::OptionFlags solve_flags;
+  SolveCommand solve;
   CLI::App* solve_cmd = app.add_subcommand("solve", "solve a problem file, or the paper's problem without one");
   // Existence is checked by the reader, after the parse: an unknown flag before a stray argument is
   // reported as such, not as a missing file.
-  solve_cmd->add_option("problem", problem_path, "problem file (TOML, see docs/problem_files.md)");
-  CLI::Option* out_option = solve_cmd->add_option("--out", out, "output.dir: folder for the output files (\"\": none)")
-                                ->capture_default_str();
-  solve_cmd->add_option("--dir", out, "alias of --out")->group("");
-  CLI::Option* files_option =
+  solve_cmd->add_option("problem", solve.problem_path, "problem file (TOML, see docs/problem_files.md)");
+  solve.out_option = solve_cmd->add_option("--out", solve.out, "output.dir: folder for the output files (\"\": none)")
+                         ->capture_default_str();
+  solve_cmd->add_option("--dir", solve.out, "alias of --out")->group("");
+  solve_cmd->add_flag("--quiet", solve.quiet, "print only warnings and errors (no estimate, progress or summary)");
+  solve.files_option =
       solve_cmd
-          ->add_option("--files", files,
+          ->add_option("--files", solve.files,
                        "output.files, comma-separated: results.json,points.csv,solution.vti,curves.vtp")
           ->delimiter(',')
           ->allow_extra_args(false);
   const std::map<std::string, std::string> paper_note = {{"multipliers", "without a problem file: the paper's m"},
                                                          {"offset", "without a problem file: 1 (the paper's δ = L/m)"}};
-  solve_flags.add(
+  solve.flags.add(
       *solve_cmd, [](const fictus::OptionSpec&) { return true; }, paper_note);
 
   std::string plot_dir;
@@ -316,7 +356,7 @@ int main(int argc, char** argv) {
     return report(parse_error_line(e.what()) + " (see fictus --help)", exit_bad_input);
   }
   try {
-    if (*solve_cmd) return run_solve(problem_path, solve_flags, out_option, out, files, files_option);
+    if (*solve_cmd) return run_solve(solve);
     if (*plot_cmd) return run_plot(plot_dir);
     if (*reproduce_cmd) return run_reproduce(reproduce_flags, reproduce_out, table, levels);
     if (*sweep_cmd) {

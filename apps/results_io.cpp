@@ -36,10 +36,12 @@ json options_schema_json() {
   return list;
 }
 
-json solution_to_json(const Problem& problem, const Solution& s) {
+json solution_to_json(const Problem& problem, const Solution& s, const json& input) {
   json j;
   j["version"] = FICTUS_VERSION;
-  j["problem"] = problem.name;
+  j["commit"] = FICTUS_GIT_COMMIT;
+  j["problem"] = input;
+  j["problem"]["name"] = problem.name;
   j["options"] = options_to_json(problem, s.options);
   j["alpha"] = s.alpha;
   j["grid"] = {{"N", s.grid.nx()},

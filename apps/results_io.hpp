@@ -18,7 +18,10 @@ namespace fictus::cli {
 nlohmann::json options_to_json(const Problem& problem, const SolverOptions& options);
 /// The option descriptions (`fictus options --json`).
 nlohmann::json options_schema_json();
-nlohmann::json solution_to_json(const Problem& problem, const Solution& solution);
+/// results.json: `input` is what the problem was made from (the file's geometry and data), echoed
+/// under "problem" beside its name.
+nlohmann::json solution_to_json(const Problem& problem, const Solution& solution,
+                                const nlohmann::json& input = nlohmann::json::object());
 LevelResult level_result(const Solution& solution);
 
 /// An output file could not be written (exit code 3).

@@ -1,5 +1,6 @@
 #include "fictus/curve_discretization.hpp"
 
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -53,8 +54,17 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
     throw std::invalid_argument("formulation.offset: Γ at δ = offset·L/m = " + std::to_string(delta_ / h) +
                                 " h is within reach of the C_γ stencil (need δ >= 4h: a larger offset or a smaller m)");
   Gamma_ = std::make_shared<OffsetCurve>(gamma_, delta_);
-  check_simple(*Gamma_, "formulation.offset");
-  check_inside_box(*Gamma_, grid.box(), 2 * h, "formulation.offset");
+  try {
+    check_simple(*Gamma_, "formulation.offset");
+    check_inside_box(*Gamma_, grid.box(), 2 * h, "formulation.offset");
+  } catch (const std::invalid_argument& e) {  // say what moves Γ closer to γ
+    char hint[160];
+    std::snprintf(hint, sizeof hint,
+                  "; Γ lies δ = offset·L/m = %.3g from γ (%.1f h): a larger N or a smaller formulation.offset "
+                  "brings it closer",
+                  delta_, delta_ / h);
+    throw std::invalid_argument(e.what() + std::string(hint));
+  }
   Gamma_geometry_ = std::make_unique<CurveGridIntersection>(*Gamma_, grid, "formulation.offset");
 }
 

@@ -28,12 +28,14 @@ namespace {
 
 class PhaseClock {
  public:
-  explicit PhaseClock(Timings& timings) : timings_(timings), start_(now()), last_(start_) {}
+  PhaseClock(Timings& timings, const Execution& execution)
+      : timings_(timings), execution_(execution), start_(now()), last_(start_) {}
   void mark(const std::string& phase) {
     const auto t = now();
     timings_.phases.emplace_back(phase, seconds(last_, t));
     timings_.total = seconds(start_, t);
     last_ = t;
+    execution_.report(phase, timings_.phases.back().second);
   }
 
  private:
@@ -43,6 +45,7 @@ class PhaseClock {
     return std::chrono::duration<double>(b - a).count();
   }
   Timings& timings_;
+  const Execution& execution_;
   Clock::time_point start_, last_;
 };
 
@@ -147,6 +150,10 @@ const Grid2& FictitiousDomainSolver::grid() const { return state_->grid; }
 
 void FictitiousDomainSolver::set_interrupt_check(std::function<bool()> check) {
   state_->execution.set_interrupt_check(std::move(check));
+}
+
+void FictitiousDomainSolver::set_progress(std::function<void(const std::string&, double)> progress) {
+  state_->execution.set_progress(std::move(progress));
 }
 
 namespace {
@@ -360,10 +367,10 @@ Solution FictitiousDomainSolver::solve(const ContactData& data, SolverOptions op
   if (!data.g && !data.g_along_curve && !data.g_vectorized) throw std::invalid_argument("data.g: not given");
   Eigen::setNbThreads(options.threads);  // the dense LU of the Newton steps follows the threads option
   Solution sol(st.grid);
-  PhaseClock clock(sol.timings);
+  const Execution& execution = st.execution;
+  PhaseClock clock(sol.timings, execution);
   std::size_t fast_solves = 0;
 
-  const Execution& execution = st.execution;
   load_and_u0(st, clock, fast_solves);  // 0
   execution.throw_if_interrupted();
   const CurveSetup& setup = curve_setup(st, data, options, clock, sol.reused_curve);  // 1–3
@@ -433,21 +440,29 @@ std::size_t estimated_peak_bytes(const Problem& problem, const SolverOptions& op
 double estimated_seconds(const Problem& problem, const SolverOptions& options) {
   const auto [nodes, m] = nodes_and_multipliers(problem, options);
   const double n_log_n = nodes * std::log2(std::max(nodes, 2.0));
-  // Calibrated on the benchmark's 2-core machine (bench/results): the green solve costs about
-  // 7e-9 s per node·log2(nodes) with 2 threads, plus the m² Schur pairs and the m³ LU; GMRES about
-  // 2.5 m iterations of 2.5 fast solves of 2.3e-10 s per node·log2(nodes). Threads scale it
-  // linearly up to the cores there are.
+  // Calibrated on the benchmark's 2-core machine (bench/results, and 1-thread runs at h = 1/4096):
+  // the grid work (load, u₀, Green's table, final solve, errors) costs about 9e-9 s per
+  // node·log2(nodes) on one thread, the Schur blocks 2.3e-6 s per pair of points, each Newton step
+  // one dense LU of 1e-10·m³ s (8 steps assumed; the cap allows more); GMRES about 2.5 m
+  // iterations of 2.5 fast solves of 4.6e-10 s per node·log2(nodes). Threads divide it, up to the
+  // cores there are.
   const double threads =
       std::clamp(double(options.threads), 1.0, double(std::max(1u, std::thread::hardware_concurrency())));
-  const double grid = 7e-9 * n_log_n, pairs = 2e-7 * m * m, dense = 1e-10 * m * m * m;
+  const double grid = 4.5e-9 * n_log_n, pairs = 1.15e-6 * m * m, dense = 8 * 0.5e-10 * m * m * m;
   const double seconds =
       options.inner == InnerSolver::green ? grid + pairs + dense : grid + 2.5 * m * 2.5 * 2.3e-10 * n_log_n;
   return seconds * 2 / threads;
 }
 
 std::string describe_newton_failure(const Solution& s) {
+  // Blame the setting at fault: a Krylov solve stopped short makes Newton wander, whatever its cap.
   std::string line =
-      "solver.max_newton: Newton did not converge: " + s.newton.failure + "; history (active points, residual):";
+      s.newton.inner_failed
+          ? "solver.krylov_max_iterations: GMRES stopped at its cap of " +
+                std::to_string(s.options.krylov_max_iterations) +
+                " iterations before solver.krylov_tolerance (raise the cap, or use schur = green); then Newton: " +
+                s.newton.failure + "; history (active points, residual):"
+          : "solver.max_newton: Newton did not converge: " + s.newton.failure + "; history (active points, residual):";
   for (const NewtonStep& step : s.newton.history) {
     char buffer[64];
     std::snprintf(buffer, sizeof buffer, " (%d, %.2e)", step.n_active, step.residual);

@@ -1,6 +1,7 @@
 #include "fictus/semismooth_newton.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <stdexcept>
 
 namespace fictus {
@@ -52,6 +53,7 @@ NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::
     }
     result.history.push_back(
         {int(std::count(active.begin(), active.end(), 1)), linear.inner_iterations, result.residual, changed});
+    result.inner_failed = result.inner_failed || !linear.converged;
 
     // 4. Stopping test.
     if (changed == 0) {
@@ -59,7 +61,9 @@ NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::
       if (result.residual <= options.tolerance * scale) {
         result.converged = true;
       } else {
-        result.failure = "the active set repeats but the residual " + std::to_string(result.residual) +
+        char residual[32];
+        std::snprintf(residual, sizeof residual, "%.3e", result.residual);
+        result.failure = std::string("the active set repeats but the residual ") + residual +
                          " is above the tolerance (inner solver " +
                          (linear.converged ? "converged" : "did not converge") + ")";
       }

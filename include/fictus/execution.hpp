@@ -29,9 +29,19 @@ class Execution {
     if (interrupt_requested()) throw Interrupted();
   }
 
+  /// Told the name and duration of each step of a solve as it ends (on the calling thread), for
+  /// progress lines on long runs.
+  void set_progress(std::function<void(const std::string& phase, double seconds)> progress) {
+    progress_ = std::move(progress);
+  }
+  void report(const std::string& phase, double seconds) const {
+    if (progress_) progress_(phase, seconds);
+  }
+
  private:
   int threads_;
   std::function<bool()> interrupt_check_;
+  std::function<void(const std::string&, double)> progress_;
 };
 
 }  // namespace fictus

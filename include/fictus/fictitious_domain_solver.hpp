@@ -98,6 +98,9 @@ class FictitiousDomainSolver {
   /// (execution.hpp) within about one fast solve. The bindings use it for Ctrl-C.
   void set_interrupt_check(std::function<bool()> check);
 
+  /// Called with each step's name and seconds as the step ends (the CLI's progress lines).
+  void set_progress(std::function<void(const std::string& phase, double seconds)> progress);
+
   /// Solves with the curve, obstacle and exact solution of `data` and the per-solve options
   /// (options.threads and options.load_quadrature must be the constructor's: they shaped the
   /// grid-level work). Reuses the previous curve's trace rows and Schur blocks when data.gamma is the

@@ -45,7 +45,8 @@ struct NewtonResult {
   ActiveSet active;
   int iterations = 0;  // linear solves (the paper's it₀)
   bool converged = false;
-  std::string failure;  // why not, when not converged
+  std::string failure;        // why not, when not converged
+  bool inner_failed = false;  // some step's inner (Krylov) solve stopped at its cap or tolerance short
   double residual = 0.0;
   std::vector<NewtonStep> history;
 };

@@ -264,6 +264,12 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
   }
   output.finish();
   p.name = source;
+  toml::table echo;
+  echo.insert("geometry", *geometry_table);
+  if (const toml::table* d = subtable(root, "data")) echo.insert("data", *d);
+  std::ostringstream json;
+  json << toml::json_formatter{echo};
+  spec.input_json = json.str();
   return spec;
 }
 
@@ -274,11 +280,13 @@ ProblemSpec read_problem_file(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::invalid_argument(path + ": cannot open the problem file");
   constexpr std::size_t limit = 64 << 20;  // a problem file is text; /dev/zero is not one
-  std::string content(limit + 1, '\0');
-  in.read(content.data(), std::streamsize(content.size()));
+  std::string content;
+  char chunk[1 << 16];
+  while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
+    content.append(chunk, std::size_t(in.gcount()));
+    if (content.size() > limit) throw std::invalid_argument(path + ": larger than 64 MiB, not a problem file");
+  }
   if (in.bad()) throw std::invalid_argument(path + ": cannot read the problem file");
-  content.resize(std::size_t(in.gcount()));
-  if (content.size() > limit) throw std::invalid_argument(path + ": larger than 64 MiB, not a problem file");
   std::stringstream text(content);
   ProblemSpec spec = parse_problem_text(text.str(), path);
   std::string name = path.substr(path.find_last_of('/') + 1);

@@ -18,6 +18,9 @@ def main(folder):
         assert key in results, f"missing key {key}"
         assert isinstance(results[key], kind), f"{key} is not {kind.__name__}"
     assert "condition_number" in results
+    assert isinstance(results["commit"], str) and results["commit"], "commit"
+    assert results["problem"]["name"], "problem.name"
+    assert "geometry" in results["problem"] and "data" in results["problem"], "problem echo"
     for key in ("N", "h", "n_nodes", "n_unknowns"):
         assert key in results["grid"], f"grid.{key} missing"
     n = results["grid"]["N"]

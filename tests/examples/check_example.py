@@ -21,6 +21,9 @@ def main():
     parser.add_argument("--compare")
     args = parser.parse_args()
     r = load(args.dir)
+    echo = r["problem"]  # what was solved: the problem file's geometry and data, or the built-in problem
+    assert isinstance(echo["geometry"], str) or "shape" in echo["geometry"], echo
+    assert isinstance(echo["data"], str) or {"f", "g"} <= set(echo["data"]), echo
     assert r["newton"]["converged"], r["newton"]
     s = r["signorini"]
     tol = 1e-10  # the Newton systems are solved by dense LU: round-off level

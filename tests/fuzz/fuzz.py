@@ -386,7 +386,9 @@ def random_flags(rng, options):
             value = random_value(rng, option["default"])
         else:
             value = rng.choice(WORDS + ["1e999", "-", "--N", "0x10", "1,2", " 3"])
-        if isinstance(value, list):
+        if isinstance(value, list) and rng.random() < 0.7:  # the documented form: --box 0,1,0,1
+            flags += [f"--{option['key']}", ",".join(str(item) for item in value)]
+        elif isinstance(value, list):
             flags.append(f"--{option['key']}")
             flags += [str(item) for item in value] or [""]
         else:
@@ -466,12 +468,12 @@ def fuzz(args):
             case, outcome = pending.pop(0).result()
             counts[outcome["class"]] += 1
             key = signature(outcome)
-            if outcome["class"] in DEFECTS and args.findings:
+            if (outcome["class"] in DEFECTS or outcome["class"] == "timeout") and args.findings:
                 os.makedirs(args.findings, exist_ok=True)
                 with open(os.path.join(args.findings, case_name(case) + ".json"), "w") as handle:
                     json.dump(dict(case, outcome=outcome), handle, indent=1, ensure_ascii=False)
             elif outcome["class"] in ("ok", "error") and args.grow and key not in seen and len(
-                    json.dumps(case)) < 20000:
+                    json.dumps(case)) < 20000 and added < args.max_grow:
                 seen.add(key)
                 added += 1
                 with open(os.path.join(args.grow, "fuzz-" + case_name(case) + ".json"), "w") as handle:
@@ -530,6 +532,7 @@ def main():
     run.add_argument("--workers", type=int, default=1)
     run.add_argument("--timeout", type=float, default=30)
     run.add_argument("--grow")
+    run.add_argument("--max-grow", type=int, default=40, help="cases added to the corpus at most")
     run.add_argument("--findings")
     run.add_argument("--report")
     again = commands.add_parser("replay")

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <thread>
 
 #include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/paper_problem.hpp"
@@ -122,3 +123,27 @@ TEST(Reuse, NewCurveMatchesAFreshSolve) {
 }
 
 }  // namespace
+
+// The estimates before a solve: memory and time grow like the grid (N² and N² log N) once the grid
+// dominates; GMRES is estimated slower than the explicit Schur complement; more threads, less time.
+TEST(Estimates, GrowWithTheGridAndFollowTheInnerSolverAndThreads) {
+  auto estimate = [](int N, fictus::InnerSolver inner, int threads) {
+    const fictus::Problem problem = fictus::paper_problem(N);
+    fictus::SolverOptions options = fictus::paper_options(N, fictus::Variant::smooth);
+    options.inner = inner;
+    options.threads = threads;
+    return std::pair{double(fictus::estimated_peak_bytes(problem, options)),
+                     fictus::estimated_seconds(problem, options)};
+  };
+  const auto [bytes_4k, seconds_4k] = estimate(4096, fictus::InnerSolver::green, 1);
+  const auto [bytes_8k, seconds_8k] = estimate(8192, fictus::InnerSolver::green, 1);
+  EXPECT_GT(bytes_8k / bytes_4k, 3.5);  // 4 for the grid arrays; the m² blocks and the fixed part grow less
+  EXPECT_LT(bytes_8k / bytes_4k, 4.0);
+  EXPECT_GT(seconds_8k / seconds_4k, 4.0);
+  EXPECT_LT(seconds_8k / seconds_4k, 5.0);
+  EXPECT_GT(bytes_4k, 3 * 8.0 * 4097 * 4097);  // three grid arrays at least
+  EXPECT_GT(estimate(1024, fictus::InnerSolver::krylov, 1).second,
+            10 * estimate(1024, fictus::InnerSolver::green, 1).second);
+  if (std::thread::hardware_concurrency() >= 2)
+    EXPECT_LT(estimate(4096, fictus::InnerSolver::green, 2).second, seconds_4k);
+}

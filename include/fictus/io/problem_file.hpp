@@ -17,6 +17,7 @@ struct ProblemSpec {
   SolverOptions options;
   OutputOptions output;
   std::vector<std::string> warnings;  // e.g. a clockwise curve that was reoriented
+  std::string input_json;             // the file's [geometry] and [data] as a JSON object (results.json echoes it)
 };
 
 /// Reads and checks a problem file. Throws std::invalid_argument with a one-line message naming the
