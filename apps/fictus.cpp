@@ -205,10 +205,15 @@ int run_solve(const SolveCommand& command) {
 /// Runs the plot script with an argument vector (no shell: any folder name is safe).
 int run_plot(const std::string& folder) {
   if (!fs::is_directory(folder)) throw std::invalid_argument("plot: " + folder + " is not a folder");
+  // An installed fictus (cmake --install) finds its script beside it in share/fictus; the build tree's
+  // uses the one in the sources.
+  std::error_code error;
+  const fs::path installed = fs::read_symlink("/proc/self/exe", error).parent_path() / "../share/fictus/plot.py";
+  const std::string script = !error && fs::exists(installed, error) ? installed.string() : FICTUS_PLOT_SCRIPT;
   const pid_t child = fork();
   if (child < 0) throw std::runtime_error("plot: cannot start " FICTUS_PYTHON);
   if (child == 0) {
-    const char* argv[] = {FICTUS_PYTHON, FICTUS_PLOT_SCRIPT, folder.c_str(), nullptr};
+    const char* argv[] = {FICTUS_PYTHON, script.c_str(), folder.c_str(), nullptr};
     execv(FICTUS_PYTHON, const_cast<char* const*>(argv));
     std::fprintf(stderr, "fictus: error: plot: cannot run %s\n", FICTUS_PYTHON);
     _exit(127);

@@ -246,6 +246,8 @@ void check_simple(const Curve& curve, const std::string& what, int samples) {
   for (const Point2& q : p)
     x0 = std::min(x0, q.x), x1 = std::max(x1, q.x), y0 = std::min(y0, q.y), y1 = std::max(y1, q.y);
   const double size = std::max(x1 - x0, y1 - y0);
+  if (!(size > 0 && size <= 1e100))  // an extent that overflows (semi-axes of 1e308) or a point
+    throw std::invalid_argument(what + ": the curve's extent is " + (size > 0 ? "beyond 1e100" : "zero"));
   {  // closed: p(2π) = p(0) (a jump of x(t), y(t) or r(t) at 2π is not a closed curve)
     const Point2 gap = curve.position(two_pi) - curve.position(0.0);
     if (!(norm(gap) <= 1e-9 * size)) {

@@ -45,3 +45,5 @@ record polygon --problem "$ex/polygon.toml" -- solve --N 96
 record manufactured_ellipse --problem "$ex/manufactured_ellipse.toml" -- solve --N 128
 record periodic_krylov --problem "$here/seeds/periodic_krylov.toml" -- solve
 record parse_flag_then_file --problem "$ex/circle.toml" -- solve --N 128 --variant nonsmooth --files results.json,points.csv
+# Found by the fuzzer under UBSan: a semi-axis of 1.8e308 made the curve's extent overflow (NaN cast)
+record huge_semi_axis --problem "$here/seeds/huge_semi_axis.toml" -- solve --N 9 --max_memory 1
