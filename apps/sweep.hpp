@@ -8,7 +8,6 @@ namespace fictus::cli {
 
 struct SweepArguments {
   std::string g_scale, rotate, move;  // lists "a,b,c" or "start:stop:count"
-  bool field = false;                 // also compute û (one fast solve per problem)
   std::string out = "results/sweep";
 };
 

@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
   md << "# fictus benchmark, " << date << "\n\n"
      << "- machine: " << machine << "\n- compiler: " << compiler << ", FFTW 3.3 (ESTIMATE plans)\n"
      << "- commit: " << commit << "\n- threads: " << threads << " unless a table says otherwise\n"
-     << "- problem: the paper's (§4 of DESIGN), m as in the paper (default rule above 1/4096); "
+     << "- problem: the paper's (docs/reproduction.md), m as in the paper (default rule above 1/4096); "
         "Krylov tolerance 1e-12; times in seconds, one run each\n\n";
 
   // 0. Trace rules and m rule in one run: the paper's shifted C_γ against the reconstructed traces
@@ -212,22 +212,24 @@ int main(int argc, char** argv) {
                    a.solution->newton.active == b.solution->newton.active ? "identical" : "DIFFERENT");
     }
   }
-  // 3. Threads: 1 vs 2 per phase at h = 1/4096.
-  md << "\n## 1 vs 2 threads per phase, h = 1/4096, smooth, green\n\n| threads | total |";
-  for (const char* p : phase_names) md << ' ' << p << " |";
-  md << "\n|---|---|";
-  for (std::size_t k = 0; k < std::size(phase_names); ++k) md << "---|";
-  md << "\n";
-  Run one = run(4096, fictus::Variant::smooth, fictus::InnerSolver::green, 1);
-  Run two = run(4096, fictus::Variant::smooth, fictus::InnerSolver::green, 2);
-  for (const Run* r : {&one, &two})
-    md << format("| %d | %.3f |", r->threads, r->solution->timings.total) << phase_cells(*r->solution) << "\n";
-  md << "| speed-up | " << format("%.2f", one.solution->timings.total / two.solution->timings.total) << " |";
-  for (const char* p : phase_names) {
-    const double a = one.solution->timings[p], b = two.solution->timings[p];
-    md << (b > 0 ? format(" %.2f |", a / b) : std::string(" – |"));
+  // 3. Threads: 1 vs 2 per phase at h = 1/4096 (only when --max-level reaches it).
+  if (max_level >= 12) {
+    md << "\n## 1 vs 2 threads per phase, h = 1/4096, smooth, green\n\n| threads | total |";
+    for (const char* p : phase_names) md << ' ' << p << " |";
+    md << "\n|---|---|";
+    for (std::size_t k = 0; k < std::size(phase_names); ++k) md << "---|";
+    md << "\n";
+    Run one = run(4096, fictus::Variant::smooth, fictus::InnerSolver::green, 1);
+    Run two = run(4096, fictus::Variant::smooth, fictus::InnerSolver::green, 2);
+    for (const Run* r : {&one, &two})
+      md << format("| %d | %.3f |", r->threads, r->solution->timings.total) << phase_cells(*r->solution) << "\n";
+    md << "| speed-up | " << format("%.2f", one.solution->timings.total / two.solution->timings.total) << " |";
+    for (const char* p : phase_names) {
+      const double a = one.solution->timings[p], b = two.solution->timings[p];
+      md << (b > 0 ? format(" %.2f |", a / b) : std::string(" – |"));
+    }
+    md << "\n";
   }
-  md << "\n";
   // 4. Sweeps at h = 1/1024 on one solver: 100 obstacles (boundary quantities only), 20 rotations.
   md << "\n## Sweeps on one grid, h = 1/1024, smooth, green, boundary quantities only\n\n| sweep | problems | first "
         "[s] | per problem after the first [s] | problems per second |\n|---|---|---|---|---|\n";
@@ -256,7 +258,10 @@ int main(int argc, char** argv) {
                  (count - 1) / rest);
   }
   std::filesystem::create_directories(out_dir);
-  const std::string path = out_dir + "/" + date + "-" + command_output("hostname") + ".md";
+  // A report already there (committed, of the same day and host) is kept: the new one gets -2, -3, …
+  const std::string stem = out_dir + "/" + date + "-" + command_output("hostname");
+  std::string path = stem + ".md";
+  for (int k = 2; std::filesystem::exists(path); ++k) path = stem + "-" + std::to_string(k) + ".md";
   std::ofstream(path) << md.str();
   std::printf("%s\nwrote %s\n", md.str().c_str(), path.c_str());
   return 0;

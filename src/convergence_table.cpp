@@ -41,6 +41,16 @@ std::array<double, 3> fitted_rates(const std::vector<LevelResult>& rows) {
   return slope;
 }
 
+std::optional<std::array<double, 3>> paper_rates_over(Variant variant, const std::vector<LevelResult>& rows) {
+  std::vector<LevelResult> paper;
+  for (const LevelResult& r : rows)
+    if (const std::optional<PaperRow> p = paper_row(variant, r.N))
+      paper.push_back({.N = p->N, .l2_omega = p->l2_omega, .h1_omega = p->h1_omega, .l2_gamma = p->l2_gamma});
+  if (paper.size() < 2) return std::nullopt;
+  if (paper.size() == paper_table(variant).size()) return paper_rates(variant);
+  return fitted_rates(paper);
+}
+
 std::string format_convergence_table(const std::string& title, const std::vector<LevelResult>& rows,
                                      std::optional<Variant> paper_variant) {
   std::string out = title + "\n";
@@ -67,10 +77,8 @@ std::string format_convergence_table(const std::string& title, const std::vector
   if (rows.size() >= 2) {
     const auto fit = fitted_rates(rows);
     out += printf_string("%-44s %9.2f %9.2f %9.2f |", "rates (least-squares fit)", fit[0], fit[1], fit[2]);
-    if (paper_variant) {
-      const auto pr = paper_rates(*paper_variant);
-      out += printf_string(" %-8s %8s %9.2f %9.2f %9.2f", "paper", "", pr[0], pr[1], pr[2]);
-    }
+    if (const auto pr = paper_variant ? paper_rates_over(*paper_variant, rows) : std::nullopt)
+      out += printf_string(" %-8s %8s %9.2f %9.2f %9.2f", "paper", "", (*pr)[0], (*pr)[1], (*pr)[2]);
     out += "\n";
   }
   return out;

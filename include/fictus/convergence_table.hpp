@@ -26,6 +26,11 @@ std::vector<std::array<double, 3>> observed_rates(const std::vector<LevelResult>
 /// Least-squares slope of log e against log h over all levels.
 std::array<double, 3> fitted_rates(const std::vector<LevelResult>& rows);
 
+/// The paper's rates over the levels of `rows`: its printed rates when the rows cover all six of its
+/// levels, else the least-squares slope of its figures at the levels shown (nothing when fewer than
+/// two of them are the paper's).
+std::optional<std::array<double, 3>> paper_rates_over(Variant variant, const std::vector<LevelResult>& rows);
+
 /// Our rows, with the paper's figures for the same h beside them where it has them.
 std::string format_convergence_table(const std::string& title, const std::vector<LevelResult>& rows,
                                      std::optional<Variant> paper_variant);
