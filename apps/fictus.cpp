@@ -197,7 +197,16 @@ int run_solve(const SolveCommand& command) {
         files.push_back({name, [&](std::ostream& out) { fictus::cli::write_vtp(out, solution); }});
     }
     fictus::cli::write_output_set(dir, files);
-    if (!command.quiet) std::printf("wrote %zu files to %s/\n", spec.output.files.size(), spec.output.dir.c_str());
+    if (!command.quiet) {
+      std::uintmax_t bytes = 0;
+      std::error_code error;
+      for (const std::string& name : spec.output.files) {
+        const std::uintmax_t size = fs::file_size(dir / name, error);
+        if (!error) bytes += size;
+      }
+      std::printf("wrote %zu files to %s/ (%.3g MiB; solution.vti is zlib-compressed)\n", spec.output.files.size(),
+                  spec.output.dir.c_str(), bytes / 1048576.0);
+    }
   }
   return 0;
 }

@@ -10,6 +10,7 @@ import csv
 import os
 import re
 import sys
+import zlib
 
 import matplotlib
 matplotlib.use("Agg")
@@ -17,22 +18,36 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 
+def appended_array(raw, offset, compressed):
+    """The bytes of one appended array: raw (a UInt64 size, then the bytes) or in VTK's zlib layout
+    (UInt64 block count, block size, last block size, compressed sizes, then the blocks)."""
+    if not compressed:
+        size = int(np.frombuffer(raw[offset:offset + 8], dtype="<u8")[0])
+        return raw[offset + 8:offset + 8 + size]
+    blocks = int(np.frombuffer(raw[offset:offset + 8], dtype="<u8")[0])
+    sizes = np.frombuffer(raw[offset + 24:offset + 24 + 8 * blocks], dtype="<u8")
+    start, parts = offset + 24 + 8 * blocks, []
+    for size in sizes:
+        parts.append(zlib.decompress(raw[start:start + int(size)]))
+        start += int(size)
+    return b"".join(parts)
+
+
 def read_vti(path):
-    """Reads fictus's own solution.vti: ImageData with raw appended arrays (UInt64 headers)."""
+    """Reads fictus's own solution.vti: ImageData with appended arrays (UInt64 headers, zlib or raw)."""
     with open(path, "rb") as handle:
         data = handle.read()
     head, _, tail = data.partition(b"<AppendedData encoding=\"raw\">")
     text = head.decode()
+    compressed = "vtkZLibDataCompressor" in text
     extent = [int(v) for v in re.search(r'WholeExtent="([^"]+)"', text).group(1).split()]
     origin = [float(v) for v in re.search(r'Origin="([^"]+)"', text).group(1).split()]
     spacing = [float(v) for v in re.search(r'Spacing="([^"]+)"', text).group(1).split()]
     raw = tail[tail.index(b"_") + 1:]
     arrays = {}
     for kind, name, offset in re.findall(r'type="(\w+)" Name="(\w+)" format="appended" offset="(\d+)"', text):
-        offset = int(offset)
-        size = int(np.frombuffer(raw[offset:offset + 8], dtype="<u8")[0])
         dtype = {"Float64": "<f8", "UInt8": "u1"}[kind]
-        values = np.frombuffer(raw[offset + 8:offset + 8 + size], dtype=dtype)
+        values = np.frombuffer(appended_array(raw, int(offset), compressed), dtype=dtype)
         arrays[name] = values.reshape(extent[3] + 1, extent[1] + 1)
     nx, ny = extent[1], extent[3]
     x = origin[0] + spacing[0] * np.arange(nx + 1)

@@ -1,7 +1,12 @@
 #include "vtk_io.hpp"
 
+#include <zlib.h>
+
+#include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "fictus/curve_grid_intersection.hpp"
@@ -9,11 +14,45 @@
 namespace fictus::cli {
 
 namespace {
+/// Deflates `size` bytes into `out` (a zlib stream, as VTK's reader inflates it). Run-length
+/// strategy at level 1: it takes the long runs of zeros outside ω at a fraction of the default's time.
+bool deflate_block(const unsigned char* data, std::uint64_t size, std::vector<unsigned char>& out) {
+  z_stream z{};
+  if (deflateInit2(&z, 1, Z_DEFLATED, 15, 8, Z_RLE) != Z_OK) return false;
+  out.resize(deflateBound(&z, uLong(size)));
+  z.next_in = const_cast<unsigned char*>(data);
+  z.avail_in = uInt(size);
+  z.next_out = out.data();
+  z.avail_out = uInt(out.size());
+  const bool done = deflate(&z, Z_FINISH) == Z_STREAM_END;
+  out.resize(z.total_out);
+  deflateEnd(&z);
+  return done;
+}
+
+/// One array of the appended section in VTK's zlib layout: a UInt64 header (number of blocks, block
+/// size, size of the last block, compressed size of each block), then the compressed blocks.
 template <class T>
-void append_raw(std::ostream& out, const std::vector<T>& values) {
+std::string zlib_block(const std::vector<T>& values) {
+  constexpr std::uint64_t block = 1 << 20;
+  const auto* data = reinterpret_cast<const unsigned char*>(values.data());
   const std::uint64_t bytes = values.size() * sizeof(T);
-  out.write(reinterpret_cast<const char*>(&bytes), sizeof bytes);
-  out.write(reinterpret_cast<const char*>(values.data()), std::streamsize(bytes));
+  const std::uint64_t blocks = bytes == 0 ? 0 : (bytes + block - 1) / block;
+  std::vector<std::uint64_t> header = {blocks, block, bytes == 0 ? 0 : bytes - (blocks - 1) * block};
+  // Blocks are independent: compressed in parallel, joined in order.
+  std::vector<std::vector<unsigned char>> parts(blocks);
+  bool failed = false;
+#pragma omp parallel for schedule(dynamic) reduction(|| : failed)
+  for (std::int64_t b = 0; b < std::int64_t(blocks); ++b) {
+    failed = failed || !deflate_block(data + b * block, std::min(block, bytes - b * block), parts[b]);
+  }
+  if (failed) throw std::runtime_error("output: zlib could not compress solution.vti");
+  std::string body;
+  for (const auto& part : parts) {
+    header.push_back(part.size());
+    body.append(reinterpret_cast<const char*>(part.data()), part.size());
+  }
+  return std::string(reinterpret_cast<const char*>(header.data()), header.size() * sizeof(std::uint64_t)) + body;
 }
 }  // namespace
 
@@ -42,33 +81,32 @@ void write_vti(std::ostream& out, const Problem& problem, const Solution& s) {
         error[k] = u[k] - exact[k];
       }
   }
-  const std::uint64_t header = sizeof(std::uint64_t);
-  std::uint64_t offset = 0;
+  struct Array {
+    const char* type;
+    const char* name;
+    std::string data;
+  };
+  std::vector<Array> arrays = {{"Float64", "u", zlib_block(u)}, {"UInt8", "inside", zlib_block(inside)}};
+  if (with_exact) {
+    arrays.push_back({"Float64", "u_exact", zlib_block(exact)});
+    arrays.push_back({"Float64", "error", zlib_block(error)});
+  }
   out.precision(17);
   out << "<?xml version=\"1.0\"?>\n"
-      << "<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+      << "<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\" "
+         "compressor=\"vtkZLibDataCompressor\">\n"
       << "  <ImageData WholeExtent=\"0 " << nx << " 0 " << ny << " 0 0\" Origin=\"" << grid.box().lower.x << ' '
       << grid.box().lower.y << " 0\" Spacing=\"" << grid.h() << ' ' << grid.h() << " 1\">\n"
       << "    <Piece Extent=\"0 " << nx << " 0 " << ny << " 0 0\">\n"
       << "      <PointData Scalars=\"u\">\n";
-  auto array = [&](const char* type, const char* name, std::uint64_t bytes) {
-    out << "        <DataArray type=\"" << type << "\" Name=\"" << name << "\" format=\"appended\" offset=\"" << offset
-        << "\"/>\n";
-    offset += header + bytes;
-  };
-  array("Float64", "u", n * 8);
-  array("UInt8", "inside", n);
-  if (with_exact) {
-    array("Float64", "u_exact", n * 8);
-    array("Float64", "error", n * 8);
+  std::uint64_t offset = 0;
+  for (const Array& a : arrays) {
+    out << "        <DataArray type=\"" << a.type << "\" Name=\"" << a.name << "\" format=\"appended\" offset=\""
+        << offset << "\"/>\n";
+    offset += a.data.size();
   }
   out << "      </PointData>\n    </Piece>\n  </ImageData>\n  <AppendedData encoding=\"raw\">\n   _";
-  append_raw(out, u);
-  append_raw(out, inside);
-  if (with_exact) {
-    append_raw(out, exact);
-    append_raw(out, error);
-  }
+  for (const Array& a : arrays) out.write(a.data.data(), std::streamsize(a.data.size()));
   out << "\n  </AppendedData>\n</VTKFile>\n";
 }
 

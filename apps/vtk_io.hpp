@@ -1,5 +1,6 @@
 #pragma once
-// ParaView files: solution.vti (VTK XML ImageData, raw appended Float64/UInt8 arrays) and
+// ParaView files: solution.vti (VTK XML ImageData, appended Float64/UInt8 arrays compressed with zlib in
+// 1 MiB blocks, as VTK's vtkZLibDataCompressor writes them) and
 // curves.vtp (VTK XML PolyData, γ and Γ as closed polylines with the point data of points.csv).
 #include <ostream>
 
