@@ -7,6 +7,7 @@
 Needs numpy and matplotlib (Debian: python3-numpy, python3-matplotlib).
 """
 import csv
+import json
 import os
 import re
 import sys
@@ -16,6 +17,22 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.ticker import NullFormatter, ScalarFormatter  # noqa: E402
+
+
+def plain(axis):
+    """Tick labels as plain numbers (scientific beyond 1e±4), never an offset such as "1e−6+9.999e−1"."""
+    formatter = ScalarFormatter(useOffset=False)
+    formatter.set_powerlimits((-3, 4))
+    axis.set_major_formatter(formatter)
+
+
+def variant_of(folder):
+    path = os.path.join(folder, "results.json")
+    if not os.path.exists(path):
+        return None
+    with open(path) as handle:
+        return json.load(handle).get("options", {}).get("variant")
 
 
 def appended_array(raw, offset, compressed):
@@ -71,7 +88,15 @@ def plot_solution(folder):
     u = np.where(arrays["inside"] > 0, arrays["u"], np.nan)
     fig, ax = plt.subplots(figsize=(7, 6))
     image = ax.pcolormesh(x, y, u, shading="auto", cmap="viridis")
-    fig.colorbar(image, ax=ax, label="û in ω")
+    bar = fig.colorbar(image, ax=ax, label="û in ω")
+    plain(bar.ax.yaxis)
+    title = "fictus: û, γ, Γ and the contact set"
+    if "u_exact" in arrays:  # the exact solution's contours (dashed) over û's (solid)
+        exact = np.where(arrays["inside"] > 0, arrays["u_exact"], np.nan)
+        levels = np.linspace(np.nanmin(exact), np.nanmax(exact), 9)[1:-1]
+        ax.contour(x, y, u, levels=levels, colors="k", linewidths=0.6)
+        ax.contour(x, y, exact, levels=levels, colors="w", linewidths=0.8, linestyles="--")
+        title += "\ncontours: û (black), exact solution (white, dashed)"
     ax.plot(closed(p["x"]), closed(p["y"]), "k-", lw=1, label="γ")
     if np.any(np.hypot(p["Gamma_x"] - p["x"], p["Gamma_y"] - p["y"]) > 0):
         ax.plot(closed(p["Gamma_x"]), closed(p["Gamma_y"]), "--", color="tab:orange", lw=1, label="Γ")
@@ -81,7 +106,7 @@ def plot_solution(folder):
     ax.set_xlabel("x")
     ax.set_ylabel("y")
     ax.legend(loc="upper right", fontsize=8)
-    ax.set_title("fictus: û, γ, Γ and the contact set")
+    ax.set_title(title, fontsize=10)
     fig.savefig(os.path.join(folder, "solution.png"), dpi=120)
     plt.close(fig)
 
@@ -90,13 +115,19 @@ def plot_profiles(folder):
     p = read_csv(os.path.join(folder, "points.csv"))
     fig, axes = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
     contact = p["contact"] > 0
-    for ax, values, label in zip(axes, (p["u"] - p["g"], p["dudn"], p["lambda"]), ("u − g", "∂u/∂n", "λ")):
+    variant = variant_of(folder)
+    lam = {"smooth": "λ: control on Γ\n(not a pressure)", "nonsmooth": "λ: contact\npressure on γ"}.get(variant, "λ")
+    # Round-off is shown as 0: values below 1e-9 of the problem's scale (|u|, |g|, |∂u/∂n|, |λ|).
+    scale = max(np.max(np.abs(p[key])) for key in ("u", "g", "dudn", "lambda"))
+    for ax, values, label in zip(axes, (p["u"] - p["g"], p["dudn"], p["lambda"]), ("u − g", "∂u/∂n", lam)):
+        values = np.where(np.abs(values) < 1e-9 * scale, 0.0, values)
+        plain(ax.yaxis)
         ax.plot(p["s"], values, "k.-", ms=3)
         ax.plot(p["s"][contact], values[contact], "r.", ms=4)
-        ax.axhline(0.0, color="gray", lw=0.5)
+        ax.axhline(0.0, color="gray", lw=0.5, zorder=0)
         ax.set_ylabel(label)
     axes[-1].set_xlabel("arc length s along γ (red: contact)")
-    fig.suptitle("Signorini conditions along γ")
+    fig.suptitle("Signorini conditions along γ" + (f" ({variant} variant)" if variant else ""))
     fig.savefig(os.path.join(folder, "profiles.png"), dpi=120)
     plt.close(fig)
 
@@ -107,23 +138,48 @@ PAPER = {  # relative L2(ω), L2(γ) of the paper's Tables 1 and 2, h = 1/128 �
 }
 
 
+def slope_triangle(ax, h, e, order, colour):
+    """A triangle of slope `order` below the data near its finest h, labelled with the order."""
+    h0, h1 = h, h * 2
+    e0 = e * 0.3
+    e1 = e0 * (h1 / h0) ** order
+    ax.loglog([h0, h1, h1, h0], [e0, e0, e1, e0], "-", color=colour, lw=0.8)
+    ax.text(h1 * 1.08, np.sqrt(e0 * e1), f"{order}", color=colour, fontsize=8, va="center")
+
+
 def plot_convergence(folder):
-    fig, ax = plt.subplots(figsize=(7, 5))
+    fig, ax = plt.subplots(figsize=(7.5, 5.5))
+    hs = []
     for table, colour in ((1, "C0"), (2, "C1")):
         path = os.path.join(folder, f"table{table}.csv")
         if not os.path.exists(path):
             continue
         t = read_csv(path)
+        hs += list(t["h"])
         ax.loglog(t["h"], t["rel_l2_omega"], "o-", color=colour, label=f"Table {table}: L²(ω)")
         ax.loglog(t["h"], t["rel_h1_omega"], "s-", color=colour, label=f"Table {table}: H¹(ω)")
         ax.loglog(t["h"], t["rel_l2_gamma"], "^-", color=colour, label=f"Table {table}: L²(γ)")
-        h_paper = [1 / 128 / 2 ** k for k in range(6)]
-        ax.loglog(h_paper, PAPER[table][0], "o:", color=colour, alpha=0.5, label=f"paper {table}: L²(ω)")
+        # the paper's rows at the levels shown
+        rows = [k for k in range(6) if np.any(np.isclose(t["h"], 1 / 128 / 2 ** k))]
+        if rows:
+            h_paper = [1 / 128 / 2 ** k for k in rows]
+            ax.loglog(h_paper, [PAPER[table][0][k] for k in rows], "o:", color=colour, alpha=0.5,
+                      label=f"paper {table}: L²(ω)")
+            ax.loglog(h_paper, [PAPER[table][1][k] for k in rows], "^:", color=colour, alpha=0.5,
+                      label=f"paper {table}: L²(γ)")
+        order = 1 if table == 1 else 2
+        slope_triangle(ax, min(t["h"]), min(t["rel_l2_omega"]), order, colour)
+    if hs:  # one tick per grid, labelled 1/N
+        ticks = sorted(set(hs))
+        ax.set_xticks(ticks)
+        ax.set_xticklabels([f"1/{round(1 / h)}" for h in ticks])
+        ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_xlabel("h")
     ax.set_ylabel("relative error")
-    ax.grid(True, which="both", lw=0.3)
-    ax.legend(fontsize=7)
-    ax.set_title("fictus convergence (dotted: the paper)")
+    ax.grid(True, which="major", lw=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    ax.set_title("fictus convergence; dotted: the paper (its H¹ column is not a relative error)\n"
+                 "triangles: slopes 1 (Table 1) and 2 (Table 2)", fontsize=9)
     fig.savefig(os.path.join(folder, "convergence.png"), dpi=120)
     plt.close(fig)
 
