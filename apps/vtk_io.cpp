@@ -32,27 +32,39 @@ bool deflate_block(const unsigned char* data, std::uint64_t size, std::vector<un
 
 /// One array of the appended section in VTK's zlib layout: a UInt64 header (number of blocks, block
 /// size, size of the last block, compressed size of each block), then the compressed blocks.
+/// One array of the appended section in VTK's zlib layout: a UInt64 header (number of blocks, block
+/// size, size of the last block, compressed size of each block), then the compressed blocks.
+struct ZlibArray {
+  std::vector<std::uint64_t> header;
+  std::vector<std::vector<unsigned char>> blocks;
+  std::uint64_t bytes() const {
+    std::uint64_t total = header.size() * sizeof(std::uint64_t);
+    for (const auto& block : blocks) total += block.size();
+    return total;
+  }
+  void write(std::ostream& out) const {  // straight from the blocks: no joined copy of the array
+    out.write(reinterpret_cast<const char*>(header.data()), std::streamsize(header.size() * sizeof(std::uint64_t)));
+    for (const auto& block : blocks)
+      out.write(reinterpret_cast<const char*>(block.data()), std::streamsize(block.size()));
+  }
+};
+
 template <class T>
-std::string zlib_block(const std::vector<T>& values) {
+ZlibArray zlib_array(const std::vector<T>& values) {
   constexpr std::uint64_t block = 1 << 20;
   const auto* data = reinterpret_cast<const unsigned char*>(values.data());
   const std::uint64_t bytes = values.size() * sizeof(T);
   const std::uint64_t blocks = bytes == 0 ? 0 : (bytes + block - 1) / block;
-  std::vector<std::uint64_t> header = {blocks, block, bytes == 0 ? 0 : bytes - (blocks - 1) * block};
-  // Blocks are independent: compressed in parallel, joined in order.
-  std::vector<std::vector<unsigned char>> parts(blocks);
+  ZlibArray array{{blocks, block, bytes == 0 ? 0 : bytes - (blocks - 1) * block},
+                  std::vector<std::vector<unsigned char>>(blocks)};
+  // Blocks are independent: compressed in parallel, kept in order.
   bool failed = false;
 #pragma omp parallel for schedule(dynamic) reduction(|| : failed)
-  for (std::int64_t b = 0; b < std::int64_t(blocks); ++b) {
-    failed = failed || !deflate_block(data + b * block, std::min(block, bytes - b * block), parts[b]);
-  }
+  for (std::int64_t b = 0; b < std::int64_t(blocks); ++b)
+    failed = failed || !deflate_block(data + b * block, std::min(block, bytes - b * block), array.blocks[b]);
   if (failed) throw std::runtime_error("output: zlib could not compress solution.vti");
-  std::string body;
-  for (const auto& part : parts) {
-    header.push_back(part.size());
-    body.append(reinterpret_cast<const char*>(part.data()), part.size());
-  }
-  return std::string(reinterpret_cast<const char*>(header.data()), header.size() * sizeof(std::uint64_t)) + body;
+  for (const auto& part : array.blocks) array.header.push_back(part.size());
+  return array;
 }
 }  // namespace
 
@@ -84,12 +96,12 @@ void write_vti(std::ostream& out, const Problem& problem, const Solution& s) {
   struct Array {
     const char* type;
     const char* name;
-    std::string data;
+    ZlibArray data;
   };
-  std::vector<Array> arrays = {{"Float64", "u", zlib_block(u)}, {"UInt8", "inside", zlib_block(inside)}};
+  std::vector<Array> arrays = {{"Float64", "u", zlib_array(u)}, {"UInt8", "inside", zlib_array(inside)}};
   if (with_exact) {
-    arrays.push_back({"Float64", "u_exact", zlib_block(exact)});
-    arrays.push_back({"Float64", "error", zlib_block(error)});
+    arrays.push_back({"Float64", "u_exact", zlib_array(exact)});
+    arrays.push_back({"Float64", "error", zlib_array(error)});
   }
   out.precision(17);
   out << "<?xml version=\"1.0\"?>\n"
@@ -103,10 +115,10 @@ void write_vti(std::ostream& out, const Problem& problem, const Solution& s) {
   for (const Array& a : arrays) {
     out << "        <DataArray type=\"" << a.type << "\" Name=\"" << a.name << "\" format=\"appended\" offset=\""
         << offset << "\"/>\n";
-    offset += a.data.size();
+    offset += a.data.bytes();
   }
   out << "      </PointData>\n    </Piece>\n  </ImageData>\n  <AppendedData encoding=\"raw\">\n   _";
-  for (const Array& a : arrays) out.write(a.data.data(), std::streamsize(a.data.size()));
+  for (const Array& a : arrays) a.data.write(out);
   out << "\n  </AppendedData>\n</VTKFile>\n";
 }
 
