@@ -110,7 +110,7 @@ std::pair<int, int> parse_levels(const std::string& text) {
 /// What `fictus solve` was given on the command line.
 struct SolveCommand {
   std::string problem_path, out = "results/solve";
-  std::vector<std::string> files;
+  std::vector<std::string> files, parameters;  // parameters: NAME=VALUE
   bool quiet = false;
   fictus::cli::OptionFlags flags;
   CLI::Option* out_option = nullptr;
@@ -132,24 +132,16 @@ void print_progress_lines(fictus::FictitiousDomainSolver& solver) {
 int run_solve(const SolveCommand& command) {
   const std::string& problem_path = command.problem_path;
   const fictus::cli::OptionFlags& flags = command.flags;
-  fictus::ProblemSpec spec;
-  if (!problem_path.empty()) {
-    spec = fictus::read_problem_file(problem_path);
-  } else {
-    // The paper's problem, with its m and δ unless the flags say otherwise.
-    fictus::Problem given;
-    fictus::SolverOptions options;
-    flags.apply(given, options);
-    if (given.N % 2)
-      throw std::invalid_argument(
-          "domain.N: the paper's problem needs an even N (its data have kinks on x = 1/2 and "
-          "y = 1/2, which must be grid lines), got " +
-          std::to_string(given.N));
-    spec.problem = fictus::paper_problem(given.N, given.c, given.boundary);
-    spec.options = fictus::paper_options(given.N, options.variant);
+  fictus::ParameterValues parameters;
+  for (const std::string& p : command.parameters) {
+    const std::size_t equals = p.find('=');
+    const std::vector<double> value =
+        equals == std::string::npos || equals == 0 ? std::vector<double>{} : fictus::cli::parse_values(p.substr(equals + 1), "--parameter");
+    if (value.size() != 1)
+      throw std::invalid_argument("--parameter: expected NAME=VALUE, e.g. a=0.25, got \"" + p.substr(0, 60) + "\"");
+    parameters[p.substr(0, equals)] = value[0];
   }
-  flags.apply(spec.problem, spec.options);
-  fictus::validate_options(spec.problem, spec.options);
+  fictus::ProblemSpec spec = fictus::cli::problem_from(problem_path, flags, parameters);
   if (command.out_option->count() > 0) spec.output.dir = command.out;
   if (command.files_option->count() > 0) {
     for (const std::string& f : command.files)
@@ -162,10 +154,7 @@ int run_solve(const SolveCommand& command) {
   for (const std::string& w : spec.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
 
   const fictus::Problem& problem = spec.problem;
-  const json input = problem_path.empty()
-                         ? json{{"geometry", "the paper's ellipse (built in)"},
-                                {"data", "the paper's f, g and exact solution (built in; f follows c)"}}
-                         : json::parse(spec.input_json);
+  const json input = json::parse(spec.input_json);
   if (!spec.output.dir.empty()) fictus::cli::check_output_folder(spec.output.dir, spec.output.files);
   fictus::check_memory(problem, spec.options);
   const double seconds = fictus::estimated_seconds(problem, spec.options);
@@ -310,6 +299,9 @@ int main(int argc, char** argv) {
   solve.out_option = solve_cmd->add_option("--out", solve.out, "output.dir: folder for the output files (\"\": none)")
                          ->capture_default_str();
   solve_cmd->add_option("--dir", solve.out, "alias of --out")->group("");
+  solve_cmd->add_option("--parameter", solve.parameters,
+                        "NAME=VALUE: a value for an entry of the problem file's [parameters] (repeatable)")
+      ->allow_extra_args(false);
   solve_cmd->add_flag("--quiet", solve.quiet, "print only warnings and errors (no estimate, progress or summary)");
   solve.files_option =
       solve_cmd
@@ -339,20 +331,25 @@ int main(int argc, char** argv) {
                       },
                       {{"offset", "here: 1 (the paper's δ = L/m)"}});
 
-  // sweep: the paper's problem on one grid; its m unless --multipliers is given.
+  // sweep: a problem file (or the paper's problem) varied by one quantity, on one grid.
   fictus::cli::OptionFlags sweep_flags;
   fictus::cli::SweepArguments sweep_args;
   CLI::App* sweep_cmd = app.add_subcommand(
-      "sweep", "solve a family of problems on one grid (paper's problem; g scaled, or the curve rotated or moved)");
+      "sweep", "solve a family of problems on one grid: the obstacle scaled, the curve rotated or moved, or a parameter");
+  sweep_cmd->add_option("problem", sweep_args.problem_path, "problem file (default: the paper's problem)");
   sweep_cmd->add_option("--g-scale", sweep_args.g_scale, "obstacle factors: a,b,c or start:stop:count");
   sweep_cmd->add_option("--rotate", sweep_args.rotate,
                         "rotations of γ about its center [rad]: a,b,c or start:stop:count");
   sweep_cmd->add_option("--move", sweep_args.move, "shifts of γ along x: a,b,c or start:stop:count");
-  sweep_cmd->add_option("--out", sweep_args.out, "write sweep.csv here (\"\": none)")->capture_default_str();
-  sweep_flags.add(*sweep_cmd, [](const fictus::OptionSpec& s) { return s.section != "data" && s.key != "box"; },
-                  {{"multipliers", "here: the paper's m"},
-                   {"offset", "here: 1 (the paper's δ = L/m)"},
-                   {"condition_number", "here: false"}});
+  sweep_cmd->add_option("--parameter", sweep_args.parameter,
+                        "NAME=LIST: values of a [parameters] entry of the problem file, e.g. a=0:0.2:11");
+  sweep_cmd->add_option("--out", sweep_args.out, "write sweep.csv and sweep.json here (\"\": none)")
+      ->capture_default_str();
+  sweep_flags.add(
+      *sweep_cmd, [](const fictus::OptionSpec&) { return true; },
+      {{"multipliers", "without a problem file: the paper's m"},
+       {"offset", "without a problem file: 1 (the paper's δ = L/m)"},
+       {"condition_number", "here: false"}});
 
   CLI::App* options_cmd = app.add_subcommand("options", "list every option: key, default, allowed values, meaning");
   bool markdown = false, as_json = false;
@@ -378,14 +375,7 @@ int main(int argc, char** argv) {
     if (*solve_cmd) return run_solve(solve);
     if (*plot_cmd) return run_plot(plot_dir);
     if (*reproduce_cmd) return run_reproduce(reproduce_flags, reproduce_out, table, levels);
-    if (*sweep_cmd) {
-      fictus::Problem problem;
-      fictus::SolverOptions options = fictus::paper_options(problem.N, fictus::Variant::smooth);
-      options.multipliers = 0;  // the paper's m at the sweep's N (run_sweep)
-      options.condition_number = false;
-      sweep_flags.apply(problem, options);
-      return fictus::cli::run_sweep(sweep_args, problem, options);
-    }
+    if (*sweep_cmd) return fictus::cli::run_sweep(sweep_args, sweep_flags);
     if (*options_cmd) {
       if (markdown) {
         std::printf("%s", fictus::options_markdown().c_str());

@@ -1,6 +1,11 @@
 #include "option_flags.hpp"
 
 #include <algorithm>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "fictus/paper_problem.hpp"
 
 namespace fictus::cli {
 
@@ -39,6 +44,32 @@ void OptionFlags::apply(Problem& problem, SolverOptions& options) const {
   for (const Flag& f : flags_)
     if (given(f.spec->key)) set_option(*f.spec, problem, options, parse_option_text(*f.spec, text_.at(f.spec->key)));
   if (no_condition_flag_ && no_condition_flag_->count() > 0) options.condition_number = false;
+}
+
+ProblemSpec problem_from(const std::string& path, const OptionFlags& flags, const ParameterValues& parameters) {
+  ProblemSpec spec;
+  if (!path.empty()) {
+    spec = read_problem_file(path, parameters);
+  } else {
+    if (!parameters.empty()) throw std::invalid_argument("--parameter: only a problem file has [parameters]");
+    // The paper's problem, with its m and δ unless the flags say otherwise.
+    Problem given;
+    SolverOptions options;
+    flags.apply(given, options);
+    if (given.N % 2)
+      throw std::invalid_argument(
+          "domain.N: the paper's problem needs an even N (its data have kinks on x = 1/2 and "
+          "y = 1/2, which must be grid lines), got " +
+          std::to_string(given.N));
+    spec.problem = paper_problem(given.N, given.c, given.boundary);
+    spec.options = paper_options(given.N, options.variant);
+    spec.input_json = nlohmann::json{{"geometry", "the paper's ellipse (built in)"},
+                                     {"data", "the paper's f, g and exact solution (built in; f follows c)"}}
+                          .dump();
+  }
+  flags.apply(spec.problem, spec.options);
+  validate_options(spec.problem, spec.options);
+  return spec;
 }
 
 }  // namespace fictus::cli

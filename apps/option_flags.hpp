@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "fictus/io/problem_file.hpp"
 #include "fictus/options.hpp"
 
 namespace fictus::cli {
@@ -33,5 +34,10 @@ class OptionFlags {
   bool no_condition_ = false;
   CLI::Option* no_condition_flag_ = nullptr;
 };
+
+/// The problem a command works on, with the flags applied and checked: the problem file at `path`
+/// (its [parameters] replaced by `parameters`), or without one the paper's problem with its m and δ
+/// unless the flags give them. `input` is set to what results.json echoes under "problem".
+ProblemSpec problem_from(const std::string& path, const OptionFlags& flags, const ParameterValues& parameters = {});
 
 }  // namespace fictus::cli

@@ -8,9 +8,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <nlohmann/json.hpp>
+
 #include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/io/process.hpp"
-#include "fictus/paper_problem.hpp"
+#include "fictus/shapes.hpp"
 #include "results_io.hpp"
 
 namespace fictus::cli {
@@ -43,55 +45,158 @@ std::vector<double> parse_values(const std::string& text, const std::string& opt
   return values;
 }
 
-int run_sweep(const SweepArguments& args, const Problem& domain, SolverOptions options) {
-  const int kinds = !args.g_scale.empty() + !args.rotate.empty() + !args.move.empty();
-  if (kinds != 1) throw std::invalid_argument("sweep: give exactly one of --g-scale, --rotate, --move");
-  const std::string parameter = !args.g_scale.empty() ? "g_scale" : !args.rotate.empty() ? "rotate" : "move";
-  const std::vector<double> values = parse_values(!args.g_scale.empty()  ? args.g_scale
-                                                  : !args.rotate.empty() ? args.rotate
-                                                                         : args.move,
-                                                  "--" + parameter);
+namespace {
 
-  if (!args.out.empty()) check_output_folder(args.out, {"sweep.csv"});
-  const Problem base = paper_problem(domain.N, domain.c, domain.boundary);
-  if (options.multipliers == 0) options.multipliers = paper_multipliers(domain.N);
-  check_memory(base, options);
-  FictitiousDomainSolver solver(base, options);
+/// What a sweep varies, and how much of the solver's work each member can reuse.
+struct Family {
+  std::string kind;  // g_scale, rotate, move or parameter
+  std::string name;  // the CSV's first column: the kind, or the parameter's name
+  std::vector<double> values;
+  bool moves_curve = false;  // new trace rows and Schur blocks per member
+  bool changes_load = false;  // a new u₀ per member
+};
+
+Family family_of(const SweepArguments& args, const ProblemSpec& base) {
+  const int kinds = !args.g_scale.empty() + !args.rotate.empty() + !args.move.empty() + !args.parameter.empty();
+  if (kinds != 1) throw std::invalid_argument("sweep: give exactly one of --g-scale, --rotate, --move, --parameter");
+  Family f;
+  if (!args.g_scale.empty()) f = {"g_scale", "g_scale", parse_values(args.g_scale, "--g-scale"), false, false};
+  if (!args.rotate.empty()) f = {"rotate", "rotate", parse_values(args.rotate, "--rotate"), true, false};
+  if (!args.move.empty()) f = {"move", "move", parse_values(args.move, "--move"), true, false};
+  if (!args.parameter.empty()) {
+    const std::size_t equals = args.parameter.find('=');
+    if (equals == std::string::npos || equals == 0)
+      throw std::invalid_argument("--parameter: expected NAME=LIST, e.g. a=0.1,0.2 or a=0:1:11, got \"" +
+                                  args.parameter.substr(0, 60) + "\"");
+    f.kind = "parameter";
+    f.name = args.parameter.substr(0, equals);
+    f.values = parse_values(args.parameter.substr(equals + 1), "--parameter");
+    if (args.problem_path.empty())
+      throw std::invalid_argument("--parameter: needs a problem file with a [parameters] section");
+    if (!base.parameters.count(f.name)) {
+      std::string known;
+      for (const auto& [n, v] : base.parameters) known += (known.empty() ? "" : ", ") + n;
+      throw std::invalid_argument("--parameter: " + f.name.substr(0, 40) + " is not in the problem file's [parameters] (" +
+                                  (known.empty() ? "it has none" : known) + ")");
+    }
+    const auto uses = base.parameter_uses.find(f.name);
+    if (uses == base.parameter_uses.end())
+      throw std::invalid_argument("--parameter: no expression of the problem file uses " + f.name);
+    for (const std::string& key : uses->second) {
+      f.moves_curve |= key.rfind("geometry.", 0) == 0;
+      f.changes_load |= key == "data.f";
+    }
+  }
+  return f;
+}
+
+/// Member k of the family: the base problem changed by one value.
+Problem member(const Family& family, const ProblemSpec& base, const SweepArguments& args, const OptionFlags& flags,
+               double v) {
+  Problem problem = base.problem;
+  if (family.kind == "g_scale") {
+    if (problem.g) problem.g = [g = base.problem.g, v](double x, double y) { return v * g(x, y); };
+    if (problem.g_along_curve)
+      problem.g_along_curve = [g = base.problem.g_along_curve, v](double x, double y, double s) {
+        return v * g(x, y, s);
+      };
+  } else if (family.kind == "rotate") {
+    problem.gamma = std::make_shared<TransformedCurve>(base.problem.gamma, v, Point2{0, 0});
+  } else if (family.kind == "move") {
+    problem.gamma = std::make_shared<TransformedCurve>(base.problem.gamma, 0.0, Point2{v, 0});
+    if (base.g_about) problem.g_along_curve = base.g_about(problem.gamma->center());  // phi about the moved center
+  } else {
+    problem = problem_from(args.problem_path, flags, {{family.name, v}}).problem;
+    if (!family.moves_curve) problem.gamma = base.problem.gamma;  // the same rows and Schur blocks
+  }
+  if (family.kind != "parameter") problem.exact = nullptr;  // the exact solution is the base problem's
+  return problem;
+}
+
+}  // namespace
+
+int run_sweep(const SweepArguments& args, const OptionFlags& flags) {
+  const ProblemSpec base = problem_from(args.problem_path, flags);
+  const Family family = family_of(args, base);
+  for (const std::string& w : base.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
+  if (!args.out.empty()) check_output_folder(args.out, {"sweep.csv", "sweep.json"});
+  SolverOptions options = base.options;
+  if (!flags.given("condition_number")) options.condition_number = false;
+  check_memory(base.problem, options);
+  FictitiousDomainSolver solver(base.problem, options);
+
   std::ostringstream csv;
   csv.precision(12);
-  csv << parameter << ",iterations,converged,n_active,min_gap,min_normal_derivative,max_complementarity,seconds\n";
-  std::printf("%-10s %5s %8s %12s %12s %10s\n", parameter.c_str(), "it0", "active", "min gap", "min du/dn", "time[s]");
+  csv << family.name
+      << ",converged,newton_steps,multipliers,contact_points,contact_measure,contact_force,lambda_integral,min_gap,max_gap,"
+         "min_normal_derivative,max_complementarity,seconds\n";
+  nlohmann::json rows = nlohmann::json::array();
+  std::printf("%-12s %5s %7s %11s %11s %11s %11s %9s\n", family.name.substr(0, 12).c_str(), "it0", "contact",
+              "measure", "force", "min gap", "max gap", "time[s]");
   double first = 0, rest = 0;
   int failures = 0;
-  for (std::size_t k = 0; k < values.size(); ++k) {
-    Problem problem = base;
-    const double v = values[k];
-    if (parameter == "g_scale") problem.g = [g = base.g, v](double x, double y) { return v * g(x, y); };
-    if (parameter == "rotate") problem.gamma = std::make_shared<TransformedCurve>(base.gamma, v, Point2{0, 0});
-    if (parameter == "move") problem.gamma = std::make_shared<TransformedCurve>(base.gamma, 0.0, Point2{v, 0});
+  for (std::size_t k = 0; k < family.values.size(); ++k) {
+    const double v = family.values[k];
     const auto start = std::chrono::steady_clock::now();
-    const Solution s = solver.solve(problem, options, false);  // boundary quantities only
+    Solution s(solver.grid());
+    try {
+      const Problem problem = member(family, base, args, flags, v);
+      if (family.changes_load) solver.replace_load(problem);
+      s = solver.solve(problem, options, false);  // boundary quantities only
+    } catch (const std::invalid_argument& e) {
+      std::ostringstream at;
+      at.precision(12);
+      at << " (at " << family.name << " = " << v << ")";
+      throw std::invalid_argument(e.what() + at.str());
+    }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     (k == 0 ? first : rest) += seconds;
     failures += !s.newton.converged;
-    const long active = std::count(s.newton.active.begin(), s.newton.active.end(), 1);
-    std::printf("%-10.4g %5d %8ld %12.3e %12.3e %10.4f%s\n", v, s.newton.iterations, active, s.signorini.min_gap,
-                s.signorini.min_normal_derivative, seconds, s.newton.converged ? "" : "  NOT converged");
-    csv << v << ',' << s.newton.iterations << ',' << s.newton.converged << ',' << active << ',' << s.signorini.min_gap
-        << ',' << s.signorini.min_normal_derivative << ',' << s.signorini.max_complementarity << ',' << seconds << '\n';
+    const ContactSummary c = contact_summary(s);
+    std::printf("%-12.6g %5d %7ld %11.4e %11.4e %11.3e %11.3e %9.4f%s\n", v, s.newton.iterations, c.points, c.measure,
+                c.force, c.min_gap, c.max_gap, seconds, s.newton.converged ? "" : "  NOT converged");
+    csv << v << ',' << s.newton.converged << ',' << s.newton.iterations << ',' << s.collocation.m << ',' << c.points << ',' << c.measure << ','
+        << c.force << ',' << c.lambda << ',' << c.min_gap << ',' << c.max_gap << ',' << s.signorini.min_normal_derivative
+        << ',' << s.signorini.max_complementarity << ',' << seconds << '\n';
+    rows.push_back({{family.name, v},
+                    {"converged", s.newton.converged},
+                    {"newton_steps", s.newton.iterations},
+                    {"multipliers", s.collocation.m},
+                    {"contact_points", c.points},
+                    {"contact_measure", c.measure},
+                    {"contact_force", c.force},
+                    {"lambda_integral", c.lambda},
+                    {"min_gap", c.min_gap},
+                    {"max_gap", c.max_gap},
+                    {"min_normal_derivative", s.signorini.min_normal_derivative},
+                    {"max_complementarity", s.signorini.max_complementarity},
+                    {"seconds", seconds}});
   }
-  const std::size_t n_rest = values.size() - 1;
-  std::printf("first problem %.3f s (grid setup included); ", first);
+  const std::size_t n_rest = family.values.size() - 1;
+  std::printf("first problem %.3f s (grid setup included)", first);
   if (n_rest > 0)
-    std::printf("then %.4f s per problem, %.1f problems per second\n", rest / n_rest, n_rest / rest);
+    std::printf("; then %.4f s per problem (%s), %.1f problems per second\n", rest / n_rest,
+                family.changes_load  ? "new u0 and Newton"
+                : family.moves_curve ? "new curve rows, Schur blocks and Newton"
+                                     : "Newton only",
+                n_rest / rest);
   else
     std::printf("\n");
   if (!args.out.empty()) {
-    write_output_set(args.out, {{"sweep.csv", [&](std::ostream& out) { out << csv.str(); }}});
-    std::printf("wrote %s/sweep.csv\n", args.out.c_str());
+    nlohmann::json j{{"version", FICTUS_VERSION},
+                     {"commit", FICTUS_GIT_COMMIT},
+                     {"problem", nlohmann::json::parse(base.input_json)},
+                     {"options", options_to_json(base.problem, options)},
+                     {"sweep", {{"kind", family.kind}, {"name", family.name}, {"values", family.values}}},
+                     {"rows", rows}};
+    j["problem"]["name"] = base.problem.name;
+    write_output_set(args.out, {{"sweep.csv", [&](std::ostream& out) { out << csv.str(); }},
+                                {"sweep.json", [&](std::ostream& out) { out << j.dump(2) << '\n'; }}});
+    std::printf("wrote sweep.csv and sweep.json to %s/\n", args.out.c_str());
   }
   if (failures) {
-    std::fprintf(stderr, "fictus: error: Newton did not converge for %d of %zu problems\n", failures, values.size());
+    std::fprintf(stderr, "fictus: error: Newton did not converge for %d of %zu problems\n", failures,
+                 family.values.size());
     return 2;
   }
   return 0;

@@ -2,19 +2,23 @@
 #include <string>
 #include <vector>
 
-#include "fictus/problem.hpp"
+#include "option_flags.hpp"
 
 namespace fictus::cli {
 
 struct SweepArguments {
-  std::string g_scale, rotate, move;  // lists "a,b,c" or "start:stop:count"
+  std::string problem_path;                      // "" = the paper's problem
+  std::string g_scale, rotate, move, parameter;  // lists "a,b,c" or "start:stop:count"; parameter "NAME=LIST"
   std::string out = "results/sweep";
 };
 
 /// Values of a list option: "a,b,c" or "start:stop:count" (count points, both ends included).
 std::vector<double> parse_values(const std::string& text, const std::string& option);
 
-/// The paper's problem on the grid of `domain` (its N, c and boundary conditions), one solver for all.
-int run_sweep(const SweepArguments& args, const Problem& domain, SolverOptions options);
+/// A family of problems on one grid: the problem file (or the paper's problem) with its obstacle
+/// scaled, its curve rotated or moved, or one of its [parameters] set to each value. One solver
+/// serves all: the Green's table always, u₀ unless the parameter is in f, the curve's rows and Schur
+/// blocks unless the curve changes. Prints a line per member, writes sweep.csv and sweep.json.
+int run_sweep(const SweepArguments& args, const OptionFlags& flags);
 
 }  // namespace fictus::cli

@@ -139,7 +139,7 @@ PyProblem PyProblem::from_config(py::dict config) {
   for (auto [k, v] : config) {
     const std::string key = py::str(k);
     if (key == "domain" || key == "geometry" || key == "formulation" || key == "data" || key == "solver" ||
-        key == "output") {
+        key == "output" || key == "parameters") {
       if (!py::isinstance<py::dict>(v)) throw std::invalid_argument(key + ": expected a dict");
       py::dict target = section(key);
       for (auto [kk, vv] : v.cast<py::dict>()) target[kk] = vv;

@@ -183,6 +183,18 @@ void bind_solution(py::module_& m) {
                                }
                                return d;
                              })
+      .def_property_readonly("contact_summary",
+                             [](const PySolution& p) {
+                               const ContactSummary c = contact_summary(p.s());
+                               py::dict d;
+                               d["points"] = c.points;
+                               d["measure"] = c.measure;
+                               d["force"] = c.force;
+                               d["lambda_integral"] = c.lambda;
+                               d["min_gap"] = c.min_gap;
+                               d["max_gap"] = c.max_gap;
+                               return d;
+                             })
       .def_property_readonly("errors",
                              [](const PySolution& p) -> py::object {
                                if (!p.s().errors) return py::none();

@@ -72,6 +72,10 @@ bool same_curve_options(const SolverOptions& a, const SolverOptions& b) {
 /// these values, which must stay far from the overflow at 1.8e308.
 constexpr double largest_scale = 1e100;
 
+bool same_box(const Box2& a, const Box2& b) {
+  return a.lower.x == b.lower.x && a.lower.y == b.lower.y && a.upper.x == b.upper.x && a.upper.y == b.upper.y;
+}
+
 template <class Vector>
 bool all_finite(const Vector& v) {
   for (double x : v)
@@ -108,6 +112,7 @@ struct CurveSetup {
   std::unique_ptr<SchurComplement> schur;
   Eigen::VectorXd b0, c0;            // B_γu₀, C_γu₀
   std::optional<ConstantMode> mode;  // singular A only
+  int load_version = 0;              // the u₀ that b0, c0 and mode came from
 };
 
 struct FictitiousDomainSolver::State {
@@ -122,6 +127,7 @@ struct FictitiousDomainSolver::State {
   GridVector u0;
   bool have_u0 = false;
   double load_total = 0;
+  int load_version = 0;  // counts the loads given (replace_load)
   std::unique_ptr<CurveSetup> setup;
 };
 
@@ -141,6 +147,7 @@ FictitiousDomainSolver::FictitiousDomainSolver(const Problem& problem, const Sol
                                          {},
                                          false,
                                          0.0,
+                                         0,
                                          nullptr});
 }
 
@@ -150,6 +157,19 @@ const Grid2& FictitiousDomainSolver::grid() const { return state_->grid; }
 
 void FictitiousDomainSolver::set_interrupt_check(std::function<bool()> check) {
   state_->execution.set_interrupt_check(std::move(check));
+}
+
+void FictitiousDomainSolver::replace_load(const Problem& problem) {
+  State& st = *state_;
+  if (!problem.f && !problem.f_vectorized) throw std::invalid_argument("data.f: not given");
+  if (problem.N != st.grid.nx() || problem.c != st.c || problem.boundary != st.grid.boundary() ||
+      !same_box(problem.box, st.grid.box()))
+    throw std::invalid_argument(
+        "data.f: replace_load keeps the grid, c and the boundary conditions; make a new solver to change them");
+  st.f = problem.f;
+  st.f_vectorized = problem.f_vectorized;
+  st.have_u0 = false;
+  ++st.load_version;
 }
 
 void FictitiousDomainSolver::set_progress(std::function<void(const std::string&, double)> progress) {
@@ -205,27 +225,36 @@ std::unique_ptr<SchurComplement> schur_blocks(State& st, const BoundaryDiscretiz
   return schur;
 }
 
+/// The parts of a curve's setup that come from u₀: B_γu₀, C_γu₀ and (singular A) the load's total.
+void load_terms(const State& st, CurveSetup& setup) {
+  const BoundaryDiscretization& boundary = *setup.boundary;
+  std::vector<double> b0, c0;
+  boundary.B_gamma().multiply(st.u0, b0);
+  boundary.C_gamma().multiply(st.u0, c0);
+  setup.b0 = to_eigen(b0);
+  setup.c0 = to_eigen(c0);
+  if (st.fast->singular())
+    setup.mode = ConstantMode{row_sums(boundary.B_gamma()), row_sums(boundary.C_gamma()), row_sums(boundary.B_Gamma()),
+                              st.load_total};
+  setup.load_version = st.load_version;
+}
+
 /// Steps 1–3 for data.gamma, or the previous ones when the curve and its options are unchanged.
 const CurveSetup& curve_setup(State& st, const ContactData& data, const SolverOptions& options, PhaseClock& clock,
                               bool& reused) {
   reused = st.setup && st.setup->gamma == data.gamma && same_curve_options(st.setup->options, options);
-  if (reused) return *st.setup;
+  if (reused) {
+    if (st.setup->load_version != st.load_version) load_terms(st, *st.setup);  // a new f, the same rows
+    return *st.setup;
+  }
   st.setup.reset();
   auto setup = std::make_unique<CurveSetup>();
   setup->gamma = data.gamma;
   setup->options = options;
   setup->boundary = std::make_unique<CurveDiscretization>(data.gamma, st.grid, options, st.c, st.execution);
-  const BoundaryDiscretization& boundary = *setup->boundary;
-  std::vector<double> b0, c0;
-  boundary.B_gamma().multiply(st.u0, b0);
-  boundary.C_gamma().multiply(st.u0, c0);
-  setup->b0 = to_eigen(b0);
-  setup->c0 = to_eigen(c0);
-  if (st.fast->singular())
-    setup->mode = ConstantMode{row_sums(boundary.B_gamma()), row_sums(boundary.C_gamma()), row_sums(boundary.B_Gamma()),
-                               st.load_total};
+  load_terms(st, *setup);
   clock.mark("geometry");
-  setup->schur = schur_blocks(st, boundary, options, clock);
+  setup->schur = schur_blocks(st, *setup->boundary, options, clock);
   st.setup = std::move(setup);
   return *st.setup;
 }
@@ -452,6 +481,28 @@ double estimated_seconds(const Problem& problem, const SolverOptions& options) {
   const double seconds =
       options.inner == InnerSolver::green ? grid + pairs + dense : grid + 2.5 * m * 2.5 * 2.3e-10 * n_log_n;
   return seconds * 2 / threads;
+}
+
+ContactSummary contact_summary(const Solution& s) {
+  ContactSummary c;
+  const Collocation& points = s.collocation;
+  const double spacing = points.length / points.m;
+  const double control_spacing =
+      s.Gamma && s.options.variant == Variant::smooth ? ArcLengthTable(*s.Gamma).length() / points.m : spacing;
+  c.min_gap = std::numeric_limits<double>::infinity();
+  c.max_gap = -c.min_gap;
+  for (int i = 0; i < points.m; ++i) {
+    const double gap = s.trace[i] - s.g[i];
+    c.min_gap = std::min(c.min_gap, gap);
+    c.max_gap = std::max(c.max_gap, gap);
+    c.lambda += s.lambda[i] * control_spacing;
+    if (s.newton.active[i] == 1) {
+      ++c.points;
+      c.force += s.normal_derivative[i] * spacing;
+    }
+  }
+  c.measure = c.points * spacing;
+  return c;
 }
 
 std::string describe_newton_failure(const Solution& s) {

@@ -98,6 +98,11 @@ class FictitiousDomainSolver {
   /// (execution.hpp) within about one fast solve. The bindings use it for Ctrl-C.
   void set_interrupt_check(std::function<bool()> check);
 
+  /// A new load f (problem.f or problem.f_vectorized) on the same grid, c and boundary conditions:
+  /// u₀ is recomputed on the next solve; the Green's table and the curve's trace rows and Schur blocks
+  /// are kept (a sweep over a parameter of f costs one fast solve and one Newton per member).
+  void replace_load(const Problem& problem);
+
   /// Called with each step's name and seconds as the step ends (the CLI's progress lines).
   void set_progress(std::function<void(const std::string& phase, double seconds)> progress);
 
@@ -112,6 +117,19 @@ class FictitiousDomainSolver {
  private:
   std::unique_ptr<State> state_;
 };
+
+/// The contact in numbers, from the per-point values of a solution (point i owns the arc L/m of γ
+/// around it).
+struct ContactSummary {
+  long points = 0;      // points in contact (the active set)
+  double measure = 0;   // length of the contact set: points · L/m
+  double force = 0;     // total contact force ∫ ∂u/∂n ds over the contact set: Σ_active (C_γû)_i · L/m
+  double lambda = 0;    // non-smooth: ∫_γ λ ds = Σ λ_i · L/m, the force from the multipliers ([∂û/∂n] = λ);
+                        // smooth: the total control on Γ, Σ λ_i · |Γ|/m (not a force on γ)
+  double min_gap = 0;   // min_i (B_γû − g)_i  (≈ 0: the contact points)
+  double max_gap = 0;   // max_i (B_γû − g)_i  (the widest opening)
+};
+ContactSummary contact_summary(const Solution& solution);
 
 /// The peak memory of a solve, estimated before anything is allocated: three grid arrays (u₀, the
 /// field, and the Green's table or the Krylov work vector) of 8 bytes per node, four dense m×m blocks

@@ -212,3 +212,18 @@ def test_ctrl_c_stops_a_solve_within_a_fraction_of_a_second(schur, N):
     stopped = time.perf_counter() - start
     assert stopped < 0.3 + 1.0, f"stopped {stopped:.2f} s after the start, the signal came at 0.3 s"
     assert fictus.Problem.paper(N=128).solve().converged  # the module is still usable
+
+
+def test_parameters_and_the_contact_summary_match_the_cli(tmp_path):
+    path = os.path.join(EXAMPLES, "parameters.toml")
+    results, _ = cli_solve(tmp_path, path, "--N", "128", "--parameter", "height=0.02")
+    with open(path) as handle:
+        text = handle.read().replace("N = 256", "N = 128").replace("height = 0.0", "height = 0.02")
+    s = fictus.Problem.from_toml(text).solve()
+    for key, value in results["contact"].items():
+        assert s.contact_summary[key] == pytest.approx(value, rel=1e-12, abs=1e-15), key
+    assert s.contact_summary["points"] == int(s.contact.sum())
+    d = fictus.Problem.from_dict({**CIRCLE, "parameters": {"a": 0.05},
+                                  "data": {"f": "-1", "g": "a * x"}}).solve()
+    e = fictus.Problem.from_dict({**CIRCLE, "data": {"f": "-1", "g": "0.05 * x"}}).solve()
+    np.testing.assert_array_equal(d.lambda_, e.lambda_)

@@ -14,6 +14,7 @@ namespace fictus {
 struct Expression::Shared {
   std::string text, key;
   std::vector<std::string> variables;
+  std::vector<std::pair<std::string, double>> constants;
   std::uint64_t id;
 };
 
@@ -45,8 +46,10 @@ double* make_local(const char* name, void* data) {
   return &c->locals.emplace_back(0.0);
 }
 
-std::unique_ptr<Compiled> compile(const std::string& text, const std::vector<std::string>& variables) {
+std::unique_ptr<Compiled> compile(const std::string& text, const std::vector<std::string>& variables,
+                                  const std::vector<std::pair<std::string, double>>& constants) {
   auto c = std::make_unique<Compiled>();
+  for (const auto& [name, value] : constants) c->parser.DefineConst(name, value);
   c->values.assign(variables.size(), 0.0);
   for (std::size_t k = 0; k < variables.size(); ++k) c->parser.DefineVar(variables[k], &c->values[k]);
   c->parser.SetVarFactory(make_local, c.get());
@@ -56,18 +59,24 @@ std::unique_ptr<Compiled> compile(const std::string& text, const std::vector<std
 
 bool is_name_char(char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; }
 
+/// Where `name` first appears in `text` as a whole word, or npos.
+std::size_t find_word(const std::string& text, const std::string& name) {
+  std::size_t at = 0;
+  while ((at = text.find(name, at)) != std::string::npos) {
+    const bool starts = at == 0 || !is_name_char(text[at - 1]);
+    const std::size_t end = at + name.size();
+    if (starts && (end == text.size() || !is_name_char(text[end]))) return at;
+    at = end;
+  }
+  return std::string::npos;
+}
+
 /// A local must be assigned where it first appears ("a = …, … a …"); otherwise it is a misspelt
 /// or unknown variable. Returns the first offending name, or "". (A read before the assignment on
 /// some branch, e.g. "a = a + x", passes here and evaluates to NaN: locals start as NaN.)
 std::string unassigned_local(const std::string& text, const std::vector<std::string>& locals) {
   for (const std::string& name : locals) {
-    std::size_t at = 0;
-    while ((at = text.find(name, at)) != std::string::npos) {
-      const bool starts = at == 0 || !is_name_char(text[at - 1]);
-      const std::size_t end = at + name.size();
-      if (starts && (end == text.size() || !is_name_char(text[end]))) break;
-      at = end;
-    }
+    const std::size_t at = find_word(text, name);
     std::size_t next = at == std::string::npos ? at : at + name.size();
     while (next < text.size() && static_cast<unsigned char>(text[next]) <= 0x20) ++next;  // muParser's blanks
     if (next == text.size()) next = std::string::npos;
@@ -80,16 +89,18 @@ std::string unassigned_local(const std::string& text, const std::vector<std::str
 
 }  // namespace
 
-Expression::Expression(std::string text, std::vector<std::string> variables, std::string key) {
+Expression::Expression(std::string text, std::vector<std::string> variables, std::string key,
+                       std::vector<std::pair<std::string, double>> constants) {
   auto shared = std::make_shared<Shared>();
   shared->text = std::move(text);
   shared->key = std::move(key);
   shared->variables = std::move(variables);
+  shared->constants = std::move(constants);
   shared->id = next_id++;
   if (shared->text.find_first_not_of(" \t\n") == std::string::npos)
     throw std::invalid_argument(shared->key + ": empty expression");
   try {
-    auto c = compile(shared->text, shared->variables);
+    auto c = compile(shared->text, shared->variables, shared->constants);
     c->parser.Eval();  // reports syntax errors
     const std::string unknown = unassigned_local(shared->text, c->local_names).substr(0, 40);
     if (!unknown.empty())
@@ -105,7 +116,7 @@ Expression::Expression(std::string text, std::vector<std::string> variables, std
 double Expression::operator()(const double* values) const {
   thread_local std::unordered_map<std::uint64_t, std::unique_ptr<Compiled>> cache;
   auto& slot = cache[shared_->id];
-  if (!slot) slot = compile(shared_->text, shared_->variables);
+  if (!slot) slot = compile(shared_->text, shared_->variables, shared_->constants);
   for (std::size_t k = 0; k < slot->values.size(); ++k) slot->values[k] = values[k];
   // Locals start as NaN on every evaluation: one read before it is assigned (on some branch) gives
   // NaN, which the callers' finiteness checks report, never a value left from an earlier call.
@@ -125,5 +136,8 @@ double Expression::operator()(std::initializer_list<double> values) const {
 
 const std::string& Expression::text() const { return shared_->text; }
 const std::string& Expression::key() const { return shared_->key; }
+bool Expression::mentions(const std::string& name) const {
+  return find_word(shared_->text, name) != std::string::npos;
+}
 
 }  // namespace fictus

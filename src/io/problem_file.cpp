@@ -2,7 +2,10 @@
 
 #include <toml++/toml.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <map>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -137,7 +140,58 @@ const toml::table* subtable(const toml::table& root, const std::string& name) {
   return n->as_table();
 }
 
-std::shared_ptr<const Curve> read_geometry(TableReader& g, std::vector<std::string>& warnings) {
+using Constants = std::vector<std::pair<std::string, double>>;
+
+/// The expressions of a problem file, made with its [parameters] and remembering which name which.
+struct ExpressionMaker {
+  Constants constants;
+  std::map<std::string, std::vector<std::string>>* uses;
+  Expression operator()(const std::string& text, std::vector<std::string> variables, const std::string& key) const {
+    Expression e(text, std::move(variables), key, constants);
+    for (const auto& [name, value] : constants)
+      if (e.mentions(name)) (*uses)[name].push_back(key);
+    return e;
+  }
+};
+
+/// [parameters]: named numbers for the expressions, the file's values replaced by `overrides`.
+std::map<std::string, double> read_parameters(const toml::table* table, const ParameterValues& overrides) {
+  static const std::set<std::string> taken = {
+      "x",    "y",    "t",     "phi",  "s",     "sin",   "cos",   "tan", "asin", "acos", "atan", "sinh", "cosh",
+      "tanh", "asinh", "acosh", "atanh", "log2", "log10", "log",  "ln",  "exp",  "sqrt", "sign", "rint", "abs",
+      "min",  "max",  "sum",   "avg"};
+  std::map<std::string, double> values;
+  if (table)
+    for (const auto& [k, node] : *table) {
+      const std::string name(k.str()), key = "parameters." + name;
+      const bool identifier = !name.empty() && name.size() <= 40 && (std::isalpha(static_cast<unsigned char>(name[0]))) &&
+                              std::all_of(name.begin(), name.end(), [](char ch) {
+                                return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+                              });
+      if (!identifier)
+        fail(key.substr(0, 60), "a parameter name is a letter followed by letters, digits or _ (at most 40)");
+      if (taken.count(name)) fail(key, "the name is a variable or function of the expressions; choose another");
+      const std::optional<double> v =
+          node.is_integer() ? std::optional<double>(double(*node.value<int64_t>())) : node.value<double>();
+      if (!v || node.is_boolean()) fail(key, "expected a number");
+      if (!std::isfinite(*v)) fail(key, "must be finite (NaN or Inf given)");
+      values[name] = *v;
+    }
+  for (const auto& [name, value] : overrides) {
+    if (!values.count(name)) {
+      std::string known;
+      for (const auto& [n, v] : values) known += (known.empty() ? "" : ", ") + n;
+      fail("parameters." + name.substr(0, 40),
+           "not a parameter of the problem file (its [parameters]: " + (known.empty() ? "none" : known) + ")");
+    }
+    if (!std::isfinite(value)) fail("parameters." + name, "must be finite");
+    values[name] = value;
+  }
+  return values;
+}
+
+std::shared_ptr<const Curve> read_geometry(TableReader& g, const ExpressionMaker& expression,
+                                           std::vector<std::string>& warnings) {
   const std::string shape = g.required_string("shape");
   std::shared_ptr<const Curve> curve;
   if (shape == "ellipse") {
@@ -171,11 +225,12 @@ std::shared_ptr<const Curve> read_geometry(TableReader& g, std::vector<std::stri
     }
     curve = polygon;
   } else if (shape == "parametric") {
-    const Expression x(g.required_string("x"), {"t"}, "geometry.x"), y(g.required_string("y"), {"t"}, "geometry.y");
+    const Expression x = expression(g.required_string("x"), {"t"}, "geometry.x"),
+                     y = expression(g.required_string("y"), {"t"}, "geometry.y");
     curve = std::make_shared<ParametricCurve>([x](double t) { return x({t}); }, [y](double t) { return y({t}); });
   } else if (shape == "star") {
     const auto c = g.required_numbers("center", 2);
-    const Expression r(g.required_string("r"), {"t"}, "geometry.r");
+    const Expression r = expression(g.required_string("r"), {"t"}, "geometry.r");
     curve = std::make_shared<StarCurve>(Point2{c[0], c[1]}, [r](double t) { return r({t}); });
   } else {
     fail("geometry.shape", "unknown shape \"" + shape + "\" (ellipse, circle, polygon, parametric, star)");
@@ -197,7 +252,8 @@ const std::vector<std::string>& output_file_names() {
   return names;
 }
 
-ProblemSpec parse_problem_text(const std::string& text, const std::string& source) {
+ProblemSpec parse_problem_text(const std::string& text, const std::string& source,
+                               const ParameterValues& parameters) {
   toml::table root;
   try {
     root = toml::parse(text, source);
@@ -209,10 +265,12 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
   for (const auto& [k, v] : root) {
     const std::string name(k.str());
     if (name != "domain" && name != "geometry" && name != "formulation" && name != "data" && name != "solver" &&
-        name != "output")
-      fail(name, "unknown section (domain, geometry, formulation, data, solver, output)");
+        name != "output" && name != "parameters")
+      fail(name, "unknown section (domain, geometry, formulation, data, solver, output, parameters)");
   }
   ProblemSpec spec;
+  spec.parameters = read_parameters(subtable(root, "parameters"), parameters);
+  ExpressionMaker expression{{spec.parameters.begin(), spec.parameters.end()}, &spec.parameter_uses};
   Problem& p = spec.problem;
   SolverOptions& o = spec.options;
 
@@ -223,7 +281,7 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
   const toml::table* geometry_table = subtable(root, "geometry");
   if (!geometry_table) fail("geometry", "missing section [geometry]");
   TableReader geometry(geometry_table, "geometry");
-  p.gamma = read_geometry(geometry, spec.warnings);
+  p.gamma = read_geometry(geometry, expression, spec.warnings);
   geometry.finish();
 
   TableReader formulation(subtable(root, "formulation"), "formulation");
@@ -232,15 +290,15 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
 
   TableReader data(subtable(root, "data"), "data");
   data.read_options(p, o);
-  const Expression f(data.required_string("f"), {"x", "y"}, "data.f");
+  const Expression f = expression(data.required_string("f"), {"x", "y"}, "data.f");
   p.f = [f](double x, double y) { return f({x, y}); };
-  const Expression g(data.required_string("g"), {"x", "y", "phi", "s"}, "data.g");
-  const Point2 center = p.gamma->center();
-  p.g_along_curve = [g, center](double x, double y, double s) {
-    return g({x, y, std::atan2(y - center.y, x - center.x), s});
+  const Expression g = expression(data.required_string("g"), {"x", "y", "phi", "s"}, "data.g");
+  spec.g_about = [g](Point2 center) -> std::function<double(double, double, double)> {
+    return [g, center](double x, double y, double s) { return g({x, y, std::atan2(y - center.y, x - center.x), s}); };
   };
+  p.g_along_curve = spec.g_about(p.gamma->center());
   if (data.has("exact")) {
-    const Expression exact(data.string("exact", ""), {"x", "y"}, "data.exact");
+    const Expression exact = expression(data.string("exact", ""), {"x", "y"}, "data.exact");
     p.exact = [exact](double x, double y) { return exact({x, y}); };
   }
   data.finish();
@@ -267,13 +325,18 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
   toml::table echo;
   echo.insert("geometry", *geometry_table);
   if (const toml::table* d = subtable(root, "data")) echo.insert("data", *d);
+  if (!spec.parameters.empty()) {
+    toml::table in_effect;
+    for (const auto& [name, value] : spec.parameters) in_effect.insert(name, value);
+    echo.insert("parameters", in_effect);
+  }
   std::ostringstream json;
   json << toml::json_formatter{echo};
   spec.input_json = json.str();
   return spec;
 }
 
-ProblemSpec read_problem_file(const std::string& path) {
+std::string read_problem_text(const std::string& path) {
   std::error_code error;
   if (std::filesystem::is_directory(path, error))
     throw std::invalid_argument(path + ": is a folder, not a problem file");
@@ -287,8 +350,11 @@ ProblemSpec read_problem_file(const std::string& path) {
     if (content.size() > limit) throw std::invalid_argument(path + ": larger than 64 MiB, not a problem file");
   }
   if (in.bad()) throw std::invalid_argument(path + ": cannot read the problem file");
-  std::stringstream text(content);
-  ProblemSpec spec = parse_problem_text(text.str(), path);
+  return content;
+}
+
+ProblemSpec read_problem_file(const std::string& path, const ParameterValues& parameters) {
+  ProblemSpec spec = parse_problem_text(read_problem_text(path), path, parameters);
   std::string name = path.substr(path.find_last_of('/') + 1);
   spec.problem.name = name.substr(0, name.rfind(".toml"));
   return spec;

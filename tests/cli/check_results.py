@@ -8,6 +8,7 @@ import sys
 REQUIRED = {
     "version": str, "options": dict, "grid": dict, "multipliers": int, "newton": dict,
     "inner": dict, "timings": dict, "signorini": dict, "errors": dict, "peak_memory_bytes": int,
+    "contact": dict,
 }
 
 
@@ -34,6 +35,11 @@ def main(folder):
     assert signorini["min_gap"] >= -1e-10, signorini
     assert signorini["min_normal_derivative"] >= -1e-10, signorini
     assert signorini["max_complementarity"] <= 1e-10, signorini
+    contact = results["contact"]
+    assert contact["points"] == results["newton"]["n_active"], contact
+    spacing = results["curve"]["spacing"]
+    assert math.isclose(contact["measure"], contact["points"] * spacing, rel_tol=1e-12), contact
+    assert contact["force"] > 0 and abs(contact["min_gap"]) < 1e-10 and contact["max_gap"] > 0, contact
     for key in ("l2_omega", "h1_omega", "h1semi_omega", "l2_gamma",
                 "rel_l2_omega", "rel_h1_omega", "rel_l2_gamma"):
         value = results["errors"][key]
@@ -41,6 +47,9 @@ def main(folder):
     with open(f"{folder}/points.csv") as handle:
         rows = handle.read().strip().splitlines()
     assert rows[0] == "i,s,x,y,nx,ny,g,u,dudn,lambda,contact,Gamma_x,Gamma_y"
+    columns = [row.split(",") for row in rows[1:]]
+    force = sum(float(c[8]) for c in columns if c[10] == "1") * spacing
+    assert math.isclose(force, contact["force"], rel_tol=1e-6), (force, contact["force"])
     assert len(rows) == results["multipliers"] + 1
     print("results.json and points.csv OK")
 

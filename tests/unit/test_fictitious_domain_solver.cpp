@@ -15,7 +15,8 @@ fictus::SolverOptions options_for(fictus::Variant variant, fictus::InnerSolver i
   return o;
 }
 
-double max_abs_diff(const std::vector<double>& a, const std::vector<double>& b) {
+template <class Vector>
+double max_abs_diff(const Vector& a, const Vector& b) {
   double d = 0;
   for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, std::abs(a[i] - b[i]));
   return d;
@@ -120,6 +121,53 @@ TEST(Reuse, NewCurveMatchesAFreshSolve) {
   const fictus::Solution fresh = fictus::solve(problem, o);
   EXPECT_EQ(moved.newton.active, fresh.newton.active);
   EXPECT_LE(max_abs_diff(moved.lambda, fresh.lambda), 1e-10);
+}
+
+TEST(Reuse, NewLoadKeepsTheCurveAndMatchesAFreshSolve) {
+  // replace_load: u₀ again, the rows and Schur blocks kept (the sweep over a parameter of f). Also on
+  // the singular periodic box, where the load's total enters the bordered Newton system.
+  for (const auto& [c, boundary] : {std::pair{1.0, fictus::Boundary::dirichlet}, {0.0, fictus::Boundary::periodic}}) {
+    fictus::Problem problem = fictus::paper_problem(128, c, boundary);
+    fictus::FictitiousDomainSolver solver(problem);
+    const fictus::SolverOptions o = options_for(fictus::Variant::smooth, fictus::InnerSolver::green, 128);
+    solver.solve(problem, o);
+    const fictus::ScalarField f = problem.f;
+    problem.f = [f](double x, double y) { return 1.7 * f(x, y) - 0.3 * x; };
+    solver.replace_load(problem);
+    const fictus::Solution reloaded = solver.solve(problem, o);
+    EXPECT_TRUE(reloaded.reused_curve);
+    const fictus::Solution fresh = fictus::solve(problem, o);
+    ASSERT_TRUE(fresh.newton.converged);
+    EXPECT_EQ(reloaded.newton.active, fresh.newton.active);
+    EXPECT_LE(max_abs_diff(reloaded.lambda, fresh.lambda), 1e-10);
+    EXPECT_LE(max_abs_diff(reloaded.u, fresh.u), 1e-12);
+    EXPECT_NEAR(reloaded.alpha, fresh.alpha, 1e-12);
+  }
+  fictus::Problem other = fictus::paper_problem(256);
+  fictus::FictitiousDomainSolver solver(fictus::paper_problem(128));
+  EXPECT_THROW(solver.replace_load(other), std::invalid_argument);  // another grid needs another solver
+}
+
+TEST(ContactSummary, MeasureForceAndGapsFromThePoints) {
+  const fictus::Problem problem = fictus::paper_problem(256);
+  const fictus::Solution s =
+      fictus::solve(problem, options_for(fictus::Variant::smooth, fictus::InnerSolver::green, 256));
+  const fictus::ContactSummary c = fictus::contact_summary(s);
+  const double spacing = s.collocation.length / s.collocation.m;
+  double force = 0, min_gap = 1e300, max_gap = -1e300;
+  long points = 0;
+  for (int i = 0; i < s.collocation.m; ++i) {
+    min_gap = std::min(min_gap, s.trace[i] - s.g[i]);
+    max_gap = std::max(max_gap, s.trace[i] - s.g[i]);
+    if (s.newton.active[i] == 1) ++points, force += s.normal_derivative[i] * spacing;
+  }
+  EXPECT_GT(points, 0);
+  EXPECT_EQ(c.points, points);
+  EXPECT_DOUBLE_EQ(c.measure, points * spacing);
+  EXPECT_NEAR(c.force, force, 1e-14 * std::abs(force));
+  EXPECT_GT(c.force, 0);
+  EXPECT_EQ(c.min_gap, min_gap);
+  EXPECT_EQ(c.max_gap, max_gap);
 }
 
 }  // namespace

@@ -48,6 +48,43 @@ TEST(ProblemFile, NormalDerivativeOption) {
   }
 }
 
+TEST(ProblemFile, ParametersEnterTheExpressionsAndCanBeReplaced) {
+  const std::string text =
+      "[parameters]\nrad = 0.3\nlift = 0.1\nunused = 2\n"
+      "[geometry]\nshape = \"star\"\ncenter = [0.5, 0.5]\nr = \"rad\"\n"
+      "[data]\nf = \"lift * x\"\ng = \"lift + phi\"\nexact = \"x + lift\"\n";
+  const fictus::ProblemSpec spec = fictus::parse_problem_text(text);
+  EXPECT_DOUBLE_EQ(spec.problem.f(2.0, 0.0), 0.2);
+  EXPECT_DOUBLE_EQ(spec.problem.gamma->position(0.0).x, 0.8);
+  EXPECT_EQ(spec.parameter_uses.at("lift"), (std::vector<std::string>{"data.f", "data.g", "data.exact"}));
+  EXPECT_EQ(spec.parameter_uses.at("rad"), (std::vector<std::string>{"geometry.r"}));
+  EXPECT_EQ(spec.parameter_uses.count("unused"), 0u);
+  EXPECT_NE(spec.input_json.find("\"parameters\""), std::string::npos);
+
+  const fictus::ProblemSpec other = fictus::parse_problem_text(text, "problem", {{"lift", -1.0}, {"rad", 0.25}});
+  EXPECT_DOUBLE_EQ(other.problem.f(2.0, 0.0), -2.0);
+  EXPECT_DOUBLE_EQ(other.problem.gamma->position(0.0).x, 0.75);
+  EXPECT_DOUBLE_EQ(other.parameters.at("lift"), -1.0);
+
+  auto message = [&](const std::string& t, const fictus::ParameterValues& values = {}) {
+    try {
+      fictus::parse_problem_text(t, "problem", values);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(message(text, {{"nope", 1.0}}).rfind("parameters.nope: not a parameter", 0), 0u);
+  const std::string data = "[geometry]\nshape = \"circle\"\ncenter = [0.5, 0.5]\nradius = 0.3\n"
+                           "[data]\nf = \"1\"\ng = \"0\"\n";
+  EXPECT_EQ(message("[parameters]\nx = 1\n" + data).rfind("parameters.x: the name is a variable", 0), 0u);
+  EXPECT_EQ(message("[parameters]\nsin = 1\n" + data).rfind("parameters.sin:", 0), 0u);
+  EXPECT_EQ(message("[parameters]\na = \"1\"\n" + data), "parameters.a: expected a number");
+  EXPECT_EQ(message("[parameters]\na = nan\n" + data).rfind("parameters.a: must be finite", 0), 0u);
+  EXPECT_EQ(message("[parameters]\n\"a b\" = 1\n" + data).rfind("parameters.a b: a parameter name", 0), 0u);
+  EXPECT_EQ(message(data), "");
+}
+
 TEST(ProblemFile, ManufacturedExamplesMatchTheirCxxTwins) {
   for (const auto& twin : manufactured::all(256)) {
     const fictus::ProblemSpec spec =

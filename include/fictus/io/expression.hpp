@@ -8,6 +8,7 @@
 #include <initializer_list>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fictus {
@@ -16,13 +17,17 @@ class Expression {
  public:
   /// Throws std::invalid_argument("<key>: cannot parse \"<text>\": <reason>") on a syntax error or
   /// an unknown variable.
-  Expression(std::string text, std::vector<std::string> variables, std::string key);
+  /// `constants` are named numbers the text may use (a problem file's [parameters]).
+  Expression(std::string text, std::vector<std::string> variables, std::string key,
+             std::vector<std::pair<std::string, double>> constants = {});
 
   /// Value for the variables in the order given at construction.
   double operator()(std::initializer_list<double> values) const;
   double operator()(const double* values) const;
 
   const std::string& text() const;
+  /// Whether the text names `name` as a whole word (a variable, constant or local of that name).
+  bool mentions(const std::string& name) const;
   const std::string& key() const;
 
  private:

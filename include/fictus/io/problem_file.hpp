@@ -1,5 +1,7 @@
 #pragma once
 // Problem files (TOML). Every key, its default and unit: docs/problem_files.md.
+#include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -17,14 +19,27 @@ struct ProblemSpec {
   SolverOptions options;
   OutputOptions output;
   std::vector<std::string> warnings;  // e.g. a clockwise curve that was reoriented
-  std::string input_json;             // the file's [geometry] and [data] as a JSON object (results.json echoes it)
+  std::string input_json;             // the file's [geometry], [data] and [parameters] as JSON (results.json echoes it)
+  std::map<std::string, double> parameters;  // [parameters] as in effect (the file's values, or the overrides)
+  /// For each parameter, the keys of the expressions that name it ("data.g", "geometry.r", …).
+  std::map<std::string, std::vector<std::string>> parameter_uses;
+  /// The file's obstacle g(x, y, s) with phi measured about `center` (for the curve moved there).
+  std::function<std::function<double(double, double, double)>(Point2)> g_about;
 };
+
+/// Values for some of a file's [parameters], replacing the file's (fictus sweep --parameter).
+using ParameterValues = std::map<std::string, double>;
 
 /// Reads and checks a problem file. Throws std::invalid_argument with a one-line message naming the
 /// key ("data.f: cannot parse …", "geometry.shape: unknown shape …", "solver.tolerance: unknown
 /// key", …) on any error: unknown keys, wrong types, NaN/Inf, unparsable expressions.
-ProblemSpec read_problem_file(const std::string& path);
-ProblemSpec parse_problem_text(const std::string& text, const std::string& source = "problem");
+/// `parameters` replace values of the file's [parameters] (each must be one of them).
+ProblemSpec read_problem_file(const std::string& path, const ParameterValues& parameters = {});
+ProblemSpec parse_problem_text(const std::string& text, const std::string& source = "problem",
+                               const ParameterValues& parameters = {});
+
+/// The file as text (at most 64 MiB; a folder or an unreadable file is an error naming the path).
+std::string read_problem_text(const std::string& path);
 
 /// The names `[output] files` accepts.
 const std::vector<std::string>& output_file_names();
