@@ -135,8 +135,9 @@ int run_solve(const SolveCommand& command) {
   fictus::ParameterValues parameters;
   for (const std::string& p : command.parameters) {
     const std::size_t equals = p.find('=');
-    const std::vector<double> value =
-        equals == std::string::npos || equals == 0 ? std::vector<double>{} : fictus::cli::parse_values(p.substr(equals + 1), "--parameter");
+    const std::vector<double> value = equals == std::string::npos || equals == 0
+                                          ? std::vector<double>{}
+                                          : fictus::cli::parse_values(p.substr(equals + 1), "--parameter");
     if (value.size() != 1)
       throw std::invalid_argument("--parameter: expected NAME=VALUE, e.g. a=0.25, got \"" + p.substr(0, 60) + "\"");
     parameters[p.substr(0, equals)] = value[0];
@@ -299,8 +300,9 @@ int main(int argc, char** argv) {
   solve.out_option = solve_cmd->add_option("--out", solve.out, "output.dir: folder for the output files (\"\": none)")
                          ->capture_default_str();
   solve_cmd->add_option("--dir", solve.out, "alias of --out")->group("");
-  solve_cmd->add_option("--parameter", solve.parameters,
-                        "NAME=VALUE: a value for an entry of the problem file's [parameters] (repeatable)")
+  solve_cmd
+      ->add_option("--parameter", solve.parameters,
+                   "NAME=VALUE: a value for an entry of the problem file's [parameters] (repeatable)")
       ->allow_extra_args(false);
   solve_cmd->add_flag("--quiet", solve.quiet, "print only warnings and errors (no estimate, progress or summary)");
   solve.files_option =
@@ -335,7 +337,8 @@ int main(int argc, char** argv) {
   fictus::cli::OptionFlags sweep_flags;
   fictus::cli::SweepArguments sweep_args;
   CLI::App* sweep_cmd = app.add_subcommand(
-      "sweep", "solve a family of problems on one grid: the obstacle scaled, the curve rotated or moved, or a parameter");
+      "sweep",
+      "solve a family of problems on one grid: the obstacle scaled, the curve rotated or moved, or a parameter");
   sweep_cmd->add_option("problem", sweep_args.problem_path, "problem file (default: the paper's problem)");
   sweep_cmd->add_option("--g-scale", sweep_args.g_scale, "obstacle factors: a,b,c or start:stop:count");
   sweep_cmd->add_option("--rotate", sweep_args.rotate,
@@ -345,11 +348,10 @@ int main(int argc, char** argv) {
                         "NAME=LIST: values of a [parameters] entry of the problem file, e.g. a=0:0.2:11");
   sweep_cmd->add_option("--out", sweep_args.out, "write sweep.csv and sweep.json here (\"\": none)")
       ->capture_default_str();
-  sweep_flags.add(
-      *sweep_cmd, [](const fictus::OptionSpec&) { return true; },
-      {{"multipliers", "without a problem file: the paper's m"},
-       {"offset", "without a problem file: 1 (the paper's δ = L/m)"},
-       {"condition_number", "here: false"}});
+  sweep_flags.add(*sweep_cmd, [](const fictus::OptionSpec&) { return true; },
+                  {{"multipliers", "without a problem file: the paper's m"},
+                   {"offset", "without a problem file: 1 (the paper's δ = L/m)"},
+                   {"condition_number", "here: false"}});
 
   CLI::App* options_cmd = app.add_subcommand("options", "list every option: key, default, allowed values, meaning");
   bool markdown = false, as_json = false;

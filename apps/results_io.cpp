@@ -75,7 +75,7 @@ json solution_to_json(const Problem& problem, const Solution& s, const json& inp
                     {"min_normal_derivative", s.signorini.min_normal_derivative},
                     {"max_complementarity", s.signorini.max_complementarity}};
   const ContactSummary contact = contact_summary(s);
-  j["contact"] = {{"points", contact.points},   {"measure", contact.measure}, {"force", contact.force},
+  j["contact"] = {{"points", contact.points},          {"measure", contact.measure}, {"force", contact.force},
                   {"lambda_integral", contact.lambda}, {"min_gap", contact.min_gap}, {"max_gap", contact.max_gap}};
   if (s.check)
     j["signorini"]["check"] = {{"rule", s.check->rule},

@@ -52,7 +52,7 @@ struct Family {
   std::string kind;  // g_scale, rotate, move or parameter
   std::string name;  // the CSV's first column: the kind, or the parameter's name
   std::vector<double> values;
-  bool moves_curve = false;  // new trace rows and Schur blocks per member
+  bool moves_curve = false;   // new trace rows and Schur blocks per member
   bool changes_load = false;  // a new u₀ per member
 };
 
@@ -76,7 +76,8 @@ Family family_of(const SweepArguments& args, const ProblemSpec& base) {
     if (!base.parameters.count(f.name)) {
       std::string known;
       for (const auto& [n, v] : base.parameters) known += (known.empty() ? "" : ", ") + n;
-      throw std::invalid_argument("--parameter: " + f.name.substr(0, 40) + " is not in the problem file's [parameters] (" +
+      throw std::invalid_argument("--parameter: " + f.name.substr(0, 40) +
+                                  " is not in the problem file's [parameters] (" +
                                   (known.empty() ? "it has none" : known) + ")");
     }
     const auto uses = base.parameter_uses.find(f.name);
@@ -128,11 +129,12 @@ int run_sweep(const SweepArguments& args, const OptionFlags& flags) {
   std::ostringstream csv;
   csv.precision(12);
   csv << family.name
-      << ",converged,newton_steps,multipliers,contact_points,contact_measure,contact_force,lambda_integral,min_gap,max_gap,"
+      << ",converged,newton_steps,multipliers,contact_points,contact_measure,contact_force,lambda_integral,min_gap,max_"
+         "gap,"
          "min_normal_derivative,max_complementarity,seconds\n";
   nlohmann::json rows = nlohmann::json::array();
-  std::printf("%-12s %5s %7s %11s %11s %11s %11s %9s\n", family.name.substr(0, 12).c_str(), "it0", "contact",
-              "measure", "force", "min gap", "max gap", "time[s]");
+  std::printf("%-12s %5s %7s %11s %11s %11s %11s %9s\n", family.name.substr(0, 12).c_str(), "it0", "contact", "measure",
+              "force", "min gap", "max gap", "time[s]");
   double first = 0, rest = 0;
   int failures = 0;
   for (std::size_t k = 0; k < family.values.size(); ++k) {
@@ -155,9 +157,9 @@ int run_sweep(const SweepArguments& args, const OptionFlags& flags) {
     const ContactSummary c = contact_summary(s);
     std::printf("%-12.6g %5d %7ld %11.4e %11.4e %11.3e %11.3e %9.4f%s\n", v, s.newton.iterations, c.points, c.measure,
                 c.force, c.min_gap, c.max_gap, seconds, s.newton.converged ? "" : "  NOT converged");
-    csv << v << ',' << s.newton.converged << ',' << s.newton.iterations << ',' << s.collocation.m << ',' << c.points << ',' << c.measure << ','
-        << c.force << ',' << c.lambda << ',' << c.min_gap << ',' << c.max_gap << ',' << s.signorini.min_normal_derivative
-        << ',' << s.signorini.max_complementarity << ',' << seconds << '\n';
+    csv << v << ',' << s.newton.converged << ',' << s.newton.iterations << ',' << s.collocation.m << ',' << c.points
+        << ',' << c.measure << ',' << c.force << ',' << c.lambda << ',' << c.min_gap << ',' << c.max_gap << ','
+        << s.signorini.min_normal_derivative << ',' << s.signorini.max_complementarity << ',' << seconds << '\n';
     rows.push_back({{family.name, v},
                     {"converged", s.newton.converged},
                     {"newton_steps", s.newton.iterations},

@@ -299,6 +299,7 @@ void newton(const CurveSetup& setup, const SolverOptions& options, const Executi
   for (const NewtonStep& step : sol.newton.history) sol.inner_iterations += step.inner_iterations;
   if (options.condition_number) sol.condition_number = setup.schur->condition_number(sol.newton.active);
   sol.lambda.assign(sol.newton.lambda.data(), sol.newton.lambda.data() + sol.newton.lambda.size());
+  sol.lambda_total = row_sums(setup.boundary->B_Gamma()).dot(sol.newton.lambda);
   sol.alpha = sol.newton.alpha;
   if (!all_finite(sol.lambda) || !std::isfinite(sol.alpha) || max_abs(sol.lambda) > largest_scale)
     throw std::invalid_argument("data.g: the multipliers reach " + format_number(max_abs(sol.lambda)) + " (|g| up to " +
@@ -487,21 +488,19 @@ ContactSummary contact_summary(const Solution& s) {
   ContactSummary c;
   const Collocation& points = s.collocation;
   const double spacing = points.length / points.m;
-  const double control_spacing =
-      s.Gamma && s.options.variant == Variant::smooth ? ArcLengthTable(*s.Gamma).length() / points.m : spacing;
   c.min_gap = std::numeric_limits<double>::infinity();
   c.max_gap = -c.min_gap;
   for (int i = 0; i < points.m; ++i) {
     const double gap = s.trace[i] - s.g[i];
     c.min_gap = std::min(c.min_gap, gap);
     c.max_gap = std::max(c.max_gap, gap);
-    c.lambda += s.lambda[i] * control_spacing;
     if (s.newton.active[i] == 1) {
       ++c.points;
       c.force += s.normal_derivative[i] * spacing;
     }
   }
   c.measure = c.points * spacing;
+  c.lambda = s.lambda_total;
   return c;
 }
 

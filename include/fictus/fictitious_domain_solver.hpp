@@ -67,7 +67,8 @@ struct Solution {
   std::shared_ptr<const Curve> Gamma;  // the curve carrying λ (γ itself in the non-smooth variant)
   double delta = 0;                    // distance of Γ from γ
   std::vector<double> lambda, g, trace, normal_derivative;  // per point: λ, g, B_γû, C_γû
-  double alpha = 0;                                         // constant added to û (singular A: periodic box, c = 0)
+  double lambda_total = 0;  // Σ_i λ_i·|Γ_i| = 1ᵀB_Γᵀλ, the total load λ adds to the box (∫_Γ λ ds)
+  double alpha = 0;         // constant added to û (singular A: periodic box, c = 0)
   NewtonResult newton;
   std::size_t fast_solves = 0;  // applications of A⁻¹ in this solve (the paper's it₁)
   int inner_iterations = 0;     // Krylov iterations over all Newton steps
@@ -121,13 +122,14 @@ class FictitiousDomainSolver {
 /// The contact in numbers, from the per-point values of a solution (point i owns the arc L/m of γ
 /// around it).
 struct ContactSummary {
-  long points = 0;      // points in contact (the active set)
-  double measure = 0;   // length of the contact set: points · L/m
-  double force = 0;     // total contact force ∫ ∂u/∂n ds over the contact set: Σ_active (C_γû)_i · L/m
-  double lambda = 0;    // non-smooth: ∫_γ λ ds = Σ λ_i · L/m, the force from the multipliers ([∂û/∂n] = λ);
-                        // smooth: the total control on Γ, Σ λ_i · |Γ|/m (not a force on γ)
-  double min_gap = 0;   // min_i (B_γû − g)_i  (≈ 0: the contact points)
-  double max_gap = 0;   // max_i (B_γû − g)_i  (the widest opening)
+  long points = 0;     // points in contact (the active set)
+  double measure = 0;  // length of the contact set: points · L/m
+  double force = 0;    // total contact force ∫ ∂u/∂n ds over the contact set: Σ_active (C_γû)_i · L/m
+  double lambda = 0;   // ∫_Γ λ ds = Σ λ_i·|Γ_i| (Solution::lambda_total): non-smooth, the jump [∂û/∂n]
+                       // integrated over γ (it includes the fictitious field outside ω: not the
+                       // contact force); smooth, the total control on Γ
+  double min_gap = 0;  // min_i (B_γû − g)_i  (≈ 0: the contact points)
+  double max_gap = 0;  // max_i (B_γû − g)_i  (the widest opening)
 };
 ContactSummary contact_summary(const Solution& solution);
 

@@ -136,8 +136,6 @@ double Expression::operator()(std::initializer_list<double> values) const {
 
 const std::string& Expression::text() const { return shared_->text; }
 const std::string& Expression::key() const { return shared_->key; }
-bool Expression::mentions(const std::string& name) const {
-  return find_word(shared_->text, name) != std::string::npos;
-}
+bool Expression::mentions(const std::string& name) const { return find_word(shared_->text, name) != std::string::npos; }
 
 }  // namespace fictus

@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <map>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <numbers>
 #include <set>
 #include <sstream>
@@ -156,18 +156,18 @@ struct ExpressionMaker {
 
 /// [parameters]: named numbers for the expressions, the file's values replaced by `overrides`.
 std::map<std::string, double> read_parameters(const toml::table* table, const ParameterValues& overrides) {
-  static const std::set<std::string> taken = {
-      "x",    "y",    "t",     "phi",  "s",     "sin",   "cos",   "tan", "asin", "acos", "atan", "sinh", "cosh",
-      "tanh", "asinh", "acosh", "atanh", "log2", "log10", "log",  "ln",  "exp",  "sqrt", "sign", "rint", "abs",
-      "min",  "max",  "sum",   "avg"};
+  static const std::set<std::string> taken = {"x",     "y",    "t",     "phi",  "s",    "sin",  "cos",   "tan",
+                                              "asin",  "acos", "atan",  "sinh", "cosh", "tanh", "asinh", "acosh",
+                                              "atanh", "log2", "log10", "log",  "ln",   "exp",  "sqrt",  "sign",
+                                              "rint",  "abs",  "min",   "max",  "sum",  "avg"};
   std::map<std::string, double> values;
   if (table)
     for (const auto& [k, node] : *table) {
       const std::string name(k.str()), key = "parameters." + name;
-      const bool identifier = !name.empty() && name.size() <= 40 && (std::isalpha(static_cast<unsigned char>(name[0]))) &&
-                              std::all_of(name.begin(), name.end(), [](char ch) {
-                                return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
-                              });
+      const bool identifier =
+          !name.empty() && name.size() <= 40 && (std::isalpha(static_cast<unsigned char>(name[0]))) &&
+          std::all_of(name.begin(), name.end(),
+                      [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; });
       if (!identifier)
         fail(key.substr(0, 60), "a parameter name is a letter followed by letters, digits or _ (at most 40)");
       if (taken.count(name)) fail(key, "the name is a variable or function of the expressions; choose another");
@@ -252,8 +252,7 @@ const std::vector<std::string>& output_file_names() {
   return names;
 }
 
-ProblemSpec parse_problem_text(const std::string& text, const std::string& source,
-                               const ParameterValues& parameters) {
+ProblemSpec parse_problem_text(const std::string& text, const std::string& source, const ParameterValues& parameters) {
   toml::table root;
   try {
     root = toml::parse(text, source);

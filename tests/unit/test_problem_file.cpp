@@ -75,8 +75,9 @@ TEST(ProblemFile, ParametersEnterTheExpressionsAndCanBeReplaced) {
     return std::string();
   };
   EXPECT_EQ(message(text, {{"nope", 1.0}}).rfind("parameters.nope: not a parameter", 0), 0u);
-  const std::string data = "[geometry]\nshape = \"circle\"\ncenter = [0.5, 0.5]\nradius = 0.3\n"
-                           "[data]\nf = \"1\"\ng = \"0\"\n";
+  const std::string data =
+      "[geometry]\nshape = \"circle\"\ncenter = [0.5, 0.5]\nradius = 0.3\n"
+      "[data]\nf = \"1\"\ng = \"0\"\n";
   EXPECT_EQ(message("[parameters]\nx = 1\n" + data).rfind("parameters.x: the name is a variable", 0), 0u);
   EXPECT_EQ(message("[parameters]\nsin = 1\n" + data).rfind("parameters.sin:", 0), 0u);
   EXPECT_EQ(message("[parameters]\na = \"1\"\n" + data), "parameters.a: expected a number");
