@@ -1,0 +1,140 @@
+#!/usr/bin/env python3
+"""Runs every code block of README.md and docs/*.md, so that a wrong example fails the suite.
+
+  ```sh / ```bash    run with bash -e -o pipefail
+  ```python          run with the build's python3 and the module on PYTHONPATH
+  ```toml            parsed (tomllib): a problem file or a piece of one
+  ```text            not run: synopses, sample output, formulas
+A fence without one of these tags is an error, and so is a command (a line starting with fictus,
+make, cmake, python3, pip, $ …) in an indented block: commands go in fenced blocks, where they run.
+A block may be skipped with the line `<!-- doc-test: skip: <reason> -->` just above its fence.
+
+Blocks run in order, file by file, in one scratch folder that holds `examples` and `build` (links to
+the sources' and the build's), with build/apps (the fictus program) first on PATH; a block may use
+what an earlier block of the same file wrote.
+
+usage: run_blocks.py SOURCE_DIR BUILD_DIR PYTHON [--only FILE]
+"""
+import argparse
+import glob
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import tomllib
+
+RUN = {"sh", "bash", "python"}
+KNOWN = RUN | {"toml", "text"}
+COMMAND = re.compile(r"^\s*(\$ |fictus |make |cmake |python3? |pip |\.venv/|PYTHONPATH=|export |cd )")
+SKIP = re.compile(r"<!--\s*doc-test:\s*skip:\s*(.*?)\s*-->")
+
+
+def blocks(path):
+    """(line, tag, text, skip reason or None) for each fenced block; problems found on the way."""
+    lines = open(path, encoding="utf-8").read().split("\n")
+    found, problems = [], []
+    k = 0
+    while k < len(lines):
+        fence = re.match(r"^```(\S*)\s*$", lines[k])
+        if fence:
+            tag, start = fence.group(1), k + 1
+            end = start
+            while end < len(lines) and not lines[end].startswith("```"):
+                end += 1
+            if end == len(lines):
+                problems.append(f"{path}:{k + 1}: the fence is never closed")
+            skip = SKIP.search(lines[k - 1]) if k > 0 else None
+            if tag not in KNOWN:
+                problems.append(f"{path}:{k + 1}: a fence tagged '{tag}': tag it one of {sorted(KNOWN)}")
+            if skip and not skip.group(1):
+                problems.append(f"{path}:{k}: a skip needs a reason")
+            found.append((k + 1, tag, "\n".join(lines[start:end]) + "\n", skip.group(1) if skip else None))
+            k = end + 1
+            continue
+        # An indented code block: 4 spaces after a blank line (not a list item's continuation).
+        if lines[k].startswith("    ") and k > 0 and lines[k - 1].strip() == "":
+            j = k
+            while j < len(lines) and (lines[j].startswith("    ") or lines[j].strip() == ""):
+                if COMMAND.match(lines[j][4:]):
+                    problems.append(f"{path}:{j + 1}: a command in an indented block (put it in a ```sh block, "
+                                    f"or ```text for a synopsis): {lines[j].strip()[:60]}")
+                j += 1
+            k = j
+            continue
+        k += 1
+    return found, problems
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("source")
+    parser.add_argument("build")
+    parser.add_argument("python")
+    parser.add_argument("--only", help="one Markdown file (relative to the source)")
+    args = parser.parse_args()
+    source, build = os.path.abspath(args.source), os.path.abspath(args.build)
+    files = [os.path.join(source, "README.md")] + sorted(glob.glob(os.path.join(source, "docs", "*.md")))
+    if args.only:
+        files = [os.path.join(source, args.only)]
+
+    scratch = tempfile.mkdtemp(prefix="fictus-doc-")
+    env = dict(os.environ)
+    env["PATH"] = os.path.join(build, "apps") + os.pathsep + env.get("PATH", "")
+    env["PYTHONPATH"] = os.path.join(build, "python")
+    env["MPLBACKEND"] = "Agg"
+    counts = {"ran": 0, "parsed": 0, "skipped": 0, "text": 0}
+    failures = []
+    try:
+        for path in files:
+            relative = os.path.relpath(path, source)
+            work = os.path.join(scratch, relative.replace("/", "_"))
+            os.makedirs(work)
+            os.symlink(os.path.join(source, "examples"), os.path.join(work, "examples"))
+            os.symlink(build, os.path.join(work, "build"))
+            found, problems = blocks(path)
+            failures += problems
+            for line, tag, text, skip in found:
+                where = f"{relative}:{line}"
+                if skip is not None:
+                    counts["skipped"] += 1
+                    print(f"skip  {where} ({tag}): {skip}")
+                    continue
+                if tag not in KNOWN:
+                    continue  # reported above
+                if tag == "text":
+                    counts["text"] += 1
+                    continue
+                if tag == "toml":
+                    try:
+                        tomllib.loads(text)
+                        counts["parsed"] += 1
+                        print(f"ok    {where} (toml parses)")
+                    except tomllib.TOMLDecodeError as e:
+                        failures.append(f"{where}: the TOML does not parse: {e}")
+                    continue
+                command = ([args.python, "-"] if tag == "python" else ["bash", "-e", "-o", "pipefail", "-s"])
+                start = time.time()
+                r = subprocess.run(command, input=text, cwd=work, env=env, capture_output=True, text=True,
+                                   timeout=600)
+                seconds = time.time() - start
+                counts["ran"] += 1
+                if r.returncode != 0:
+                    tail = (r.stdout + r.stderr).strip().splitlines()[-8:]
+                    failures.append(f"{where} ({tag}) exited {r.returncode}:\n    " + "\n    ".join(tail))
+                    print(f"FAIL  {where} ({tag}, {seconds:.1f} s)")
+                else:
+                    print(f"ok    {where} ({tag}, {seconds:.1f} s)")
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+    print(f"{counts['ran']} blocks run, {counts['parsed']} TOML blocks parsed, {counts['skipped']} skipped with a "
+          f"reason, {counts['text']} text blocks")
+    if failures:
+        print("\n".join(failures))
+        sys.exit(1)
+
+
+if __name__ == "__main__":
+    main()
