@@ -3,6 +3,8 @@
 
   ```sh / ```bash    run with bash -e -o pipefail
   ```python          run with the build's python3 and the module on PYTHONPATH
+  ```cpp             built as the main() of a CMake project against an installed fictus
+                     (find_package(fictus), cmake --install of the build into the scratch folder), run
   ```toml            parsed (tomllib): a problem file or a piece of one
   ```text            not run: synopses, sample output, formulas
 A fence without one of these tags is an error, and so is a command (a line starting with fictus,
@@ -26,7 +28,7 @@ import tempfile
 import time
 import tomllib
 
-RUN = {"sh", "bash", "python"}
+RUN = {"sh", "bash", "python", "cpp"}
 KNOWN = RUN | {"toml", "text"}
 COMMAND = re.compile(r"^\s*(\$ |fictus |make |cmake |python3? |pip |\.venv/|PYTHONPATH=|export |cd )")
 SKIP = re.compile(r"<!--\s*doc-test:\s*skip:\s*(.*?)\s*-->")
@@ -66,6 +68,36 @@ def blocks(path):
             continue
         k += 1
     return found, problems
+
+
+CONSUMER = """cmake_minimum_required(VERSION 3.20)
+project(doc_block LANGUAGES CXX)
+set(CMAKE_CXX_STANDARD 20)
+find_package(fictus 0.1 REQUIRED)
+add_executable(block main.cpp)
+target_link_libraries(block PRIVATE fictus::fictus fictus::fictus_io)
+"""
+
+
+def run_cpp(text, work, scratch, build, env, counter):
+    """Builds the block against fictus installed into scratch/prefix (once) and runs it in `work`."""
+    prefix = os.path.join(scratch, "prefix")
+    if not os.path.isdir(prefix):
+        subprocess.run(["cmake", "--install", build, "--prefix", prefix], check=True, capture_output=True)
+    project = os.path.join(scratch, f"cpp{counter}")
+    os.makedirs(project)
+    with open(os.path.join(project, "main.cpp"), "w") as f:
+        f.write(text)
+    with open(os.path.join(project, "CMakeLists.txt"), "w") as f:
+        f.write(CONSUMER)
+    binary = os.path.join(project, "build")
+    for step in (["cmake", "-S", project, "-B", binary, f"-DCMAKE_PREFIX_PATH={prefix}", "-DCMAKE_BUILD_TYPE=Release"],
+                 ["cmake", "--build", binary]):
+        r = subprocess.run(step, capture_output=True, text=True)
+        if r.returncode != 0:
+            return r
+    return subprocess.run([os.path.join(binary, "block")], cwd=work, env=env, capture_output=True, text=True,
+                          timeout=600)
 
 
 def main():
@@ -117,8 +149,11 @@ def main():
                     continue
                 command = ([args.python, "-"] if tag == "python" else ["bash", "-e", "-o", "pipefail", "-s"])
                 start = time.time()
-                r = subprocess.run(command, input=text, cwd=work, env=env, capture_output=True, text=True,
-                                   timeout=600)
+                if tag == "cpp":
+                    r = run_cpp(text, work, scratch, build, env, counts["ran"])
+                else:
+                    r = subprocess.run(command, input=text, cwd=work, env=env, capture_output=True, text=True,
+                                       timeout=600)
                 seconds = time.time() - start
                 counts["ran"] += 1
                 if r.returncode != 0:
