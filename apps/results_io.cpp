@@ -191,13 +191,13 @@ void write_output_set(const fs::path& dir, const std::vector<OutputFile>& files)
 std::string points_csv(const Solution& s) {
   std::ostringstream out;
   out.precision(17);
-  out << "i,s,x,y,nx,ny,g,u,dudn,lambda,contact,Gamma_x,Gamma_y\n";
+  out << "i,s,x,y,nx,ny,g,u,dudn,lambda,contact,Gamma_x,Gamma_y,arc\n";
   for (int i = 0; i < s.collocation.m; ++i) {
     const Point2 G = s.Gamma->position(s.collocation.t[i]);
     out << i << ',' << s.collocation.s[i] << ',' << s.collocation.point[i].x << ',' << s.collocation.point[i].y << ','
         << s.collocation.normal[i].x << ',' << s.collocation.normal[i].y << ',' << s.g[i] << ',' << s.trace[i] << ','
         << s.normal_derivative[i] << ',' << s.lambda[i] << ',' << int(s.newton.active[i]) << ',' << G.x << ',' << G.y
-        << '\n';
+        << ',' << s.collocation.arc[i] << '\n';
   }
   return out.str();
 }

@@ -8,7 +8,8 @@
 
 namespace fictus {
 
-Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase) {
+Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase,
+                             const ArcLengthTable* placement) {
   if (m < 1) throw std::invalid_argument("make_collocation: need m >= 1, got " + std::to_string(m));
   Collocation c;
   c.m = m;
@@ -16,27 +17,42 @@ Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_lengt
   c.spacing = c.length / m;
   c.phase = phase;
   c.s.resize(m);
+  c.arc.resize(m);
   c.t.resize(m);
   c.arc_begin.resize(m);
   c.arc_end.resize(m);
   c.point.resize(m);
   c.normal.resize(m);
   const double two_pi = 2.0 * std::numbers::pi;
-  auto t_at = [&](double s) {  // parameter at arc length s (mod L); exact ends at 0 and L
-    s = std::fmod(s, c.length);
-    s = s < 0 ? s + c.length : s;
-    return s <= 0 ? 0.0 : arc_length.t_of_s(s);
+  const ArcLengthTable& measure = placement ? *placement : arc_length;
+  const double total = measure.length(), step = total / m;
+  auto t_at = [&](double w) {  // parameter at measure w (mod the total); exact ends at 0 and the total
+    w = std::fmod(w, total);
+    w = w < 0 ? w + total : w;
+    return w <= 0 ? 0.0 : measure.t_of_s(w);
   };
   for (int i = 0; i < m; ++i) {
-    c.s[i] = (i + phase) * c.spacing;
-    c.t[i] = t_at(c.s[i]);
-    const double begin = c.s[i] - 0.5 * c.spacing, end = c.s[i] + 0.5 * c.spacing;
-    c.arc_begin[i] = std::abs(begin) < 1e-14 * c.length ? 0.0 : t_at(begin);
-    c.arc_end[i] = std::abs(end - c.length) < 1e-14 * c.length ? two_pi : t_at(end);
+    const double w = (i + phase) * step, begin = w - 0.5 * step, end = w + 0.5 * step;
+    c.t[i] = t_at(w);
+    c.arc_begin[i] = std::abs(begin) < 1e-14 * total ? 0.0 : t_at(begin);
+    c.arc_end[i] = std::abs(end - total) < 1e-14 * total ? two_pi : t_at(end);
     c.point[i] = curve.position(c.t[i]);
     c.normal[i] = curve.outward_normal(c.t[i]);
+    if (placement) {
+      c.s[i] = arc_length.s_of_t(c.t[i]);
+      const double from = arc_length.s_of_t(c.arc_begin[i]), to = arc_length.s_of_t(c.arc_end[i]);
+      c.arc[i] = to >= from ? to - from : to + c.length - from;
+    } else {
+      c.s[i] = w;
+      c.arc[i] = c.spacing;
+    }
   }
   return c;
+}
+
+ArcLengthTable offset_placement(const Curve& curve, double delta) {
+  return ArcLengthTable(
+      [&curve, delta](double t) { return curve.speed(t) * std::max(1.0, 1.0 + delta * curve.curvature(t)); });
 }
 
 double phase_off_corners(const Curve& curve, const ArcLengthTable& arc_length, int m) {

@@ -59,7 +59,10 @@ Point2 TransformedCurve::position(double t) const {
 }
 
 ArcLengthTable::ArcLengthTable(const Curve& curve, int panels)
-    : curve_(curve), dt_(two_pi / panels), cumulative_(panels + 1, 0.0) {
+    : ArcLengthTable([&curve](double t) { return curve.speed(t); }, panels) {}
+
+ArcLengthTable::ArcLengthTable(std::function<double(double)> speed, int panels)
+    : speed_(std::move(speed)), dt_(two_pi / panels), cumulative_(panels + 1, 0.0) {
   if (panels < 1) throw std::invalid_argument("ArcLengthTable: panels must be positive");
   for (int k = 0; k < panels; ++k) cumulative_[k + 1] = cumulative_[k] + partial(k, (k + 1) * dt_);
 }
@@ -68,7 +71,7 @@ double ArcLengthTable::partial(int panel, double t) const {
   const GaussRule& rule = gauss_legendre(12);
   const double t0 = panel * dt_, span = t - t0;
   double sum = 0.0;
-  for (std::size_t g = 0; g < rule.nodes.size(); ++g) sum += rule.weights[g] * curve_.speed(t0 + rule.nodes[g] * span);
+  for (std::size_t g = 0; g < rule.nodes.size(); ++g) sum += rule.weights[g] * speed_(t0 + rule.nodes[g] * span);
   return sum * span;
 }
 
@@ -90,7 +93,7 @@ double ArcLengthTable::t_of_s(double s) const {
       hi = t;
     else
       lo = t;
-    double next = t - r / curve_.speed(t);
+    double next = t - r / speed_(t);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
     if (std::abs(next - t) < 1e-15 * two_pi) return next;
     t = next;

@@ -37,9 +37,8 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
     throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) +
                                 " is too large for the grid (spacing L/m = " + std::to_string(L / m) +
                                 " < 2h; use m <= " + std::to_string(int(L / (2 * h))) + ")");
-  collocation_ = make_collocation(gamma, arc_length, m, phase_off_corners(gamma, arc_length, m));
-
   if (options.variant == Variant::nonsmooth) {
+    collocation_ = make_collocation(gamma, arc_length, m, phase_off_corners(gamma, arc_length, m));
     Gamma_ = gamma_;
     return;
   }
@@ -47,7 +46,12 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
     throw std::invalid_argument(
         "formulation.variant: the smooth variant needs a curve with a continuous normal "
         "(use \"nonsmooth\" for polygons)");
-  delta_ = options.offset * collocation_.spacing;
+  delta_ = options.offset * L / m;
+  // Points placed so that the arcs of Γ behind them are equal where γ is convex (there Γ's arcs are
+  // stretched by 1 + δκ): the longest arc of Γ, which sets the ripple of the controls, is as short as m
+  // allows (docs/math.md, "Placement of the points").
+  const ArcLengthTable placement = offset_placement(gamma, delta_);
+  collocation_ = make_collocation(gamma, arc_length, m, 0.5, &placement);
   // The biquadratic stencil of C_γ reaches 1.5·√2·h ≈ 2.1h from x_i; its nodes must stay out of the
   // cells cut by Γ (which reach 1.4h from Γ), where the kink of û pollutes the nodal values.
   if (options.normal_derivative == NormalDerivative::reconstructed && delta_ < 4 * h)

@@ -487,7 +487,6 @@ double estimated_seconds(const Problem& problem, const SolverOptions& options) {
 ContactSummary contact_summary(const Solution& s) {
   ContactSummary c;
   const Collocation& points = s.collocation;
-  const double spacing = points.length / points.m;
   c.min_gap = std::numeric_limits<double>::infinity();
   c.max_gap = -c.min_gap;
   for (int i = 0; i < points.m; ++i) {
@@ -496,10 +495,10 @@ ContactSummary contact_summary(const Solution& s) {
     c.max_gap = std::max(c.max_gap, gap);
     if (s.newton.active[i] == 1) {
       ++c.points;
-      c.force += s.normal_derivative[i] * spacing;
+      c.force += s.normal_derivative[i] * points.arc[i];
+      c.measure += points.arc[i];
     }
   }
-  c.measure = c.points * spacing;
   c.lambda = s.lambda_total;
   return c;
 }

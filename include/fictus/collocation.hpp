@@ -1,7 +1,9 @@
 #pragma once
-// m collocation points on γ equally spaced in arc length: point i sits at s_i = (i + phase)·L/m
-// (phase ½ by default) and owns the arc [s_i − L/2m, s_i + L/2m] between the midpoints to its
-// neighbours. An arc may wrap past t = 0: then arc_begin > arc_end.
+// m collocation points on γ. Point i sits at the middle of arc i and owns that arc; the arcs are
+// equal in arc length (spacing s = L/m), or equal in a placement measure ∫ w(t)|p′(t)| dt: the
+// smooth variant's, w = max(1, 1 + δκ), makes the arcs of Γ (their normal offsets at distance δ) equal
+// wherever γ is convex (docs/math.md, "Placement of the points"). An arc may wrap past t = 0: then
+// arc_begin > arc_end.
 #include <vector>
 
 #include "fictus/curve.hpp"
@@ -11,9 +13,10 @@ namespace fictus {
 struct Collocation {
   int m = 0;
   double length = 0.0;   // L = |γ|
-  double spacing = 0.0;  // s = L/m
+  double spacing = 0.0;  // s = L/m, the mean length of the arcs
   double phase = 0.5;
   std::vector<double> s;                   // arc length of point i
+  std::vector<double> arc;                 // length of the arc of γ point i owns (L/m without placement)
   std::vector<double> t;                   // parameter of point i
   std::vector<double> arc_begin, arc_end;  // parameters bounding arc i, arc_begin[0] = 0
   std::vector<Point2> point, normal;       // x_i and the outward unit normal n_i
@@ -21,7 +24,14 @@ struct Collocation {
   int n_points() const { return m; }
 };
 
-Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase = 0.5);
+/// The points of arcs equal in `placement` (nullptr: in arc length), point i at the placement
+/// measure's (i + phase)·W/m.
+Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase = 0.5,
+                             const ArcLengthTable* placement = nullptr);
+
+/// The smooth variant's placement measure for Γ at distance δ: speed |p′(t)|·max(1, 1 + δκ(t)), the
+/// speed of the offset curve where γ is convex and of γ itself where it is concave.
+ArcLengthTable offset_placement(const Curve& curve, double delta);
 
 /// The phase (among 32 candidates, ½ first) that keeps the points farthest from the curve's corners.
 double phase_off_corners(const Curve& curve, const ArcLengthTable& arc_length, int m);

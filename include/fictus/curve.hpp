@@ -2,6 +2,7 @@
 // Closed curves γ = ∂ω: a parametrization p(t), t ∈ [0, 2π), 2π-periodic, counter-clockwise
 // (ω on the left), with first and second derivatives. The outward normal is
 // n = (y', −x')/|p'|, the curvature κ = (x'y'' − y'x'')/|p'|³ (> 0 on a convex curve).
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -80,17 +81,19 @@ class TransformedCurve final : public Curve {
   Point2 shift_;
 };
 
-/// Cumulative arc length s(t) on [0, 2π] by composite Gauss–Legendre, and its inverse.
+/// Cumulative arc length s(t) on [0, 2π] by composite Gauss–Legendre, and its inverse; or, with a
+/// `speed` of its own, any length measure ∫ speed dt along the curve (a weighted arc length).
 class ArcLengthTable {
  public:
   explicit ArcLengthTable(const Curve& curve, int panels = 2048);
+  ArcLengthTable(std::function<double(double t)> speed, int panels = 2048);
   double length() const { return cumulative_.back(); }
   double s_of_t(double t) const;  // t ∈ [0, 2π]
   double t_of_s(double s) const;  // s ∈ [0, L] (Newton, safeguarded by the panel bracket)
 
  private:
-  double partial(int panel, double t) const;  // ∫_{t_panel}^{t} |p'|
-  const Curve& curve_;
+  double partial(int panel, double t) const;  // ∫_{t_panel}^{t} speed
+  std::function<double(double)> speed_;
   double dt_;
   std::vector<double> cumulative_;  // s at panel starts, size panels + 1
 };

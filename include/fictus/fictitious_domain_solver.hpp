@@ -119,8 +119,8 @@ class FictitiousDomainSolver {
   std::unique_ptr<State> state_;
 };
 
-/// The contact in numbers, from the per-point values of a solution (point i owns the arc L/m of γ
-/// around it).
+/// The contact in numbers, from the per-point values of a solution (point i owns the arc
+/// collocation.arc[i] of γ around it).
 struct ContactSummary {
   long points = 0;     // points in contact (the active set)
   double measure = 0;  // length of the contact set: points · L/m

@@ -56,6 +56,40 @@ TEST(Collocation, EquallySpacedInArcLength) {
   }
 }
 
+TEST(Collocation, OffsetPlacementMakesTheArcsOfGammaEqualWhereGammaIsConvex) {
+  // Convex ellipse: every arc of Γ (the normal offsets of γ's arcs at δ) has the length |Γ|/m; γ's arcs
+  // are shorter at the ends of the major axis (curvature a/b² = 10) and cover γ once.
+  auto e = std::make_shared<fictus::Ellipse>(fictus::Point2{0.5, 0.5}, 0.4, 0.2);
+  const fictus::ArcLengthTable table(*e);
+  const double delta = 0.057;
+  const fictus::ArcLengthTable placement = fictus::offset_placement(*e, delta);
+  const fictus::Collocation c = fictus::make_collocation(*e, table, 34, 0.5, &placement);
+  const fictus::OffsetCurve Gamma(e, delta);
+  const fictus::ArcLengthTable on_Gamma(Gamma);
+  EXPECT_NEAR(placement.length(), on_Gamma.length(), 1e-12);
+  double total = 0, shortest = 1e300, longest = 0;
+  for (int i = 0; i < c.m; ++i) {
+    const double from = on_Gamma.s_of_t(c.arc_begin[i]), to = on_Gamma.s_of_t(c.arc_end[i]);
+    EXPECT_NEAR(to >= from ? to - from : to + on_Gamma.length() - from, on_Gamma.length() / c.m, 1e-11);
+    EXPECT_NEAR(c.s[i], table.s_of_t(c.t[i]), 1e-14);
+    total += c.arc[i];
+    shortest = std::min(shortest, c.arc[i]);
+    longest = std::max(longest, c.arc[i]);
+  }
+  EXPECT_NEAR(total, table.length(), 1e-12);
+  EXPECT_LT(shortest, 0.8 * c.spacing);  // at the ends of the major axis: about |Γ|/m / (1 + δ·10) = 0.76 s
+  EXPECT_GT(longest, c.spacing);
+
+  // A star with concave parts: there the weight is 1 (γ's own arc length), so no arc of γ is longer
+  // than W/m, W = ∫ max(1, 1 + δκ) ds, and none of Γ's longer than that either.
+  const fictus::StarCurve star({0.5, 0.5}, [](double t) { return 0.3 + 0.08 * std::cos(5 * t); });
+  const fictus::ArcLengthTable star_table(star);
+  const fictus::ArcLengthTable star_placement = fictus::offset_placement(star, 0.03);
+  const fictus::Collocation d = fictus::make_collocation(star, star_table, 60, 0.5, &star_placement);
+  for (int i = 0; i < d.m; ++i) EXPECT_LE(d.arc[i], star_placement.length() / d.m * (1 + 1e-9));
+  EXPECT_GT(star_placement.length(), star_table.length());
+}
+
 TEST(Collocation, DefaultRuleKeepsTheSpacingInCells) {
   const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2);
   const double L = fictus::ArcLengthTable(e).length();
