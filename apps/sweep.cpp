@@ -40,7 +40,8 @@ std::vector<double> parse_values(const std::string& text, const std::string& opt
     throw std::invalid_argument(option + ": expected a list a,b,c or start:stop:count, got \"" + text + "\"");
   }
   for (double v : values)
-    if (!std::isfinite(v)) throw std::invalid_argument(option + ": values must be finite");
+    if (!std::isfinite(v) || std::abs(v) > 1e100)
+      throw std::invalid_argument(option + ": values must be finite and at most 1e100 in size");
   if (values.empty()) throw std::invalid_argument(option + ": no values");
   return values;
 }
@@ -61,7 +62,12 @@ Family family_of(const SweepArguments& args, const ProblemSpec& base) {
   if (kinds != 1) throw std::invalid_argument("sweep: give exactly one of --g-scale, --rotate, --move, --parameter");
   Family f;
   if (!args.g_scale.empty()) f = {"g_scale", "g_scale", parse_values(args.g_scale, "--g-scale"), false, false};
-  if (!args.rotate.empty()) f = {"rotate", "rotate", parse_values(args.rotate, "--rotate"), true, false};
+  if (!args.rotate.empty()) {
+    f = {"rotate", "rotate", parse_values(args.rotate, "--rotate"), true, false};
+    for (double v : f.values)
+      if (std::abs(v) > 1e4)
+        throw std::invalid_argument("--rotate: angles are in radians; |angle| <= 1e4 (cos and sin lose digits beyond)");
+  }
   if (!args.move.empty()) f = {"move", "move", parse_values(args.move, "--move"), true, false};
   if (!args.parameter.empty()) {
     const std::size_t equals = args.parameter.find('=');
@@ -197,8 +203,10 @@ int run_sweep(const SweepArguments& args, const OptionFlags& flags) {
     std::printf("wrote sweep.csv and sweep.json to %s/\n", args.out.c_str());
   }
   if (failures) {
-    std::fprintf(stderr, "fictus: error: Newton did not converge for %d of %zu problems\n", failures,
-                 family.values.size());
+    std::fprintf(stderr,
+                 "fictus: error: solver.max_newton: Newton did not converge for %d of %zu problems (converged = 0 "
+                 "in sweep.csv; fictus solve of one of them gives the iteration history)\n",
+                 failures, family.values.size());
     return 2;
   }
   return 0;

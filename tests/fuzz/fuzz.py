@@ -20,7 +20,8 @@
 Outcome classes. Acceptable: ok (exit 0, results.json and points.csv finite and within 1e100,
 Newton converged, foreign files in the folder kept), error (exit 1, 2 or 3, exactly one
 `fictus: error: <key>: …` line of at most 240 characters on stderr, the output folder as it was),
-timeout (still running after the time limit: the tool is slow, not wrong). Defects: crash (killed
+timeout (still running after the time limit: the tool is slow, not wrong). A sweep whose Newton fails
+for some members (exit 2) writes its complete sweep.csv and sweep.json all the same, those rows marked. Defects: crash (killed
 by a signal), bad_exit (an undocumented exit code), internal (exit 4), sanitizer (an ASan/UBSan report), bad_message,
 nonfinite (exit 0 with a non-finite or out-of-range number, or Newton not converged),
 changed_output (a failing run changed the folder or left a temporary behind).
@@ -67,6 +68,28 @@ def finite_numbers(value, where, problems):
         problems.append(f"{where} is null")
     elif isinstance(value, float) and (not math.isfinite(value) or abs(value) > 1e100):
         problems.append(f"{where} = {value}")
+
+
+def check_sweep(folder):
+    """Problems with the files of a successful sweep: sweep.csv and sweep.json finite and complete."""
+    path = os.path.join(folder, "sweep.csv")
+    if not os.path.exists(path):
+        return ["sweep.csv was not written"]
+    problems = []
+    with open(path) as handle:
+        rows = list(handle)
+    for row in rows[1:]:
+        for cell in row.strip().split(","):
+            number = float(cell)
+            if not math.isfinite(number) or abs(number) > 1e100:
+                problems.append(f"sweep.csv: {cell}")
+    with open(os.path.join(folder, "sweep.json")) as handle:
+        document = json.load(handle)
+    if len(document["rows"]) != len(rows) - 1:
+        problems.append("sweep.json and sweep.csv differ in rows")
+    document.pop("problem", None)
+    finite_numbers(document, "sweep", problems)
+    return problems
 
 
 def check_success(folder):
@@ -153,6 +176,10 @@ def run_case(exe, case, timeout):
         if rc == 4:
             return dict(outcome, **{"class": "internal", "message": stderr[-2000:]})
         if rc == 0:
+            if command[1] == "sweep":
+                problems = check_sweep(folder)
+                return dict(outcome, **({"class": "nonfinite", "message": "; ".join(problems)[:2000]} if problems
+                                        else {"class": "ok"}))
             if command[1] != "solve":
                 return dict(outcome, **{"class": "ok"})
             problems = check_success(folder)
@@ -175,7 +202,13 @@ def run_case(exe, case, timeout):
         if not match or len(errors[0].encode()) > MAX_LINE:
             return dict(outcome, **{"class": "bad_message", "message": stderr[-2000:]})
         outcome.update(key=match.group(1), message=errors[0])
-        if folder_state(folder) != before or leftovers:
+        after = folder_state(folder)
+        if command[1] == "sweep" and rc == 2:  # a sweep writes its rows, those not converged marked
+            problems = check_sweep(folder)
+            if problems:
+                return dict(outcome, **{"class": "nonfinite", "message": "; ".join(problems)[:2000]})
+            after = {name: digest for name, digest in after.items() if name not in ("sweep.csv", "sweep.json")}
+        if after != before or leftovers:
             return dict(outcome, **{"class": "changed_output"})
         return dict(outcome, **{"class": "error"})
 
@@ -424,7 +457,20 @@ def make_case(rng, seeds, options):
     text = to_toml(document)
     if rng.random() < 0.12:
         text = mutate_text(rng, text)
+    if rng.random() < 0.1:  # a sweep: a family of the problem, by one of its kinds
+        return {"problem": text, "args": ["sweep"] + sweep_family(rng, document) + random_flags(rng, options)}
     return {"problem": text, "args": ["solve"] + random_flags(rng, options)}
+
+
+def sweep_family(rng, document):
+    """--g-scale, --rotate, --move or --parameter with a list of 1–4 values, extreme ones too."""
+    values = [random_number(rng, rng.choice([1.0, 0.1, 3.0])) for _ in range(rng.choice([1, 2, 3, 4]))]
+    text = ",".join(str(v) for v in values) if rng.random() < 0.8 else rng.choice(["0:1:3", "1:1:0", "a,b", "", "1:2:3:4"])
+    names = list(document.get("parameters", {}) or {}) if isinstance(document.get("parameters"), dict) else []
+    kind = rng.choice(["--g-scale", "--rotate", "--move"] + (["--parameter"] * 3 if names else []))
+    if kind == "--parameter":
+        return [kind, f"{rng.choice(names + ['nothere'])}={text}"]
+    return [kind, text]
 
 
 # ----------------------------------------------------------------------------------------------

@@ -47,3 +47,8 @@ record periodic_krylov --problem "$here/seeds/periodic_krylov.toml" -- solve
 record parse_flag_then_file --problem "$ex/circle.toml" -- solve --N 128 --variant nonsmooth --files results.json,points.csv
 # Found by the fuzzer under UBSan: a semi-axis of 1.8e308 made the curve's extent overflow (NaN cast)
 record huge_semi_axis --problem "$here/seeds/huge_semi_axis.toml" -- solve --N 9 --max_memory 1
+
+# Sweeps (found by the fuzzer when sweeps joined it): a family whose Newton fails names the key;
+# an absurd rotation is refused
+record sweep_newton_fails --problem "$here/seeds/sweep_newton_fails.toml" -- sweep --rotate 0,1.0
+record sweep_rotate_1e300 --problem "$here/seeds/sweep_rotate_1e300.toml" -- sweep --rotate 1e+300 --normal_shift 1
