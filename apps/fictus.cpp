@@ -6,6 +6,7 @@
 #include <unistd.h>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -36,10 +37,7 @@ namespace {
 // Exit codes, one per class of failure (docs/usage.md).
 constexpr int exit_bad_input = 1, exit_newton = 2, exit_output = 3, exit_internal = 4;
 
-/// Newton did not converge (exit code 2).
-struct NewtonFailure : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using fictus::cli::NewtonFailure;
 
 /// The one error line: "fictus: error: <message>", at most 240 bytes, on stderr. A longer message is cut
 /// at a character boundary (never inside a UTF-8 sequence) and ends in "...".
@@ -135,12 +133,17 @@ int run_solve(const SolveCommand& command) {
   fictus::ParameterValues parameters;
   for (const std::string& p : command.parameters) {
     const std::size_t equals = p.find('=');
-    const std::vector<double> value = equals == std::string::npos || equals == 0
-                                          ? std::vector<double>{}
-                                          : fictus::cli::parse_values(p.substr(equals + 1), "--parameter");
-    if (value.size() != 1)
-      throw std::invalid_argument("--parameter: expected NAME=VALUE, e.g. a=0.25, got \"" + p.substr(0, 60) + "\"");
-    parameters[p.substr(0, equals)] = value[0];
+    std::size_t used = 0;
+    double value = 0;
+    try {
+      if (equals != std::string::npos && equals > 0) value = std::stod(p.substr(equals + 1), &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != p.size() - equals - 1 || !std::isfinite(value))
+      throw std::invalid_argument("--parameter: expected NAME=VALUE with a finite number, e.g. a=0.25, got \"" +
+                                  p.substr(0, 60) + "\"");
+    parameters[p.substr(0, equals)] = value;
   }
   fictus::ProblemSpec spec = fictus::cli::problem_from(problem_path, flags, parameters);
   if (command.out_option->count() > 0) spec.output.dir = command.out;

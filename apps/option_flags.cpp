@@ -47,9 +47,16 @@ void OptionFlags::apply(Problem& problem, SolverOptions& options) const {
 }
 
 ProblemSpec problem_from(const std::string& path, const OptionFlags& flags, const ParameterValues& parameters) {
+  return problem_from_text(path.empty() ? "" : read_problem_text(path), path, flags, parameters);
+}
+
+ProblemSpec problem_from_text(const std::string& text, const std::string& path, const OptionFlags& flags,
+                              const ParameterValues& parameters) {
   ProblemSpec spec;
   if (!path.empty()) {
-    spec = read_problem_file(path, parameters);
+    spec = parse_problem_text(text, path, parameters);
+    const std::string name = path.substr(path.find_last_of('/') + 1);
+    spec.problem.name = name.substr(0, name.rfind(".toml"));
   } else {
     if (!parameters.empty()) throw std::invalid_argument("--parameter: only a problem file has [parameters]");
     // The paper's problem, with its m and δ unless the flags say otherwise.

@@ -39,5 +39,8 @@ class OptionFlags {
 /// (its [parameters] replaced by `parameters`), or without one the paper's problem with its m and δ
 /// unless the flags give them. `input` is set to what results.json echoes under "problem".
 ProblemSpec problem_from(const std::string& path, const OptionFlags& flags, const ParameterValues& parameters = {});
+/// The same from the file's text, read once (a sweep's members: the file may change or be a pipe).
+ProblemSpec problem_from_text(const std::string& text, const std::string& path, const OptionFlags& flags,
+                              const ParameterValues& parameters = {});
 
 }  // namespace fictus::cli

@@ -24,6 +24,11 @@ nlohmann::json solution_to_json(const Problem& problem, const Solution& solution
                                 const nlohmann::json& input = nlohmann::json::object());
 LevelResult level_result(const Solution& solution);
 
+/// Newton did not converge (exit code 2): the message names the setting (describe_newton_failure).
+struct NewtonFailure : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 /// An output file could not be written (exit code 3).
 struct OutputError : std::runtime_error {
   using std::runtime_error::runtime_error;

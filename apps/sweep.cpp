@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -86,6 +87,12 @@ Family family_of(const SweepArguments& args, const ProblemSpec& base) {
                                   " is not in the problem file's [parameters] (" +
                                   (known.empty() ? "it has none" : known) + ")");
     }
+    for (const char* column :
+         {"converged", "newton_steps", "multipliers", "contact_points", "contact_measure", "contact_force",
+          "lambda_integral", "min_gap", "max_gap", "min_normal_derivative", "max_complementarity", "seconds"})
+      if (f.name == column)
+        throw std::invalid_argument("--parameter: a parameter named " + f.name +
+                                    " would clash with that column of sweep.csv; rename it in [parameters]");
     const auto uses = base.parameter_uses.find(f.name);
     if (uses == base.parameter_uses.end())
       throw std::invalid_argument("--parameter: no expression of the problem file uses " + f.name);
@@ -98,8 +105,8 @@ Family family_of(const SweepArguments& args, const ProblemSpec& base) {
 }
 
 /// Member k of the family: the base problem changed by one value.
-Problem member(const Family& family, const ProblemSpec& base, const SweepArguments& args, const OptionFlags& flags,
-               double v) {
+Problem member(const Family& family, const ProblemSpec& base, const SweepArguments& args, const std::string& text,
+               const OptionFlags& flags, double v) {
   Problem problem = base.problem;
   if (family.kind == "g_scale") {
     if (problem.g) problem.g = [g = base.problem.g, v](double x, double y) { return v * g(x, y); };
@@ -113,7 +120,7 @@ Problem member(const Family& family, const ProblemSpec& base, const SweepArgumen
     problem.gamma = std::make_shared<TransformedCurve>(base.problem.gamma, 0.0, Point2{v, 0});
     if (base.g_about) problem.g_along_curve = base.g_about(problem.gamma->center());  // phi about the moved center
   } else {
-    problem = problem_from(args.problem_path, flags, {{family.name, v}}).problem;
+    problem = problem_from_text(text, args.problem_path, flags, {{family.name, v}}).problem;
     if (!family.moves_curve) problem.gamma = base.problem.gamma;  // the same rows and Schur blocks
   }
   if (family.kind != "parameter") problem.exact = nullptr;  // the exact solution is the base problem's
@@ -123,14 +130,20 @@ Problem member(const Family& family, const ProblemSpec& base, const SweepArgumen
 }  // namespace
 
 int run_sweep(const SweepArguments& args, const OptionFlags& flags) {
-  const ProblemSpec base = problem_from(args.problem_path, flags);
+  const std::string text = args.problem_path.empty() ? "" : read_problem_text(args.problem_path);
+  const ProblemSpec base = problem_from_text(text, args.problem_path, flags);
   const Family family = family_of(args, base);
   for (const std::string& w : base.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
   if (!args.out.empty()) check_output_folder(args.out, {"sweep.csv", "sweep.json"});
   SolverOptions options = base.options;
-  if (!flags.given("condition_number")) options.condition_number = false;
+  options.condition_number = false;  // not a column of the sweep
   check_memory(base.problem, options);
+  const auto setup_start = std::chrono::steady_clock::now();
   FictitiousDomainSolver solver(base.problem, options);
+  // The base problem first: its own errors (a smooth variant on a polygon, Γ leaving the box) are
+  // not a member's. For an obstacle family its rows and blocks serve every member.
+  solver.solve(base.problem, options, false);
+  const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
 
   std::ostringstream csv;
   csv.precision(12);
@@ -141,14 +154,15 @@ int run_sweep(const SweepArguments& args, const OptionFlags& flags) {
   nlohmann::json rows = nlohmann::json::array();
   std::printf("%-12s %5s %7s %11s %11s %11s %11s %9s\n", family.name.substr(0, 12).c_str(), "it0", "contact", "measure",
               "force", "min gap", "max gap", "time[s]");
-  double first = 0, rest = 0;
+  double total = 0;
   int failures = 0;
+  std::optional<std::pair<double, std::string>> first_failure;
   for (std::size_t k = 0; k < family.values.size(); ++k) {
     const double v = family.values[k];
     const auto start = std::chrono::steady_clock::now();
     Solution s(solver.grid());
     try {
-      const Problem problem = member(family, base, args, flags, v);
+      const Problem problem = member(family, base, args, text, flags, v);
       if (family.changes_load) solver.replace_load(problem);
       s = solver.solve(problem, options, false);  // boundary quantities only
     } catch (const std::invalid_argument& e) {
@@ -158,8 +172,9 @@ int run_sweep(const SweepArguments& args, const OptionFlags& flags) {
       throw std::invalid_argument(e.what() + at.str());
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    (k == 0 ? first : rest) += seconds;
+    total += seconds;
     failures += !s.newton.converged;
+    if (!s.newton.converged && !first_failure) first_failure = std::pair{v, describe_newton_failure(s)};
     const ContactSummary c = contact_summary(s);
     std::printf("%-12.6g %5d %7ld %11.4e %11.4e %11.3e %11.3e %9.4f%s\n", v, s.newton.iterations, c.points, c.measure,
                 c.force, c.min_gap, c.max_gap, seconds, s.newton.converged ? "" : "  NOT converged");
@@ -180,16 +195,12 @@ int run_sweep(const SweepArguments& args, const OptionFlags& flags) {
                     {"max_complementarity", s.signorini.max_complementarity},
                     {"seconds", seconds}});
   }
-  const std::size_t n_rest = family.values.size() - 1;
-  std::printf("first problem %.3f s (grid setup included)", first);
-  if (n_rest > 0)
-    std::printf("; then %.4f s per problem (%s), %.1f problems per second\n", rest / n_rest,
-                family.changes_load  ? "new u0 and Newton"
-                : family.moves_curve ? "new curve rows, Schur blocks and Newton"
-                                     : "Newton only",
-                n_rest / rest);
-  else
-    std::printf("\n");
+  std::printf("grid setup and the base problem %.3f s; then %.4f s per problem (%s), %.1f problems per second\n", setup,
+              total / family.values.size(),
+              family.changes_load  ? "new u0 and Newton"
+              : family.moves_curve ? "new curve rows, Schur blocks and Newton"
+                                   : "Newton only",
+              family.values.size() / total);
   if (!args.out.empty()) {
     nlohmann::json j{{"version", FICTUS_VERSION},
                      {"commit", FICTUS_GIT_COMMIT},
@@ -202,12 +213,15 @@ int run_sweep(const SweepArguments& args, const OptionFlags& flags) {
                                 {"sweep.json", [&](std::ostream& out) { out << j.dump(2) << '\n'; }}});
     std::printf("wrote sweep.csv and sweep.json to %s/\n", args.out.c_str());
   }
-  if (failures) {
-    std::fprintf(stderr,
-                 "fictus: error: solver.max_newton: Newton did not converge for %d of %zu problems (converged = 0 "
-                 "in sweep.csv; fictus solve of one of them gives the iteration history)\n",
-                 failures, family.values.size());
-    return 2;
+  if (first_failure) {
+    std::ostringstream at;  // after the key of the failure: "solver.max_newton: at rotate = 0 (…): …"
+    at.precision(12);
+    at << "at " << family.name << " = " << first_failure->first << " (" << failures << " of " << family.values.size()
+       << " did not converge; converged = 0 in sweep.csv): ";
+    std::string line = first_failure->second;
+    const std::size_t key_end = line.find(": ");
+    line.insert(key_end == std::string::npos ? 0 : key_end + 2, at.str());
+    throw NewtonFailure(line);
   }
   return 0;
 }

@@ -1,5 +1,6 @@
 #pragma once
-// m collocation points on γ. Point i sits at the middle of arc i and owns that arc; the arcs are
+// m collocation points on γ. Point i sits at the middle of arc i (in the measure that spaces them) and
+// owns that arc; the arcs are
 // equal in arc length (spacing s = L/m), or equal in a placement measure ∫ w(t)|p′(t)| dt: the
 // smooth variant's, w = max(1, 1 + δκ), makes the arcs of Γ (their normal offsets at distance δ) equal
 // wherever γ is convex (docs/math.md, "Placement of the points"). An arc may wrap past t = 0: then

@@ -73,6 +73,8 @@ class TransformedCurve final : public Curve {
   Point2 derivative(double t) const override { return rotate(base_->derivative(t)); }
   Point2 second_derivative(double t) const override { return rotate(base_->second_derivative(t)); }
   Point2 center() const override { return base_->center() + shift_; }
+  std::vector<double> corners() const override { return base_->corners(); }  // the same parameter t
+  bool smooth() const override { return base_->smooth(); }
 
  private:
   Point2 rotate(Point2 v) const { return {cos_ * v.x - sin_ * v.y, sin_ * v.x + cos_ * v.y}; }
@@ -82,7 +84,8 @@ class TransformedCurve final : public Curve {
 };
 
 /// Cumulative arc length s(t) on [0, 2π] by composite Gauss–Legendre, and its inverse; or, with a
-/// `speed` of its own, any length measure ∫ speed dt along the curve (a weighted arc length).
+/// `speed` of its own, any length measure ∫ speed dt along the curve (a weighted arc length). The table
+/// keeps a reference to the curve (or the speed's captures): the curve must outlive it.
 class ArcLengthTable {
  public:
   explicit ArcLengthTable(const Curve& curve, int panels = 2048);

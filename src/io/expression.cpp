@@ -107,6 +107,15 @@ Expression::Expression(std::string text, std::vector<std::string> variables, std
       throw std::invalid_argument(shared->key + ": cannot parse \"" + shown(shared->text) + "\": unknown variable \"" +
                                   unknown + "\" (a local name must be assigned first: \"" + unknown + " = …, …\")");
   } catch (const mu::Parser::exception_type& e) {
+    for (const auto& [name, value] : shared->constants) {  // "a = …" where a is a parameter
+      const std::size_t at = find_word(shared->text, name);
+      std::size_t next = at == std::string::npos ? at : shared->text.find_first_not_of(" \t", at + name.size());
+      if (next != std::string::npos && shared->text[next] == '=' &&
+          (next + 1 == shared->text.size() || shared->text[next + 1] != '='))
+        throw std::invalid_argument(
+            shared->key + ": \"" + name.substr(0, 40) +
+            "\" is a parameter ([parameters]) and cannot be assigned; name the local otherwise");
+    }
     throw std::invalid_argument(shared->key + ": cannot parse \"" + shown(shared->text) +
                                 "\": " + e.GetMsg().substr(0, 80));
   }
@@ -136,6 +145,11 @@ double Expression::operator()(std::initializer_list<double> values) const {
 
 const std::string& Expression::text() const { return shared_->text; }
 const std::string& Expression::key() const { return shared_->key; }
+bool is_builtin_name(const std::string& name) {
+  const mu::Parser parser;
+  return parser.GetFunDef().count(name) > 0 || parser.GetConst().count(name) > 0;
+}
+
 bool Expression::mentions(const std::string& name) const { return find_word(shared_->text, name) != std::string::npos; }
 
 }  // namespace fictus

@@ -156,10 +156,7 @@ struct ExpressionMaker {
 
 /// [parameters]: named numbers for the expressions, the file's values replaced by `overrides`.
 std::map<std::string, double> read_parameters(const toml::table* table, const ParameterValues& overrides) {
-  static const std::set<std::string> taken = {"x",     "y",    "t",     "phi",  "s",    "sin",  "cos",   "tan",
-                                              "asin",  "acos", "atan",  "sinh", "cosh", "tanh", "asinh", "acosh",
-                                              "atanh", "log2", "log10", "log",  "ln",   "exp",  "sqrt",  "sign",
-                                              "rint",  "abs",  "min",   "max",  "sum",  "avg"};
+  static const std::set<std::string> variables = {"x", "y", "t", "phi", "s"};
   std::map<std::string, double> values;
   if (table)
     for (const auto& [k, node] : *table) {
@@ -170,7 +167,8 @@ std::map<std::string, double> read_parameters(const toml::table* table, const Pa
                       [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; });
       if (!identifier)
         fail(key.substr(0, 60), "a parameter name is a letter followed by letters, digits or _ (at most 40)");
-      if (taken.count(name)) fail(key, "the name is a variable or function of the expressions; choose another");
+      if (variables.count(name) || is_builtin_name(name))
+        fail(key, "the name is a variable or function of the expressions; choose another");
       const std::optional<double> v =
           node.is_integer() ? std::optional<double>(double(*node.value<int64_t>())) : node.value<double>();
       if (!v || node.is_boolean()) fail(key, "expected a number");

@@ -115,6 +115,25 @@ same_member(rows[0], solve("turned", turned), "rotate 0.7", tol=1e-7)
 rows, _ = sweep("paper", "--g-scale", "0.5,1", "--N", "128")
 same_member(rows[1], solve("paper", "--N", "128", "--condition_number", "false"), "paper g_scale 1")
 
+# 3b. A turned or moved polygon keeps its corners (points off the corners, the kink projector): angle 0
+#     and shift 0 give what the obstacle family gives at scale 1; the smooth variant stays refused.
+polygon = os.path.join(examples, "polygon.toml")
+reference = sweep("polygon_scale", polygon, "--g-scale", "1")[0][0]
+for kind in ("--rotate", "--move"):
+    row = sweep(f"polygon{kind}", polygon, kind, "0")[0][0]
+    check(row["converged"] == "1" and all(row[c] == reference[c] for c in ("contact_points", "newton_steps")) and
+          close(float(row["contact_force"]), float(reference["contact_force"]), 1e-12),
+          f"polygon {kind} 0 = --g-scale 1 ({row['contact_points']} vs {reference['contact_points']} points)")
+r = run("sweep", polygon, "--rotate", "0,0.1", "--variant", "smooth", "--out", "")
+check(r.returncode == 1 and "formulation.variant" in r.stderr and "(at" not in r.stderr,
+      f"a polygon in the smooth variant is the base problem's error, not a member's: {r.stderr.strip()}")
+
+# 3c. The file is read once: a sweep of a pipe works.
+with open(parameters) as f:
+    r = subprocess.run([exe, "sweep", "/dev/stdin", "--parameter", "height=0,0.01", "--N", "128", "--out", ""],
+                       stdin=f, capture_output=True, text=True)
+check(r.returncode == 0 and len(r.stdout.strip().splitlines()) == 4, f"sweep of a pipe: {r.stderr.strip()}")
+
 # 4. The CSV header is the documented one (docs/usage.md, the sweep's column table).
 usage = open(os.path.join(source, "docs", "usage.md")).read()
 section = usage[usage.index("## `fictus sweep`"):usage.index("## `fictus options`")]
@@ -140,6 +159,17 @@ for args, expected in [
     check(r.returncode == 1 and len(lines) == 1 and lines[0].startswith("fictus: error: ") and
           re.search(expected, lines[0]) is not None and not os.path.exists(out),
           f"sweep {' '.join(args)}: exit {r.returncode}, {lines}")
+clash = os.path.join(work, "clash.toml")
+with open(clash, "w") as f:
+    f.write(text.replace("[parameters]", "[parameters]\nseconds = 1.0").replace("0.05 * sin", "seconds * 0.05 * sin"))
+r = run("sweep", clash, "--parameter", "seconds=1,2", "--N", "128", "--out", "")
+check(r.returncode == 1 and "clash with that column" in r.stderr, f"a parameter named like a column: {r.stderr.strip()}")
+# Newton fails for a member: exit 2, the key first, the member named, the rows written.
+out = os.path.join(work, "newton")
+shutil.rmtree(out, ignore_errors=True)
+r = run("sweep", "--N", "128", "--g-scale", "1,2", "--max_newton", "2", "--out", out)
+check(r.returncode == 2 and r.stderr.startswith("fictus: error: solver.max_newton: at g_scale = 1 (2 of 2") and
+      os.path.exists(os.path.join(out, "sweep.csv")), f"Newton failing in a sweep: {r.stderr.strip()[:200]}")
 r = run("sweep", "--N", "64", "--parameter", "a=1", "--out", "")
 check(r.returncode == 1 and "needs a problem file" in r.stderr, "--parameter without a file is refused")
 

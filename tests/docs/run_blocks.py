@@ -40,7 +40,7 @@ def blocks(path):
     found, problems = [], []
     k = 0
     while k < len(lines):
-        fence = re.match(r"^```(\S*)\s*$", lines[k])
+        fence = re.match(r"^```(\S*)(.*)$", lines[k])  # the tag, then any info string
         if fence:
             tag, start = fence.group(1), k + 1
             end = start
@@ -149,11 +149,14 @@ def main():
                     continue
                 command = ([args.python, "-"] if tag == "python" else ["bash", "-e", "-o", "pipefail", "-s"])
                 start = time.time()
-                if tag == "cpp":
-                    r = run_cpp(text, work, scratch, build, env, counts["ran"])
-                else:
-                    r = subprocess.run(command, input=text, cwd=work, env=env, capture_output=True, text=True,
-                                       timeout=600)
+                try:
+                    if tag == "cpp":
+                        r = run_cpp(text, work, scratch, build, env, counts["ran"])
+                    else:
+                        r = subprocess.run(command, input=text, cwd=work, env=env, capture_output=True, text=True,
+                                           timeout=600)
+                except subprocess.TimeoutExpired:
+                    r = subprocess.CompletedProcess(command, 124, "", "still running after 600 s")
                 seconds = time.time() - start
                 counts["ran"] += 1
                 if r.returncode != 0:

@@ -48,7 +48,7 @@ record parse_flag_then_file --problem "$ex/circle.toml" -- solve --N 128 --varia
 # Found by the fuzzer under UBSan: a semi-axis of 1.8e308 made the curve's extent overflow (NaN cast)
 record huge_semi_axis --problem "$here/seeds/huge_semi_axis.toml" -- solve --N 9 --max_memory 1
 
-# Sweeps (found by the fuzzer when sweeps joined it): a family whose Newton fails names the key;
-# an absurd rotation is refused
-record sweep_newton_fails --problem "$here/seeds/sweep_newton_fails.toml" -- sweep --rotate 0,1.0
+# Sweeps (found by the fuzzer when sweeps joined it): a turned polygon (its Newton failed while the
+# turned curve lost its corners; solves now); an absurd rotation is refused
+record sweep_rotated_polygon --problem "$here/seeds/sweep_rotated_polygon.toml" -- sweep --rotate 0,1.0
 record sweep_rotate_1e300 --problem "$here/seeds/sweep_rotate_1e300.toml" -- sweep --rotate 1e+300 --normal_shift 1

@@ -80,6 +80,11 @@ TEST(ProblemFile, ParametersEnterTheExpressionsAndCanBeReplaced) {
       "[data]\nf = \"1\"\ng = \"0\"\n";
   EXPECT_EQ(message("[parameters]\nx = 1\n" + data).rfind("parameters.x: the name is a variable", 0), 0u);
   EXPECT_EQ(message("[parameters]\nsin = 1\n" + data).rfind("parameters.sin:", 0), 0u);
+  EXPECT_EQ(message("[parameters]\natan2 = 1\n" + data).rfind("parameters.atan2: the name is a", 0), 0u);
+  EXPECT_EQ(message("[parameters]\n_pi = 1\n" + data).rfind("parameters._pi: a parameter name", 0), 0u);
+  EXPECT_EQ(message("[parameters]\na = 1\n[geometry]\nshape = \"circle\"\ncenter = [0.5, 0.5]\nradius = 0.3\n"
+                    "[data]\nf = \"a = x, a\"\ng = \"0\"\n"),
+            "data.f: \"a\" is a parameter ([parameters]) and cannot be assigned; name the local otherwise");
   EXPECT_EQ(message("[parameters]\na = \"1\"\n" + data), "parameters.a: expected a number");
   EXPECT_EQ(message("[parameters]\na = nan\n" + data).rfind("parameters.a: must be finite", 0), 0u);
   EXPECT_EQ(message("[parameters]\n\"a b\" = 1\n" + data).rfind("parameters.a b: a parameter name", 0), 0u);

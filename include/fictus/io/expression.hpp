@@ -35,4 +35,7 @@ class Expression {
   std::shared_ptr<const Shared> shared_;
 };
 
+/// A function or constant of the expression language (sin, atan2, _pi, …): not a name for a parameter.
+bool is_builtin_name(const std::string& name);
+
 }  // namespace fictus
