@@ -1,0 +1,35 @@
+#pragma once
+// 3-D: integrals of the trilinear (Q1) basis over the patches of a triangulated surface, the entries of
+// B_Γ when λ is piecewise constant on patches. Each triangle is clipped against the voxel planes into
+// convex pieces inside one voxel; on a piece the trilinear basis is a cubic polynomial of the plane, so
+// a degree-4 triangle rule on a fan of the piece integrates it exactly (to round-off).
+#include <cstddef>
+#include <vector>
+
+#include "fictus/grid.hpp"
+#include "fictus/point.hpp"
+
+namespace fictus {
+
+struct Triangle3 {
+  Point3 a, b, c;
+};
+
+/// ∫_{patch} φ_node dS for one patch and one grid node (all nodes 0 ≤ i_d ≤ n_d: the caller drops those
+/// that carry no unknown).
+struct PatchWeight {
+  int patch;
+  Grid3::Index node;
+  double value;
+};
+
+/// The nonzero ∫_{patch p} φ_k dS, sorted by patch, then by node in the grid's storage order (i fastest). `patch_of[t]`
+/// is the patch of triangle t, in 0 … n_patches − 1. Throws std::invalid_argument for a triangle that is not finite or
+/// leaves the box.
+std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Triangle3>& triangles,
+                                         const std::vector<int>& patch_of, int n_patches);
+
+/// The area of a triangle.
+double area(const Triangle3& t);
+
+}  // namespace fictus
