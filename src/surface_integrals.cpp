@@ -1,6 +1,7 @@
 #include "fictus/surface_integrals.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -133,6 +134,99 @@ std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Tr
   for (const auto& [key, value] : sums)
     if (value != 0.0) out.push_back({std::get<0>(key), {std::get<3>(key), std::get<2>(key), std::get<1>(key)}, value});
   return out;
+}
+
+}  // namespace fictus
+
+namespace fictus {
+
+namespace {
+
+/// The 12 vertices and 20 faces of the icosahedron on the unit sphere.
+void icosahedron(std::vector<Point3>& vertices, std::vector<std::array<int, 3>>& faces) {
+  const double t = (1 + std::sqrt(5.0)) / 2;
+  vertices = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+              {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  for (Point3& v : vertices) v = (1.0 / norm(v)) * v;
+  faces = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+           {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+           {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+}
+
+}  // namespace
+
+PatchedSurface ellipsoid_patches(Point3 center, Point3 semi_axes, int m, double edge) {
+  for (int d = 0; d < 3; ++d)
+    if (!(semi_axes[d] > 0) || !std::isfinite(semi_axes[d]))
+      throw std::invalid_argument("geometry.semi_axes: must be positive and finite");
+  if (!(edge > 0)) throw std::invalid_argument("ellipsoid_patches: the edge length must be positive");
+  std::vector<Point3> vertices;
+  std::vector<std::array<int, 3>> faces;
+  icosahedron(vertices, faces);
+  const double largest = std::max({semi_axes.x, semi_axes.y, semi_axes.z});
+  const int n = std::max(1, int(std::ceil(1.1 * largest / edge)));  // icosahedron edge 1.05 on the unit sphere
+  const auto on_ellipsoid = [&](Point3 p) {
+    p = (1.0 / norm(p)) * p;
+    return Point3{center.x + semi_axes.x * p.x, center.y + semi_axes.y * p.y, center.z + semi_axes.z * p.z};
+  };
+  PatchedSurface s;
+  for (const auto& f : faces) {
+    const Point3 &a = vertices[f[0]], &b = vertices[f[1]], &c = vertices[f[2]];
+    auto at = [&](int i, int j) { return on_ellipsoid(a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a)); };
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; i + j < n; ++j) {
+        s.triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
+        if (i + j + 1 < n) s.triangles.push_back({at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+      }
+  }
+  const std::size_t count = s.triangles.size();
+  if (m < 1 || std::size_t(m) > count / 4)
+    throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) + " needs 1 <= m <= " +
+                                std::to_string(count / 4) + " for this triangulation (a smaller edge allows more)");
+  std::vector<Point3> centroid(count);
+  std::vector<double> weight(count);
+  for (std::size_t t = 0; t < count; ++t) {
+    centroid[t] = (1.0 / 3) * (s.triangles[t].a + s.triangles[t].b + s.triangles[t].c);
+    weight[t] = area(s.triangles[t]);
+  }
+  // Lloyd's iteration from m triangles spread over the list (the faces of the icosahedron in turn).
+  std::vector<Point3> seeds(m);
+  for (int p = 0; p < m; ++p) seeds[p] = centroid[std::size_t(p) * count / std::size_t(m)];
+  s.patch_of.assign(count, 0);
+  for (int iteration = 0; iteration < 30; ++iteration) {
+    for (std::size_t t = 0; t < count; ++t) {
+      double best = 1e300;
+      for (int p = 0; p < m; ++p) {
+        const Point3 d = centroid[t] - seeds[p];
+        const double distance = dot(d, d);
+        if (distance < best) best = distance, s.patch_of[t] = p;
+      }
+    }
+    std::vector<Point3> sum(m);
+    std::vector<double> total(m, 0.0);
+    for (std::size_t t = 0; t < count; ++t) {
+      sum[s.patch_of[t]] = sum[s.patch_of[t]] + weight[t] * centroid[t];
+      total[s.patch_of[t]] += weight[t];
+    }
+    for (int p = 0; p < m; ++p)
+      if (total[p] > 0) seeds[p] = (1.0 / total[p]) * sum[p];
+  }
+  s.m = m;
+  s.point.resize(m);
+  s.normal.resize(m);
+  s.area.assign(m, 0.0);
+  for (std::size_t t = 0; t < count; ++t) s.area[s.patch_of[t]] += weight[t];
+  for (int p = 0; p < m; ++p) {
+    if (s.area[p] == 0.0) throw std::runtime_error("ellipsoid_patches: an empty patch (use a smaller edge)");
+    const Point3 q = on_ellipsoid(Point3{(seeds[p].x - center.x) / semi_axes.x, (seeds[p].y - center.y) / semi_axes.y,
+                                         (seeds[p].z - center.z) / semi_axes.z});
+    const Point3 gradient{(q.x - center.x) / (semi_axes.x * semi_axes.x),
+                          (q.y - center.y) / (semi_axes.y * semi_axes.y),
+                          (q.z - center.z) / (semi_axes.z * semi_axes.z)};
+    s.point[p] = q;
+    s.normal[p] = (1.0 / norm(gradient)) * gradient;
+  }
+  return s;
 }
 
 }  // namespace fictus

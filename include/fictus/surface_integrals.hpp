@@ -33,3 +33,23 @@ std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Tr
 double area(const Triangle3& t);
 
 }  // namespace fictus
+
+namespace fictus {
+
+/// A closed triangulated surface split into m patches (γ in a 3-D box): the triangles, the patch of
+/// each, and per patch a collocation point on the surface, its outward unit normal and its area.
+struct PatchedSurface {
+  std::vector<Triangle3> triangles;
+  std::vector<int> patch_of;
+  int m = 0;
+  std::vector<Point3> point, normal;
+  std::vector<double> area;
+};
+
+/// An axis-aligned ellipsoid triangulated by a subdivided icosahedron mapped onto it (triangle edges
+/// at most about `edge`), split into m patches of nearly equal area by Lloyd's iteration (k-means of the
+/// triangle centroids, weighted by area). A patch's point is its area-weighted centroid moved onto the
+/// ellipsoid along the ray from the center.
+PatchedSurface ellipsoid_patches(Point3 center, Point3 semi_axes, int m, double edge);
+
+}  // namespace fictus

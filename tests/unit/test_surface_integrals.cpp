@@ -130,3 +130,40 @@ TEST(PatchIntegrals, PatchesSumTheirTrianglesAndStayLocal) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(EllipsoidPatches, CoverTheSurfaceWithNearlyEqualPatchesAndPointsOnIt) {
+  const double pi = 3.14159265358979323846;
+  // A sphere: area 4πr² to the triangulation's O(edge²); an ellipsoid: points on it, normals outward.
+  const fictus::PatchedSurface sphere = fictus::ellipsoid_patches({0.5, 0.5, 0.5}, {0.3, 0.3, 0.3}, 100, 0.01);
+  double total = 0;
+  for (double a : sphere.area) total += a;
+  EXPECT_NEAR(total, 4 * pi * 0.09, 2e-3 * 4 * pi * 0.09);
+  const double mean = total / sphere.m;
+  for (double a : sphere.area) {
+    EXPECT_GT(a, 0.7 * mean);
+    EXPECT_LT(a, 1.3 * mean);
+  }
+  const fictus::PatchedSurface e = fictus::ellipsoid_patches({0.5, 0.4, 0.6}, {0.3, 0.2, 0.15}, 60, 0.01);
+  ASSERT_EQ(int(e.point.size()), 60);
+  for (int p = 0; p < e.m; ++p) {
+    const Point3 q = e.point[p], n = e.normal[p];
+    const double level =
+        std::pow((q.x - 0.5) / 0.3, 2) + std::pow((q.y - 0.4) / 0.2, 2) + std::pow((q.z - 0.6) / 0.15, 2);
+    EXPECT_NEAR(level, 1.0, 1e-13);
+    EXPECT_NEAR(fictus::norm(n), 1.0, 1e-14);
+    EXPECT_GT(fictus::dot(n, q - Point3{0.5, 0.4, 0.6}), 0);  // outward
+  }
+  for (int p : e.patch_of) EXPECT_TRUE(p >= 0 && p < e.m);
+  // The patch integrals of the trilinear basis sum to the patch areas.
+  const fictus::Grid3 grid(fictus::Box<3>{{0, 0, 0}, {1, 1, 1}}, 32, fictus::Boundary::dirichlet);
+  const auto weights = fictus::patch_integrals(grid, e.triangles, e.patch_of, e.m);
+  std::vector<double> sums(e.m, 0.0);
+  for (const auto& w : weights) sums[w.patch] += w.value;
+  for (int p = 0; p < e.m; ++p) EXPECT_NEAR(sums[p], e.area[p], 1e-14);
+  EXPECT_THROW(fictus::ellipsoid_patches({0.5, 0.5, 0.5}, {0.3, -1, 0.3}, 10, 0.01), std::invalid_argument);
+  EXPECT_THROW(fictus::ellipsoid_patches({0.5, 0.5, 0.5}, {0.3, 0.3, 0.3}, 100000, 0.05), std::invalid_argument);
+}
+
+}  // namespace
