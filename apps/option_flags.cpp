@@ -51,10 +51,10 @@ ProblemSpec problem_from(const std::string& path, const OptionFlags& flags, cons
 }
 
 ProblemSpec problem_from_text(const std::string& text, const std::string& path, const OptionFlags& flags,
-                              const ParameterValues& parameters) {
+                              const ParameterValues& parameters, std::shared_ptr<const Curve> curve) {
   ProblemSpec spec;
   if (!path.empty()) {
-    spec = parse_problem_text(text, path, parameters);
+    spec = parse_problem_text(text, path, parameters, std::move(curve));
     const std::string name = path.substr(path.find_last_of('/') + 1);
     spec.problem.name = name.substr(0, name.rfind(".toml"));
   } else {

@@ -40,7 +40,8 @@ class OptionFlags {
 /// unless the flags give them. `input` is set to what results.json echoes under "problem".
 ProblemSpec problem_from(const std::string& path, const OptionFlags& flags, const ParameterValues& parameters = {});
 /// The same from the file's text, read once (a sweep's members: the file may change or be a pipe).
+/// `curve` as in parse_problem_text.
 ProblemSpec problem_from_text(const std::string& text, const std::string& path, const OptionFlags& flags,
-                              const ParameterValues& parameters = {});
+                              const ParameterValues& parameters = {}, std::shared_ptr<const Curve> curve = nullptr);
 
 }  // namespace fictus::cli

@@ -120,8 +120,11 @@ Problem member(const Family& family, const ProblemSpec& base, const SweepArgumen
     problem.gamma = std::make_shared<TransformedCurve>(base.problem.gamma, 0.0, Point2{v, 0});
     if (base.g_about) problem.g_along_curve = base.g_about(problem.gamma->center());  // phi about the moved center
   } else {
-    problem = problem_from_text(text, args.problem_path, flags, {{family.name, v}}).problem;
-    if (!family.moves_curve) problem.gamma = base.problem.gamma;  // the same rows and Schur blocks
+    // The base curve unless the parameter is in the geometry: the same rows and Schur blocks, and
+    // the geometry is not read and checked again.
+    problem = problem_from_text(text, args.problem_path, flags, {{family.name, v}},
+                                family.moves_curve ? nullptr : base.problem.gamma)
+                  .problem;
   }
   if (family.kind != "parameter") problem.exact = nullptr;  // the exact solution is the base problem's
   return problem;

@@ -250,7 +250,8 @@ const std::vector<std::string>& output_file_names() {
   return names;
 }
 
-ProblemSpec parse_problem_text(const std::string& text, const std::string& source, const ParameterValues& parameters) {
+ProblemSpec parse_problem_text(const std::string& text, const std::string& source, const ParameterValues& parameters,
+                               std::shared_ptr<const Curve> curve) {
   toml::table root;
   try {
     root = toml::parse(text, source);
@@ -278,8 +279,12 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
   const toml::table* geometry_table = subtable(root, "geometry");
   if (!geometry_table) fail("geometry", "missing section [geometry]");
   TableReader geometry(geometry_table, "geometry");
-  p.gamma = read_geometry(geometry, expression, spec.warnings);
-  geometry.finish();
+  if (curve) {
+    p.gamma = std::move(curve);
+  } else {
+    p.gamma = read_geometry(geometry, expression, spec.warnings);
+    geometry.finish();
+  }
 
   TableReader formulation(subtable(root, "formulation"), "formulation");
   formulation.read_options(p, o);

@@ -35,8 +35,10 @@ using ParameterValues = std::map<std::string, double>;
 /// key", …) on any error: unknown keys, wrong types, NaN/Inf, unparsable expressions.
 /// `parameters` replace values of the file's [parameters] (each must be one of them).
 ProblemSpec read_problem_file(const std::string& path, const ParameterValues& parameters = {});
+/// `curve`: use it for γ instead of reading [geometry] again (a sweep whose parameter is not in the
+/// geometry: the table was checked when the file was first read).
 ProblemSpec parse_problem_text(const std::string& text, const std::string& source = "problem",
-                               const ParameterValues& parameters = {});
+                               const ParameterValues& parameters = {}, std::shared_ptr<const Curve> curve = nullptr);
 
 /// The file as text (at most 64 MiB; a folder or an unreadable file is an error naming the path).
 std::string read_problem_text(const std::string& path);
