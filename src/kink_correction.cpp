@@ -217,7 +217,7 @@ SparseRows merge_rows(const std::vector<std::vector<RowEntry>>& by_cell, int m, 
       for (; e < entries.size() && entries[e].arc == arc && entries[e].i == first.i && entries[e].j == first.j; ++e)
         value += entries[e].value;
       if (grid.has_unknown(first.i, first.j))
-        rows.entries.push_back({grid.index(first.i, first.j), first.i, first.j, value});
+        rows.entries.push_back({grid.index(first.i, first.j), first.i, first.j, 0, value});
     }
     rows.row_begin.push_back(rows.entries.size());
   }

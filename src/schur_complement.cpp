@@ -10,21 +10,22 @@
 
 namespace fictus {
 
-ImplicitSchur::ImplicitSchur(const FastSolver<2>& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
-                             const SparseRows& loads, const GmresOptions& options, DirectTerms direct)
-    : solver_(solver),
+ImplicitSchur::ImplicitSchur(std::function<void(GridVector&)> solve_in_place, std::size_t n_unknowns,
+                             const SparseRows& B_gamma, const SparseRows& C_gamma, const SparseRows& loads,
+                             const GmresOptions& options, DirectTerms direct)
+    : solve_in_place_(std::move(solve_in_place)),
       B_gamma_(B_gamma),
       C_gamma_(C_gamma),
       B_Gamma_(loads),
       options_(options),
       direct_(std::move(direct)),
-      work_(solver.grid().n_unknowns()) {}
+      work_(n_unknowns) {}
 
 void ImplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const {
   lambda_.assign(lambda.data(), lambda.data() + lambda.size());
   std::fill(work_.begin(), work_.end(), 0.0);
   B_Gamma_.add_transposed(lambda_, work_);
-  solver_.solve_in_place(work_);
+  solve_in_place_(work_);
   ++fast_solves_;
   B_gamma_.multiply(work_, rows_);
   sb = Eigen::Map<const Eigen::VectorXd>(rows_.data(), Eigen::Index(rows_.size()));
@@ -60,22 +61,36 @@ LinearSolveReport ImplicitSchur::solve(const ActiveSet& active, const Eigen::Vec
   return {g.iterations, g.relative_residual, g.converged};
 }
 
-Eigen::MatrixXd green_block(const GreenTable<2>& green, const SparseRows& R, const SparseRows& Q,
+namespace {
+
+/// G between the nodes of two entries.
+double green_between(const GreenTable<2>& green, const SparseRows::Entry& a, const SparseRows::Entry& b) {
+  return green.G(a.i, a.j, b.i, b.j);
+}
+double green_between(const GreenTable<3>& green, const SparseRows::Entry& a, const SparseRows::Entry& b) {
+  return green.G({a.i, a.j, a.k}, b.i, b.j, b.k);
+}
+
+}  // namespace
+
+template <int dim>
+Eigen::MatrixXd green_block(const GreenTable<dim>& green, const SparseRows& R, const SparseRows& Q,
                             const Execution& execution) {
   return green_blocks(green, {&R}, Q, execution).front();
 }
 
-std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>& green, const std::vector<const SparseRows*>& row_sets,
+template <int dim>
+std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
                                           const SparseRows& Q, const Execution& execution) {
   // The distinct nodes of all row sets, and every entry as (node slot, weight).
   std::vector<std::size_t> slot_of;  // by entry, over all row sets in order
-  std::vector<std::pair<int, int>> nodes;
+  std::vector<SparseRows::Entry> nodes;
   {
     std::unordered_map<std::size_t, std::size_t> slots;
     for (const SparseRows* R : row_sets)
       for (const auto& e : R->entries) {
         const auto [it, added] = slots.emplace(e.index, nodes.size());
-        if (added) nodes.emplace_back(e.i, e.j);
+        if (added) nodes.push_back(e);
         slot_of.push_back(it->second);
       }
   }
@@ -93,7 +108,7 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>& green, const std:
         double sum = 0.0;
         for (std::size_t b = Q.row_begin[col]; b < Q.row_begin[col + 1]; ++b) {
           const auto& qb = Q.entries[b];
-          sum += green.G(nodes[u].first, nodes[u].second, qb.i, qb.j) * qb.value;
+          sum += green_between(green, nodes[u], qb) * qb.value;
         }
         column[u] = sum;
       }
@@ -113,7 +128,8 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>& green, const std:
   return blocks;
 }
 
-ExplicitSchur::ExplicitSchur(const GreenTable<2>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
+template <int dim>
+ExplicitSchur::ExplicitSchur(const GreenTable<dim>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
                              const SparseRows& loads, const Execution& execution, const DirectTerms& direct) {
   std::vector<Eigen::MatrixXd> blocks = green_blocks(green, {&B_gamma, &C_gamma}, loads, execution);
   S_B_ = std::move(blocks[0]);
@@ -123,6 +139,13 @@ ExplicitSchur::ExplicitSchur(const GreenTable<2>& green, const SparseRows& B_gam
     S_C_ += Eigen::MatrixXd(direct.normal_derivative);
   }
 }
+
+template ExplicitSchur::ExplicitSchur(const GreenTable<2>&, const SparseRows&, const SparseRows&, const SparseRows&,
+                                      const Execution&, const DirectTerms&);
+template ExplicitSchur::ExplicitSchur(const GreenTable<3>&, const SparseRows&, const SparseRows&, const SparseRows&,
+                                      const Execution&, const DirectTerms&);
+template Eigen::MatrixXd green_block(const GreenTable<2>&, const SparseRows&, const SparseRows&, const Execution&);
+template Eigen::MatrixXd green_block(const GreenTable<3>&, const SparseRows&, const SparseRows&, const Execution&);
 
 void ExplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const {
   sb = S_B_ * lambda;

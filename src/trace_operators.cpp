@@ -15,32 +15,47 @@ namespace fictus {
 
 namespace {
 
-/// Collects the entries of one row, merging repeated nodes.
+/// Collects the entries of one row, merging repeated nodes (2-D or 3-D grids).
+template <int dim>
 class RowBuilder {
  public:
-  RowBuilder(const Grid2& grid, SparseRows& rows) : grid_(grid), rows_(rows) {}
-  void add(int i, int j, double value) {
-    if (!grid_.has_unknown(i, j)) return;
-    const std::size_t index = grid_.index(i, j);  // periodic boxes: (0, j) and (nx, j) are one node
+  RowBuilder(const Grid<dim>& grid, SparseRows& rows) : grid_(grid), rows_(rows) {}
+  void add(int i, int j, double value) requires(dim == 2) { add(typename Grid<dim>::Index{i, j}, value); }
+  void add(const typename Grid<dim>::Index& node, double value) {
+    if (!grid_.has_unknown(node)) return;
+    const std::size_t index = grid_.index(node);  // periodic boxes: (0, j) and (nx, j) are one node
     for (std::size_t k = rows_.row_begin.back(); k < rows_.entries.size(); ++k)
       if (rows_.entries[k].index == index) {
         rows_.entries[k].value += value;
         return;
       }
-    rows_.entries.push_back({index, i, j, value});
+    rows_.entries.push_back({index, node[0], node[1], dim == 3 ? node[dim - 1] : 0, value});
   }
-  /// Bilinear weights of point p in cell (ix, iy), scaled by w.
-  void add_bilinear(int ix, int iy, Point2 p, double w) {
-    const Q1Element<2> element({(p.x - grid_.x(ix)) / grid_.h(), (p.y - grid_.y(iy)) / grid_.h()}, grid_.h());
-    for (int k = 0; k < Q1Element<2>::n_nodes; ++k)
-      add(ix + Q1Element<2>::offset(k, 0), iy + Q1Element<2>::offset(k, 1), w * element.value[k]);
+  /// Multilinear weights of point p in cell `cell`, scaled by w.
+  void add_multilinear(const typename Grid<dim>::Index& cell, const Point<dim>& p, double w) {
+    Point<dim> xi;
+    for (int d = 0; d < dim; ++d) xi[d] = (p[d] - grid_.coordinate(d, cell[d])) / grid_.h();
+    const Q1Element<dim> element(xi, grid_.h());
+    for (int k = 0; k < Q1Element<dim>::n_nodes; ++k) {
+      typename Grid<dim>::Index node = cell;
+      for (int d = 0; d < dim; ++d) node[d] += Q1Element<dim>::offset(k, d);
+      add(node, w * element.value[k]);
+    }
   }
+  void add_bilinear(int ix, int iy, Point2 p, double w) requires(dim == 2) { add_multilinear({ix, iy}, p, w); }
   void end_row() { rows_.row_begin.push_back(rows_.entries.size()); }
 
  private:
-  const Grid2& grid_;
+  const Grid<dim>& grid_;
   SparseRows& rows_;
 };
+
+template <int dim>
+typename Grid<dim>::Index cell_of(const Grid<dim>& grid, const Point<dim>& p) {
+  typename Grid<dim>::Index cell;
+  for (int d = 0; d < dim; ++d) cell[d] = grid.cell(d, p[d]);
+  return cell;
+}
 
 }  // namespace
 
@@ -217,6 +232,83 @@ SparseRows arc_integral_rows(const CurveGridIntersection& geometry, const std::v
     }
     builder.end_row();
   }
+  return rows;
+}
+
+}  // namespace fictus
+
+namespace fictus {
+
+SparseRows point_value_rows(const Grid3& grid, const std::vector<Point3>& points) {
+  SparseRows rows;
+  RowBuilder builder(grid, rows);
+  for (const Point3& p : points) {
+    builder.add_multilinear(cell_of(grid, p), p, 1.0);
+    builder.end_row();
+  }
+  return rows;
+}
+
+SparseRows normal_derivative_rows(const Grid3& grid, const std::vector<Point3>& points,
+                                  const std::vector<Point3>& normals, double shift) {
+  if (points.size() != normals.size()) throw std::invalid_argument("normal_derivative_rows: size mismatch");
+  SparseRows rows;
+  RowBuilder builder(grid, rows);
+  for (std::size_t r = 0; r < points.size(); ++r) {
+    const Point3 n = normals[r], p = points[r] - shift * n;
+    const Grid3::Index cell = cell_of(grid, p);
+    Point3 xi;
+    for (int d = 0; d < 3; ++d) xi[d] = (p[d] - grid.coordinate(d, cell[d])) / grid.h();
+    const Q1Element<3> element(xi, grid.h());
+    for (int k = 0; k < Q1Element<3>::n_nodes; ++k) {
+      Grid3::Index node = cell;
+      for (int d = 0; d < 3; ++d) node[d] += Q1Element<3>::offset(k, d);
+      builder.add(node, dot(n, element.gradient(k)));
+    }
+    builder.end_row();
+  }
+  return rows;
+}
+
+SparseRows normal_derivative_rows_centered(const Grid3& grid, const std::vector<Point3>& points,
+                                           const std::vector<Point3>& normals) {
+  if (points.size() != normals.size()) throw std::invalid_argument("normal_derivative_rows: size mismatch");
+  SparseRows rows;
+  RowBuilder builder(grid, rows);
+  const double h = grid.h();
+  for (std::size_t r = 0; r < points.size(); ++r) {
+    const Point3 p = points[r], n = normals[r];
+    const Grid3::Index cell = cell_of(grid, p);
+    std::array<LagrangeBasis, 3> basis;  // the 3 nodes around the nearest node, per axis
+    std::array<int, 3> first;
+    for (int d = 0; d < 3; ++d) {
+      const double xi = (p[d] - grid.coordinate(d, cell[d])) / h;
+      first[d] = xi < 0.5 ? -1 : 0;
+      basis[d] = lagrange_basis(first[d], 2, xi);
+    }
+    for (int c = 0; c <= 2; ++c)
+      for (int b = 0; b <= 2; ++b)
+        for (int a = 0; a <= 2; ++a) {
+          const auto &bx = basis[0], &by = basis[1], &bz = basis[2];
+          const double weight = n.x * bx.derivative[a] * by.value[b] * bz.value[c] +
+                                n.y * bx.value[a] * by.derivative[b] * bz.value[c] +
+                                n.z * bx.value[a] * by.value[b] * bz.derivative[c];
+          builder.add({cell[0] + first[0] + a, cell[1] + first[1] + b, cell[2] + first[2] + c}, weight / h);
+        }
+    builder.end_row();
+  }
+  return rows;
+}
+
+SparseRows patch_integral_rows(const Grid3& grid, const std::vector<PatchWeight>& weights, int n_patches) {
+  SparseRows rows;
+  RowBuilder builder(grid, rows);
+  std::size_t k = 0;
+  for (int patch = 0; patch < n_patches; ++patch) {
+    for (; k < weights.size() && weights[k].patch == patch; ++k) builder.add(weights[k].node, weights[k].value);
+    builder.end_row();
+  }
+  if (k != weights.size()) throw std::invalid_argument("patch_integral_rows: weights not sorted by patch");
   return rows;
 }
 

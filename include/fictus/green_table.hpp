@@ -60,6 +60,16 @@ class GreenTable {
     return at2(sm, tm) - at2(sp, tm) - at2(sm, tp) + at2(sp, tp);
   }
   double T(int s, int t) const requires(dim == 2) { return T(Index{s, t}); }
+  /// The 3-D form, written out: the 3-D Schur assembly's inner loop.
+  double G(const Index& a, int k0, int k1, int k2) const requires(dim == 3) {
+    if (periodic_)
+      return at3(near_fold(a[0] - k0, period_[0]), near_fold(a[1] - k1, period_[1]), near_fold(a[2] - k2, period_[2]));
+    const int xm = near_fold(a[0] - k0, period_[0]), xp = near_fold(a[0] + k0, period_[0]);
+    const int ym = near_fold(a[1] - k1, period_[1]), yp = near_fold(a[1] + k1, period_[1]);
+    const int zm = near_fold(a[2] - k2, period_[2]), zp = near_fold(a[2] + k2, period_[2]);
+    return (at3(xm, ym, zm) - at3(xp, ym, zm) - at3(xm, yp, zm) + at3(xp, yp, zm)) -
+           (at3(xm, ym, zp) - at3(xp, ym, zp) - at3(xm, yp, zp) + at3(xp, yp, zp));
+  }
   std::size_t memory_bytes() const { return table_.size() * sizeof(double); }
 
  private:
@@ -81,6 +91,9 @@ class GreenTable {
     return table_[k];
   }
   double at2(int s, int t) const { return table_[std::size_t(t) * size_[0] + std::size_t(s)]; }
+  double at3(int s, int t, int r) const requires(dim == 3) {
+    return table_[(std::size_t(r) * size_[1] + std::size_t(t)) * size_[0] + std::size_t(s)];
+  }
   Grid<dim> grid_;
   double c_;
   bool periodic_;

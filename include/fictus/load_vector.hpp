@@ -21,4 +21,9 @@ GridVector assemble_load(const Grid2& grid, const ScalarField& f, int q = 2, con
 GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q = 2,
                          const Execution& execution = Execution{});
 
+/// 3-D: f_k = ∫_Ω f φ_k with the trilinear basis, q×q×q Gauss points per voxel (threaded over voxel
+/// layers; f must be thread-safe).
+using ScalarField3 = std::function<double(double x, double y, double z)>;
+GridVector assemble_load(const Grid3& grid, const ScalarField3& f, int q = 2, const Execution& execution = Execution{});
+
 }  // namespace fictus

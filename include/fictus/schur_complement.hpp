@@ -9,6 +9,7 @@
 //   ImplicitSchur  the paper's: never formed, one fast A⁻¹ per application, GMRES per step;
 //   ExplicitSchur  ours: S_B and S_C assembled from the discrete Green's function, dense LU.
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -64,9 +65,16 @@ class SchurComplement {
 
 class ImplicitSchur final : public SchurComplement {
  public:
-  /// `loads`: the rows whose transposes carry λ into the grid (B_Γ, or B_Γ + R).
-  ImplicitSchur(const FastSolver<2>& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
-                const SparseRows& loads, const GmresOptions& options, DirectTerms direct = {});
+  /// `loads`: the rows whose transposes carry λ into the grid (B_Γ, or B_Γ + R). Any dimension.
+  template <int dim>
+  ImplicitSchur(const FastSolver<dim>& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
+                const SparseRows& loads, const GmresOptions& options, DirectTerms direct = {})
+      : ImplicitSchur([&solver](GridVector& r) { solver.solve_in_place(r); }, solver.grid().n_unknowns(), B_gamma,
+                      C_gamma, loads, options, std::move(direct)) {}
+  /// With A⁻¹ as `solve_in_place` on vectors of `n_unknowns`.
+  ImplicitSchur(std::function<void(GridVector&)> solve_in_place, std::size_t n_unknowns, const SparseRows& B_gamma,
+                const SparseRows& C_gamma, const SparseRows& loads, const GmresOptions& options,
+                DirectTerms direct = {});
   int size() const override { return B_Gamma_.n_rows(); }
   void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override;
   LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
@@ -75,7 +83,7 @@ class ImplicitSchur final : public SchurComplement {
   std::optional<double> condition_number(const ActiveSet&) const override { return std::nullopt; }
 
  private:
-  const FastSolver<2>& solver_;
+  std::function<void(GridVector&)> solve_in_place_;
   const SparseRows &B_gamma_, &C_gamma_, &B_Gamma_;
   GmresOptions options_;
   DirectTerms direct_;
@@ -87,7 +95,8 @@ class ImplicitSchur final : public SchurComplement {
 class ExplicitSchur final : public SchurComplement {
  public:
   /// Assembles S_B and S_C from the Green's table (threaded over columns); `loads` as above.
-  ExplicitSchur(const GreenTable<2>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
+  template <int dim>
+  ExplicitSchur(const GreenTable<dim>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
                 const SparseRows& loads, const Execution& execution = Execution{}, const DirectTerms& direct = {});
   /// From given blocks (tests).
   ExplicitSchur(Eigen::MatrixXd S_B, Eigen::MatrixXd S_C) : S_B_(std::move(S_B)), S_C_(std::move(S_C)) {}
@@ -105,12 +114,14 @@ class ExplicitSchur final : public SchurComplement {
   Eigen::MatrixXd S_B_, S_C_;
 };
 
-/// Dense (rows × cols) block R G Qᵀ from sparse rows and the Green's table.
-Eigen::MatrixXd green_block(const GreenTable<2>& green, const SparseRows& R, const SparseRows& Q,
+/// Dense (rows × cols) block R G Qᵀ from sparse rows and the Green's table (dim = 2 or 3).
+template <int dim>
+Eigen::MatrixXd green_block(const GreenTable<dim>& green, const SparseRows& R, const SparseRows& Q,
                             const Execution& execution = Execution{});
 /// The blocks R_k G Qᵀ of several row sets at once: (G Qᵀ) is evaluated once per distinct node of
 /// the R_k (B_γ's four nodes of x_i lie in C_γ's 3×3), so the cost is (distinct nodes)·nnz(Q) lookups.
-std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>& green, const std::vector<const SparseRows*>& row_sets,
+template <int dim>
+std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
                                           const SparseRows& Q, const Execution& execution = Execution{});
 
 }  // namespace fictus

@@ -10,13 +10,14 @@
 
 #include "fictus/curve_grid_intersection.hpp"
 #include "fictus/grid.hpp"
+#include "fictus/surface_integrals.hpp"
 
 namespace fictus {
 
 struct SparseRows {
   struct Entry {
     std::size_t index;  // Grid::index of the node
-    int i, j;           // the node
+    int i, j, k;        // the node (k = 0 in 2-D)
     double value;
   };
   std::vector<std::size_t> row_begin{0};  // entries of row r: [row_begin[r], row_begin[r+1])
@@ -54,5 +55,17 @@ SparseRows one_sided_rows(const CurveGridIntersection& gamma, const std::vector<
 /// piece of the arc inside one cell).
 SparseRows arc_integral_rows(const CurveGridIntersection& geometry, const std::vector<double>& arc_begin,
                              const std::vector<double>& arc_end, int q = 6);
+
+// 3-D, a closed surface γ in a box (the same rows on the trilinear grid):
+//   B_γ: trilinear interpolation at x_i (8 entries); C_γ shifted: n_i·∇u_h of the voxel holding
+//   x_i − shift·n_i (8 entries); C_γ centered: n_i·∇ of the triquadratic interpolant on the 3×3×3
+//   nodes around the node nearest x_i (O(h²)); B_Γ: row p = ∫_{patch p} φ_k dS (patch_integrals).
+SparseRows point_value_rows(const Grid3& grid, const std::vector<Point3>& points);
+SparseRows normal_derivative_rows(const Grid3& grid, const std::vector<Point3>& points,
+                                  const std::vector<Point3>& normals, double shift);
+SparseRows normal_derivative_rows_centered(const Grid3& grid, const std::vector<Point3>& points,
+                                           const std::vector<Point3>& normals);
+/// Rows from patch_integrals' weights (sorted by patch); nodes without an unknown are dropped.
+SparseRows patch_integral_rows(const Grid3& grid, const std::vector<PatchWeight>& weights, int n_patches);
 
 }  // namespace fictus

@@ -1,0 +1,121 @@
+#pragma once
+// 3-D: the Signorini problem −Δu + c·u = f in ω, u ≥ g, ∂u/∂n ≥ 0, (u − g)·∂u/∂n = 0 on γ = ∂ω, a
+// closed surface in a box Ω ⊂ R³, by the fictitious domain method of the 2-D solver (docs/math.md,
+// "Three dimensions"): trilinear elements on the box's uniform grid, A⁻¹ by 3-D sine (or real
+// Fourier) transforms, λ piecewise constant on m patches of γ (non-smooth) or of its offset surface Γ
+// at distance δ outside (smooth), one collocation point per patch, and the same Schur complement and
+// semismooth Newton code as in 2-D (schur_complement.hpp, semismooth_newton.hpp).
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fictus/error_norms.hpp"
+#include "fictus/execution.hpp"
+#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/grid.hpp"
+#include "fictus/load_vector.hpp"
+#include "fictus/semismooth_newton.hpp"
+#include "fictus/solver_options.hpp"
+#include "fictus/surface_integrals.hpp"
+
+namespace fictus {
+
+using GradientField3 = std::function<Point3(double x, double y, double z)>;
+
+/// A closed surface γ = ∂ω given by a level-set function: level(x) < 0 in ω, > 0 outside, with a
+/// triangulation split into patches on demand.
+class Surface {
+ public:
+  virtual ~Surface() = default;
+  virtual double level(const Point3& p) const = 0;
+  virtual Point3 level_gradient(const Point3& p) const = 0;
+  /// γ triangulated with edges of about `edge` or less, split into m patches of nearly equal area,
+  /// with a point on γ and its outward normal per patch.
+  virtual PatchedSurface patches(int m, double edge) const = 0;
+  /// The area of γ (for the default m).
+  virtual double area() const = 0;
+  /// A box holding γ.
+  virtual Box3 bounds() const = 0;
+};
+
+/// (x − c)ᵀ diag(a)⁻² (x − c) < 1, axis-aligned; a sphere when the semi-axes are equal.
+class Ellipsoid final : public Surface {
+ public:
+  /// Throws std::invalid_argument naming geometry.center or geometry.semi_axes.
+  Ellipsoid(Point3 center, Point3 semi_axes);
+  double level(const Point3& p) const override;
+  Point3 level_gradient(const Point3& p) const override;
+  PatchedSurface patches(int m, double edge) const override;
+  double area() const override;
+  Box3 bounds() const override;
+  Point3 center() const { return center_; }
+  Point3 semi_axes() const { return semi_axes_; }
+
+ private:
+  Point3 center_, semi_axes_;
+};
+
+struct SurfaceProblem {
+  Box3 box;  // Ω
+  int N = 64;
+  Boundary boundary = Boundary::dirichlet;
+  double c = 1.0;
+  std::shared_ptr<const Surface> gamma;
+  ScalarField3 f, g;
+  ScalarField3 exact;             // optional: errors
+  GradientField3 exact_gradient;  // optional with exact (else central differences)
+};
+
+/// Default patch size s (the side of a square of the patch's area) in cells: m = area/(s·h)².
+inline constexpr double default_patch_cells_smooth_3d = 6.0;
+inline constexpr double default_patch_cells_nonsmooth_3d = 3.0;
+/// Default m for a surface of `area` on a grid of cell h.
+int default_patches(double area, double h, Variant variant);
+
+struct SurfaceSolution {
+  explicit SurfaceSolution(const Grid3& g) : grid(g) {}
+  Grid3 grid;
+  SolverOptions options;  // in effect (m resolved)
+  GridVector u;           // û at the unknowns
+  PatchedSurface gamma;   // γ's patches: points, normals, areas
+  PatchedSurface Gamma;   // the surface carrying λ (γ itself in the non-smooth variant)
+  double delta = 0;       // distance of Γ from γ
+  std::vector<double> lambda, g, trace, normal_derivative;  // per patch
+  double lambda_total = 0;
+  double alpha = 0;
+  NewtonResult newton;
+  std::size_t fast_solves = 0;
+  int inner_iterations = 0;
+  SignoriniCheck signorini;
+  std::optional<ErrorNorms> errors;
+  std::optional<PointErrors> point_errors;
+  Timings timings;
+  std::size_t peak_memory_bytes = 0;
+};
+
+/// One 3-D problem, one call, on options.threads threads; `progress` is called with each step's name
+/// and seconds as it ends. Throws std::invalid_argument naming the field on bad input.
+SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
+                      std::function<void(const std::string& phase, double seconds)> progress = {});
+
+/// ∫_ω w over the part of each voxel inside γ: full voxels by q³ Gauss points, voxels near γ split
+/// in 8 and each cut half-voxel by a rule along the axis where γ is steepest (the segment of each
+/// Gauss line inside ω found by root finding on the level set, then q Gauss points on it), exact up
+/// to the quadrature's degree for integrands smooth in the voxel. `visit(thread, cell, x, weight)` is
+/// called from `execution.threads()` threads at once, `thread` in [0, threads): keep sums per thread.
+using OmegaVisitor = std::function<void(int thread, const Grid3::Index& cell, const Point3& x, double weight)>;
+void for_each_omega_point(const Grid3& grid, const Surface& gamma, int q, const Execution& execution,
+                          const OmegaVisitor& visit);
+
+/// The volume of ω by that rule (a test of it).
+double omega_volume(const Grid3& grid, const Surface& gamma, int q = 3, const Execution& execution = Execution{});
+
+/// Errors of the trilinear û against `exact` in ω (L², H¹) and on γ from the points (Σ_p |patch p|·
+/// (û − u)(x_p)²)^½, absolute and relative.
+ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,
+                          const std::vector<double>& trace, const ScalarField3& exact,
+                          const GradientField3& exact_gradient, int q = 3, const Execution& execution = Execution{});
+
+}  // namespace fictus

@@ -1,0 +1,482 @@
+#include "fictus/surface_solver.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include "fictus/fast_solver.hpp"
+#include "fictus/green_table.hpp"
+#include "fictus/q1_element.hpp"
+#include "fictus/quadrature.hpp"
+#include "fictus/schur_complement.hpp"
+#include "fictus/trace_operators.hpp"
+
+namespace fictus {
+
+// ---------------------------------------------------------------------------------------------
+// Ellipsoid
+
+Ellipsoid::Ellipsoid(Point3 center, Point3 semi_axes) : center_(center), semi_axes_(semi_axes) {
+  for (int d = 0; d < 3; ++d) {
+    if (!std::isfinite(center[d])) throw std::invalid_argument("geometry.center: must be finite");
+    if (!(semi_axes[d] > 0) || !std::isfinite(semi_axes[d]))
+      throw std::invalid_argument("geometry.semi_axes: must be positive and finite");
+  }
+}
+
+double Ellipsoid::level(const Point3& p) const {
+  double sum = -1.0;
+  for (int d = 0; d < 3; ++d) {
+    const double t = (p[d] - center_[d]) / semi_axes_[d];
+    sum += t * t;
+  }
+  return sum;
+}
+
+Point3 Ellipsoid::level_gradient(const Point3& p) const {
+  Point3 g;
+  for (int d = 0; d < 3; ++d) g[d] = 2 * (p[d] - center_[d]) / (semi_axes_[d] * semi_axes_[d]);
+  return g;
+}
+
+PatchedSurface Ellipsoid::patches(int m, double edge) const { return ellipsoid_patches(center_, semi_axes_, m, edge); }
+
+double Ellipsoid::area() const {
+  // Knud Thomsen's formula (within 1.1 %; exact for a sphere): enough for the default m.
+  const double a = semi_axes_.x, b = semi_axes_.y, c = semi_axes_.z, p = 1.6075;
+  return 4 * std::numbers::pi * std::pow((std::pow(a * b, p) + std::pow(a * c, p) + std::pow(b * c, p)) / 3, 1 / p);
+}
+
+Box3 Ellipsoid::bounds() const {
+  Box3 box;
+  box.lower = center_ - semi_axes_;
+  box.upper = center_ + semi_axes_;
+  return box;
+}
+
+int default_patches(double area, double h, Variant variant) {
+  const double s = (variant == Variant::smooth ? default_patch_cells_smooth_3d : default_patch_cells_nonsmooth_3d) * h;
+  return std::max(minimum_multipliers, int(std::lround(area / (s * s))));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Quadrature over ω
+
+namespace {
+
+/// The distance of p from γ is at least about |level|/|∇level| near γ.
+bool near_surface(const Surface& gamma, const Point3& center, double radius) {
+  const double value = gamma.level(center);
+  const double slope = norm(gamma.level_gradient(center));
+  return !(std::abs(value) > 2.0 * radius * slope);
+}
+
+/// The cube [lower, lower + side]³ ∩ ω by lines along the axis where γ is steepest.
+template <class Visit>
+void cut_cube(const Surface& gamma, const Point3& lower, double side, const GaussRule& rule, Visit&& visit) {
+  Point3 center = lower;
+  for (int d = 0; d < 3; ++d) center[d] += side / 2;
+  const Point3 slope = gamma.level_gradient(center);
+  int axis = 0;
+  for (int d = 1; d < 3; ++d)
+    if (std::abs(slope[d]) > std::abs(slope[axis])) axis = d;
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  const int q = int(rule.nodes.size());
+  for (int b = 0; b < q; ++b)
+    for (int a = 0; a < q; ++a) {
+      Point3 start = lower;
+      start[u] += rule.nodes[a] * side;
+      start[v] += rule.nodes[b] * side;
+      const auto at = [&](double t) {
+        Point3 x = start;
+        x[axis] += t;
+        return x;
+      };
+      const double f0 = gamma.level(at(0)), f1 = gamma.level(at(side));
+      double t0 = 0, t1 = side;
+      if (f0 >= 0 && f1 >= 0) continue;
+      if ((f0 < 0) != (f1 < 0)) {  // one crossing: the root by bisection safeguarded regula falsi
+        double lo = 0, hi = side, flo = f0, fhi = f1;
+        for (int iteration = 0; iteration < 100 && hi - lo > 1e-15 * side; ++iteration) {
+          double t = lo - flo * (hi - lo) / (fhi - flo);
+          if (!(t > lo && t < hi) || iteration % 3 == 2) t = 0.5 * (lo + hi);
+          const double ft = gamma.level(at(t));
+          if ((ft < 0) == (flo < 0))
+            lo = t, flo = ft;
+          else
+            hi = t, fhi = ft;
+        }
+        const double root = 0.5 * (lo + hi);
+        if (f0 < 0)
+          t1 = root;
+        else
+          t0 = root;
+      }
+      const double base = rule.weights[a] * rule.weights[b] * side * side * (t1 - t0);
+      for (int c = 0; c < q; ++c) visit(at(t0 + rule.nodes[c] * (t1 - t0)), base * rule.weights[c]);
+    }
+}
+
+}  // namespace
+
+void for_each_omega_point(const Grid3& grid, const Surface& gamma, int q, const Execution& execution,
+                          const OmegaVisitor& visit) {
+  const GaussRule& rule = gauss_legendre(q);
+  const double h = grid.h();
+  const Box3 bounds = gamma.bounds();
+  std::array<int, 3> first, last;
+  for (int d = 0; d < 3; ++d) {
+    first[d] = grid.cell(d, bounds.lower[d]);
+    last[d] = grid.cell(d, bounds.upper[d]);
+  }
+  std::atomic<bool> stop = false;
+#pragma omp parallel for num_threads(execution.threads()) schedule(dynamic, 1)
+  for (int iz = first[2]; iz <= last[2]; ++iz) {
+    const int thread = omp_get_thread_num();
+    if (thread == 0 && execution.interrupt_requested()) stop = true;
+    if (stop) continue;
+    for (int iy = first[1]; iy <= last[1]; ++iy)
+      for (int ix = first[0]; ix <= last[0]; ++ix) {
+        const Grid3::Index cell{ix, iy, iz};
+        const Point3 lower{grid.x(ix), grid.y(iy), grid.z(iz)};
+        const Point3 center = lower + Point3{h / 2, h / 2, h / 2};
+        if (!near_surface(gamma, center, 0.87 * h)) {
+          if (gamma.level(center) > 0) continue;
+          for (int c = 0; c < q; ++c)
+            for (int b = 0; b < q; ++b)
+              for (int a = 0; a < q; ++a)
+                visit(thread, cell, lower + h * Point3{rule.nodes[a], rule.nodes[b], rule.nodes[c]},
+                      rule.weights[a] * rule.weights[b] * rule.weights[c] * h * h * h);
+          continue;
+        }
+        for (int k = 0; k < 8; ++k) {  // eight half-voxels
+          const Point3 sub = lower + (h / 2) * Point3{double(k & 1), double((k >> 1) & 1), double((k >> 2) & 1)};
+          cut_cube(gamma, sub, h / 2, rule, [&](const Point3& x, double w) { visit(thread, cell, x, w); });
+        }
+      }
+  }
+  if (stop) throw Interrupted();
+}
+
+double omega_volume(const Grid3& grid, const Surface& gamma, int q, const Execution& execution) {
+  std::vector<double> sums(execution.threads(), 0.0);
+  for_each_omega_point(grid, gamma, q, execution,
+                       [&](int thread, const Grid3::Index&, const Point3&, double w) { sums[thread] += w; });
+  double total = 0;
+  for (double s : sums) total += s;
+  return total;
+}
+
+namespace {
+
+/// û and ∇û of the trilinear function at x in `cell`.
+void sample_q1(const Grid3& grid, const GridVector& u, const Grid3::Index& cell, const Point3& x, double& value,
+               Point3& gradient) {
+  Point3 xi;
+  for (int d = 0; d < 3; ++d) xi[d] = (x[d] - grid.coordinate(d, cell[d])) / grid.h();
+  const Q1Element<3> element(xi, grid.h());
+  value = 0;
+  gradient = {};
+  for (int k = 0; k < 8; ++k) {
+    const Grid3::Index node{cell[0] + Q1Element<3>::offset(k, 0), cell[1] + Q1Element<3>::offset(k, 1),
+                            cell[2] + Q1Element<3>::offset(k, 2)};
+    if (!grid.has_unknown(node)) continue;
+    const double uk = u[grid.index(node)];
+    value += uk * element.value[k];
+    gradient = gradient + uk * element.gradient(k);
+  }
+}
+
+GradientField3 central_differences(const ScalarField3& u, double step) {
+  return [u, step](double x, double y, double z) {
+    return Point3{(u(x + step, y, z) - u(x - step, y, z)) / (2 * step),
+                  (u(x, y + step, z) - u(x, y - step, z)) / (2 * step),
+                  (u(x, y, z + step) - u(x, y, z - step)) / (2 * step)};
+  };
+}
+
+}  // namespace
+
+ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,
+                          const std::vector<double>& trace, const ScalarField3& exact,
+                          const GradientField3& exact_gradient, int q, const Execution& execution) {
+  const GradientField3 gradient =
+      exact_gradient ? exact_gradient : central_differences(exact, 1e-6 * grid.box().width(0));
+  struct Sums {
+    double e2 = 0, de2 = 0, u2 = 0, du2 = 0;
+  };
+  std::vector<Sums> sums(execution.threads());
+  for_each_omega_point(grid, gamma, q, execution, [&](int thread, const Grid3::Index& cell, const Point3& x, double w) {
+    double value;
+    Point3 slope;
+    sample_q1(grid, u_h, cell, x, value, slope);
+    const double u = exact(x.x, x.y, x.z);
+    const Point3 du = gradient(x.x, x.y, x.z);
+    const Point3 de = slope - du;
+    Sums& s = sums[thread];
+    s.e2 += w * (value - u) * (value - u);
+    s.de2 += w * dot(de, de);
+    s.u2 += w * u * u;
+    s.du2 += w * dot(du, du);
+  });
+  Sums total;
+  for (const Sums& s : sums) total.e2 += s.e2, total.de2 += s.de2, total.u2 += s.u2, total.du2 += s.du2;
+  double g2 = 0, gu2 = 0;
+  for (int p = 0; p < patches.m; ++p) {
+    const Point3 x = patches.point[p];
+    const double u = exact(x.x, x.y, x.z);
+    g2 += patches.area[p] * (trace[p] - u) * (trace[p] - u);
+    gu2 += patches.area[p] * u * u;
+  }
+  ErrorNorms e;
+  e.l2_omega = std::sqrt(total.e2);
+  e.h1semi_omega = std::sqrt(total.de2);
+  e.h1_omega = std::sqrt(total.e2 + total.de2);
+  e.l2_gamma = std::sqrt(g2);
+  const auto relative = [](double error, double norm) { return norm > 0 ? error / norm : error; };
+  e.rel_l2_omega = relative(e.l2_omega, std::sqrt(total.u2));
+  e.rel_h1semi_omega = relative(e.h1semi_omega, std::sqrt(total.du2));
+  e.rel_h1_omega = relative(e.h1_omega, std::sqrt(total.u2 + total.du2));
+  e.rel_l2_gamma = relative(e.l2_gamma, std::sqrt(gu2));
+  return e;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The solve
+
+namespace {
+
+class Clock {
+ public:
+  Clock(Timings& timings, const Execution& execution) : timings_(timings), execution_(execution) {}
+  void mark(const std::string& phase) {
+    const auto t = std::chrono::steady_clock::now();
+    timings_.phases.emplace_back(phase, std::chrono::duration<double>(t - last_).count());
+    timings_.total = std::chrono::duration<double>(t - start_).count();
+    last_ = t;
+    execution_.report(phase, timings_.phases.back().second);
+  }
+
+ private:
+  Timings& timings_;
+  const Execution& execution_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now(), last_ = start_;
+};
+
+std::string format(const char* pattern, double a, double b = 0, double c = 0) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, pattern, a, b, c);
+  return buffer;
+}
+
+/// γ (or Γ) with its bounds grown by `grow` must keep 2h from the box's sides.
+void check_inside_box(const Surface& gamma, const Grid3& grid, double grow, const std::string& field) {
+  const Box3 bounds = gamma.bounds();
+  const double margin = 2 * grid.h();
+  for (int d = 0; d < 3; ++d)
+    if (!(bounds.lower[d] - grow - grid.box().lower[d] >= margin &&
+          grid.box().upper[d] - bounds.upper[d] - grow >= margin))
+      throw std::invalid_argument(
+          field + ": " + (grow > 0 ? "the offset surface" : "the surface") +
+          format(" comes within %.3g of the box along axis %.0f (need 2h = %.3g)",
+                 std::min(bounds.lower[d] - grow - grid.box().lower[d], grid.box().upper[d] - bounds.upper[d] - grow),
+                 double(d), margin));
+}
+
+/// The triangles of `surface` moved by δ along the surface's unit normal at each vertex.
+std::vector<Triangle3> offset_triangles(const std::vector<Triangle3>& triangles, const Surface& gamma, double delta) {
+  const auto move = [&](const Point3& p) {
+    const Point3 n = gamma.level_gradient(p);
+    return p + (delta / norm(n)) * n;
+  };
+  std::vector<Triangle3> out;
+  out.reserve(triangles.size());
+  for (const Triangle3& t : triangles) out.push_back({move(t.a), move(t.b), move(t.c)});
+  return out;
+}
+
+Eigen::VectorXd row_sums(const SparseRows& rows) {
+  Eigen::VectorXd sums = Eigen::VectorXd::Zero(rows.n_rows());
+  for (int r = 0; r < rows.n_rows(); ++r)
+    for (std::size_t k = rows.row_begin[r]; k < rows.row_begin[r + 1]; ++k) sums(r) += rows.entries[k].value;
+  return sums;
+}
+
+Eigen::VectorXd to_eigen(const std::vector<double>& v) {
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), Eigen::Index(v.size()));
+}
+
+}  // namespace
+
+SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
+                      std::function<void(const std::string&, double)> progress) {
+  options.validate();
+  Execution execution(options.threads);
+  execution.set_progress(std::move(progress));
+  if (!problem.gamma) throw std::invalid_argument("geometry: no surface given");
+  if (!problem.f) throw std::invalid_argument("data.f: not given");
+  if (!problem.g) throw std::invalid_argument("data.g: not given");
+  if (!(problem.c >= 0) || !std::isfinite(problem.c)) throw std::invalid_argument("data.c: must be finite and >= 0");
+  const Grid3 grid(problem.box, problem.N, problem.boundary);
+  const Surface& gamma = *problem.gamma;
+  const double h = grid.h();
+  SurfaceSolution sol(grid);
+  Clock clock(sol.timings, execution);
+  Eigen::setNbThreads(options.threads);
+
+  // 0. The load and u₀.
+  std::unique_ptr<FastSolver<3>> fast = make_fast_solver(grid, problem.c, execution);
+  GridVector u0 = assemble_load(grid, problem.f, options.load_quadrature, execution);
+  double load_total = 0;
+  for (double v : u0) {
+    if (!std::isfinite(v)) throw std::invalid_argument("data.f: not finite somewhere in the box");
+    load_total += v;
+  }
+  clock.mark("load");
+  fast->solve_in_place(u0);
+  ++sol.fast_solves;
+  clock.mark("u0");
+
+  // 1. Geometry: the patches of γ, δ and Γ.
+  check_inside_box(gamma, grid, 0, "geometry");
+  const double area = gamma.area();
+  const int m = options.multipliers > 0 ? options.multipliers : default_patches(area, h, options.variant);
+  if (m < minimum_multipliers)
+    throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) +
+                                " is too small (need m >= " + std::to_string(minimum_multipliers) + ")");
+  const double spacing = std::sqrt(area / m);
+  if (spacing < 2 * h)
+    throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) +
+                                format(" gives patches of side %.3g < 2h = %.3g (use m <= %.0f)", spacing, 2 * h,
+                                       std::floor(area / (4 * h * h))));
+  sol.gamma = gamma.patches(m, h);
+  sol.Gamma = sol.gamma;
+  if (options.variant == Variant::smooth) {
+    sol.delta = options.offset * spacing;
+    if (options.normal_derivative == NormalDerivative::reconstructed && sol.delta < 4 * h)
+      throw std::invalid_argument(
+          format("formulation.offset: Γ at δ = offset·s = %.2f h is within reach of the C_γ "
+                 "stencil (need δ >= 4h: a larger offset or a smaller m)",
+                 sol.delta / h));
+    check_inside_box(gamma, grid, sol.delta, "formulation.offset");
+    sol.Gamma.triangles = offset_triangles(sol.gamma.triangles, gamma, sol.delta);
+    for (int p = 0; p < m; ++p) sol.Gamma.point[p] = sol.gamma.point[p] + sol.delta * sol.gamma.normal[p];
+  }
+  sol.Gamma.area.assign(m, 0.0);
+  for (std::size_t t = 0; t < sol.Gamma.triangles.size(); ++t)
+    sol.Gamma.area[sol.Gamma.patch_of[t]] += fictus::area(sol.Gamma.triangles[t]);
+
+  // 2. Trace rows.
+  const SparseRows B_gamma = point_value_rows(grid, sol.gamma.point);
+  const bool centered =
+      options.variant == Variant::smooth && options.normal_derivative == NormalDerivative::reconstructed;
+  const SparseRows C_gamma =
+      centered ? normal_derivative_rows_centered(grid, sol.gamma.point, sol.gamma.normal)
+               : normal_derivative_rows(grid, sol.gamma.point, sol.gamma.normal, options.normal_shift * h);
+  const SparseRows B_Gamma =
+      patch_integral_rows(grid, patch_integrals(grid, sol.Gamma.triangles, sol.Gamma.patch_of, m), m);
+  clock.mark("geometry");
+  execution.throw_if_interrupted();
+
+  // 3. Schur blocks.
+  std::unique_ptr<GreenTable<3>> green;
+  std::unique_ptr<SchurComplement> schur;
+  if (options.inner == InnerSolver::krylov) {
+    GmresOptions gmres;
+    gmres.relative_tolerance = options.krylov_tolerance;
+    gmres.max_iterations = options.krylov_max_iterations;
+    gmres.restart = m + 1;
+    gmres.between_iterations = [&execution] { execution.throw_if_interrupted(); };
+    schur = std::make_unique<ImplicitSchur>(*fast, B_gamma, C_gamma, B_Gamma, gmres);
+  } else {
+    green = std::make_unique<GreenTable<3>>(grid, problem.c, execution);
+    clock.mark("green_table");
+    schur = std::make_unique<ExplicitSchur>(*green, B_gamma, C_gamma, B_Gamma, execution);
+    green.reset();
+    clock.mark("schur");
+  }
+
+  // 4. g at the points.
+  sol.g.resize(m);
+  for (int p = 0; p < m; ++p) {
+    const Point3 x = sol.gamma.point[p];
+    sol.g[p] = problem.g(x.x, x.y, x.z);
+    if (!std::isfinite(sol.g[p]))
+      throw std::invalid_argument(format("data.g: not finite at the point (%.6g, %.6g, %.6g)", x.x, x.y, x.z));
+  }
+
+  // 5. Newton.
+  std::vector<double> b0, c0;
+  B_gamma.multiply(u0, b0);
+  C_gamma.multiply(u0, c0);
+  std::optional<ConstantMode> mode;
+  if (fast->singular()) mode = ConstantMode{row_sums(B_gamma), row_sums(C_gamma), row_sums(B_Gamma), load_total};
+  NewtonOptions newton_options;
+  newton_options.between_steps = [&execution] { execution.throw_if_interrupted(); };
+  newton_options.rho = options.rho;
+  newton_options.max_iterations = options.max_newton;
+  newton_options.start_all_active = options.start_all_active;
+  newton_options.tolerance = options.newton_tolerance;
+  sol.newton = solve_semismooth_newton(*schur, to_eigen(b0), to_eigen(c0), to_eigen(sol.g), newton_options,
+                                       mode ? &*mode : nullptr);
+  sol.fast_solves += schur->fast_solves();
+  for (const NewtonStep& step : sol.newton.history) sol.inner_iterations += step.inner_iterations;
+  sol.lambda.assign(sol.newton.lambda.data(), sol.newton.lambda.data() + m);
+  sol.lambda_total = row_sums(B_Gamma).dot(sol.newton.lambda);
+  sol.alpha = sol.newton.alpha;
+  clock.mark("newton");
+
+  // 6. The field.
+  GridVector u(grid.n_unknowns(), 0.0);
+  B_Gamma.add_transposed(sol.lambda, u);
+  fast->solve_in_place(u);
+  ++sol.fast_solves;
+  for (std::size_t k = 0; k < u.size(); ++k) u[k] += u0[k] + sol.alpha;
+  u0 = GridVector();
+  sol.u = std::move(u);
+  B_gamma.multiply(sol.u, sol.trace);
+  C_gamma.multiply(sol.u, sol.normal_derivative);
+  clock.mark("final_solve");
+
+  // 7. Signorini conditions at the points.
+  SignoriniCheck& s = sol.signorini;
+  s.min_gap = s.min_normal_derivative = std::numeric_limits<double>::infinity();
+  for (int p = 0; p < m; ++p) {
+    const double gap = sol.trace[p] - sol.g[p], dn = sol.normal_derivative[p];
+    s.min_gap = std::min(s.min_gap, gap);
+    s.min_normal_derivative = std::min(s.min_normal_derivative, dn);
+    s.max_complementarity = std::max(s.max_complementarity, std::abs(gap * dn));
+  }
+
+  // 8. Errors.
+  if (problem.exact) {
+    const GradientField3 gradient = problem.exact_gradient
+                                        ? problem.exact_gradient
+                                        : central_differences(problem.exact, 1e-6 * grid.box().width(0));
+    PointErrors pe;
+    for (int p = 0; p < m; ++p) {
+      const Point3 x = sol.gamma.point[p];
+      pe.max_trace = std::max(pe.max_trace, std::abs(sol.trace[p] - problem.exact(x.x, x.y, x.z)));
+      pe.max_normal_derivative =
+          std::max(pe.max_normal_derivative,
+                   std::abs(sol.normal_derivative[p] - dot(sol.gamma.normal[p], gradient(x.x, x.y, x.z))));
+    }
+    sol.point_errors = pe;
+    sol.errors = compute_errors(sol.u, grid, gamma, sol.gamma, sol.trace, problem.exact, gradient,
+                                options.error_quadrature, execution);
+    clock.mark("errors");
+  }
+  sol.options = options;
+  sol.options.multipliers = m;
+  return sol;
+}
+
+}  // namespace fictus
