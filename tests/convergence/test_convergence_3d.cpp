@@ -1,0 +1,103 @@
+// 3-D: the manufactured Signorini solutions of manufactured3d.py (∂²u/∂n² ≠ 0 on the free part, the
+// contact boundary a plane section in general position) converge at the smooth variant's order on a
+// sphere and an ellipsoid; Newton stays short; the discrete Signorini conditions hold to round-off;
+// the two inner solvers agree. Small N here (the large ones are in the benchmark).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <iostream>
+
+#include "fictus/convergence_table.hpp"
+#include "manufactured_solutions_3d.hpp"
+
+namespace {
+
+fictus::SurfaceProblem problem(const std::string& name, int N) {
+  for (const auto& p : manufactured3d::all(N))
+    if (p.name == name) return p.problem;
+  throw std::invalid_argument(name);
+}
+
+fictus::LevelResult level_of(const fictus::SurfaceSolution& s) {
+  fictus::LevelResult r;
+  r.N = s.grid.nx();
+  r.n_nodes = s.grid.n_nodes();
+  r.m = s.options.multipliers;
+  r.it0 = s.newton.iterations;
+  r.it1 = s.fast_solves;
+  r.time = s.timings.total;
+  r.l2_omega = s.errors->rel_l2_omega;
+  r.h1_omega = s.errors->rel_h1semi_omega;
+  r.l2_gamma = s.errors->rel_l2_gamma;
+  return r;
+}
+
+void expect_signorini_at_round_off(const fictus::SurfaceSolution& s) {
+  EXPECT_GT(s.signorini.min_gap, -1e-12);
+  EXPECT_GT(s.signorini.min_normal_derivative, -1e-10);
+  EXPECT_LT(s.signorini.max_complementarity, 1e-12);
+}
+
+void converges(const std::string& name, const std::vector<int>& sizes) {
+  std::vector<fictus::LevelResult> rows;
+  for (int N : sizes) {
+    fictus::SolverOptions o;
+    o.threads = 2;
+    const fictus::SurfaceSolution s = fictus::solve(problem(name, N), o);
+    ASSERT_TRUE(s.newton.converged) << "N = " << N << ": " << s.newton.failure;
+    EXPECT_LE(s.newton.iterations, 10);
+    expect_signorini_at_round_off(s);
+    int active = 0;
+    for (char a : s.newton.active) active += a;
+    EXPECT_GT(active, s.options.multipliers / 5);  // both parts of γ are there
+    EXPECT_LT(active, s.options.multipliers * 4 / 5);
+    rows.push_back(level_of(s));
+  }
+  std::cout << fictus::format_convergence_table(name + ", smooth, 3-D", rows, std::nullopt);
+  const auto fit = fictus::fitted_rates(rows);
+  // Measured over N = 64 … 128: L²(ω) 2.0–2.1, H¹(ω) 1.0, L²(γ) 2.3–2.6.
+  EXPECT_GE(fit[0], 1.8);
+  EXPECT_LE(fit[0], 2.6);
+  EXPECT_GE(fit[1], 0.85);
+  EXPECT_GE(fit[2], 1.8);
+  EXPECT_LE(rows.back().it0, rows.front().it0 + 2);  // Newton does not grow with N
+}
+
+TEST(Manufactured3d, SphereConvergesAtSecondOrder) { converges("sphere", {64, 80, 96}); }
+
+TEST(Manufactured3d, EllipsoidConvergesAtSecondOrder) { converges("ellipsoid", {80, 96, 112}); }
+
+TEST(Manufactured3d, GreenAndKrylovAgree) {
+  fictus::SolverOptions o;
+  o.threads = 2;
+  const fictus::SurfaceSolution green = fictus::solve(problem("sphere", 64), o);
+  o.inner = fictus::InnerSolver::krylov;
+  o.krylov_tolerance = 1e-12;
+  const fictus::SurfaceSolution krylov = fictus::solve(problem("sphere", 64), o);
+  ASSERT_TRUE(green.newton.converged && krylov.newton.converged);
+  EXPECT_EQ(green.newton.active, krylov.newton.active);
+  double largest = 0, difference = 0;
+  for (std::size_t i = 0; i < green.lambda.size(); ++i) {
+    largest = std::max(largest, std::abs(green.lambda[i]));
+    difference = std::max(difference, std::abs(green.lambda[i] - krylov.lambda[i]));
+  }
+  EXPECT_LT(difference, 1e-7 * largest);
+  EXPECT_GT(krylov.fast_solves, 20u);
+}
+
+TEST(Manufactured3d, NonSmoothVariantSolvesButStallsWithoutAKinkCorrection) {
+  // The non-smooth variant with the shifted C_γ (the paper's rule; 3-D has no kink correction yet):
+  // Newton and the discrete conditions are fine, the error stalls near 2 % (measured 1.9e-2 at
+  // N = 64 and 96), as the 2-D shifted rule does on such problems (docs/math.md).
+  fictus::SolverOptions o;
+  o.threads = 2;
+  o.variant = fictus::Variant::nonsmooth;
+  o.normal_derivative = fictus::NormalDerivative::shifted;
+  const fictus::SurfaceSolution s = fictus::solve(problem("sphere", 48), o);
+  ASSERT_TRUE(s.newton.converged);
+  EXPECT_LE(s.newton.iterations, 10);
+  expect_signorini_at_round_off(s);
+  EXPECT_LT(s.errors->rel_l2_omega, 0.05);
+}
+
+}  // namespace
