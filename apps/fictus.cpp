@@ -127,9 +127,95 @@ void print_progress_lines(fictus::FictitiousDomainSolver& solver) {
   });
 }
 
+/// `fictus solve` of a 3-D problem file ([domain] dim = 3): the surface solver, its output files.
+int run_solve_surface(const std::string& text, const SolveCommand& command) {
+  if (!command.parameters.empty()) throw std::invalid_argument("--parameter: 3-D problem files have no [parameters]");
+  fictus::SurfaceProblemSpec spec = fictus::parse_surface_problem_text(text, command.problem_path);
+  std::string name = command.problem_path.substr(command.problem_path.find_last_of('/') + 1);
+  spec.name = name.substr(0, name.rfind(".toml"));
+  fictus::Problem plane;  // the flags set N, boundary and c through a 2-D problem: taken over when given
+  plane.N = spec.problem.N;
+  plane.boundary = spec.problem.boundary;
+  plane.c = spec.problem.c;
+  command.flags.apply(plane, spec.options);
+  spec.problem.N = plane.N;
+  spec.problem.boundary = plane.boundary;
+  spec.problem.c = plane.c;
+  if (spec.problem.N > 1024) throw std::invalid_argument("domain.N: at most 1024 in 3-D");
+  spec.options.validate();
+  if (command.out_option->count() > 0) spec.output.dir = command.out;
+  if (command.files_option->count() > 0) {
+    const auto& names = fictus::surface_output_file_names();
+    for (const std::string& f : command.files)
+      if (std::find(names.begin(), names.end(), f) == names.end())
+        throw std::invalid_argument("output.files: unknown file \"" + f +
+                                    "\" (results.json, points.csv, solution.vti, surface.vtp)");
+    spec.output.files = command.files;
+  }
+  if (!spec.output.dir.empty()) fictus::cli::check_output_folder(spec.output.dir, spec.output.files);
+  // Memory before anything is allocated: u₀, the field, the Green's table and the load (8 bytes a node).
+  const double nodes = std::pow(double(spec.problem.N) + 1, 3);
+  const double needed = 4 * 8 * nodes + (64 << 20);
+  if (needed > 0.9 * double(fictus::available_memory_bytes()))
+    throw std::invalid_argument("domain.N: N = " + std::to_string(spec.problem.N) + " needs about " +
+                                std::to_string(int(needed / (1 << 30) + 1)) + " GiB; less is available");
+  const auto start = std::chrono::steady_clock::now();
+  std::function<void(const std::string&, double)> progress;
+  const bool long_run = !command.quiet && nodes > 2e5;  // long runs say what is coming and how it goes
+  if (long_run)
+    progress = [start](const std::string& phase, double seconds) {
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::fprintf(stderr, "fictus:   %-12s %8.2f s   (elapsed %.1f s, peak memory %.2f GiB)\n", phase.c_str(), seconds,
+                   elapsed, fictus::peak_memory_bytes() / double(1 << 30));
+      std::fflush(stderr);
+    };
+  if (long_run) {
+    std::fprintf(stderr, "fictus: solving a 3-D problem, N = %d (%.3g M unknowns)\n", spec.problem.N, nodes / 1e6);
+    std::fflush(stderr);
+  }
+  fictus::SurfaceSolution s = fictus::solve(spec.problem, spec.options, progress);
+  s.peak_memory_bytes = fictus::peak_memory_bytes();
+  if (!s.newton.converged) throw NewtonFailure("solver.max_newton: Newton did not converge: " + s.newton.failure);
+  if (!command.quiet) {
+    const long active = long(std::count(s.newton.active.begin(), s.newton.active.end(), 1));
+    std::printf("3-D, N = %d (h = %.3g), %zu nodes, m = %d patches, variant %s, inner solver %s\n", s.grid.nx(),
+                s.grid.h(), s.grid.n_nodes(), s.gamma.m, fictus::to_string(s.options.variant),
+                fictus::to_string(s.options.inner));
+    std::printf("Newton: %d steps, converged, %ld active of %d; fast solves %zu\n", s.newton.iterations, active,
+                s.gamma.m, s.fast_solves);
+    std::printf("Signorini checks: min gap %.2e, min du/dn %.2e, max |complementarity| %.2e\n", s.signorini.min_gap,
+                s.signorini.min_normal_derivative, s.signorini.max_complementarity);
+    if (s.errors)
+      std::printf("relative errors: L2(omega) %.3e, H1(omega) %.3e (semi %.3e), L2(gamma) %.3e\n",
+                  s.errors->rel_l2_omega, s.errors->rel_h1_omega, s.errors->rel_h1semi_omega, s.errors->rel_l2_gamma);
+    std::printf("time %.3f s, peak memory %.1f MiB\n", s.timings.total, s.peak_memory_bytes / 1048576.0);
+  }
+  if (!spec.output.dir.empty()) {
+    std::vector<fictus::cli::OutputFile> files;
+    for (const std::string& file : spec.output.files) {
+      if (file == "results.json")
+        files.push_back(
+            {file, [&](std::ostream& out) { out << fictus::cli::solution_to_json(spec, s).dump(2) << "\n"; }});
+      else if (file == "points.csv")
+        files.push_back({file, [&](std::ostream& out) { out << fictus::cli::points_csv(s); }});
+      else if (file == "solution.vti")
+        files.push_back({file, [&](std::ostream& out) { fictus::cli::write_vti(out, spec.problem, s); }});
+      else if (file == "surface.vtp")
+        files.push_back({file, [&](std::ostream& out) { fictus::cli::write_vtp(out, s); }});
+    }
+    fictus::cli::write_output_set(spec.output.dir, files);
+    if (!command.quiet) std::printf("wrote %zu files to %s/\n", files.size(), spec.output.dir.c_str());
+  }
+  return 0;
+}
+
 int run_solve(const SolveCommand& command) {
   const std::string& problem_path = command.problem_path;
   const fictus::cli::OptionFlags& flags = command.flags;
+  if (!problem_path.empty()) {
+    const std::string text = fictus::read_problem_text(problem_path);
+    if (fictus::problem_dimension(text, problem_path) == 3) return run_solve_surface(text, command);
+  }
   fictus::ParameterValues parameters;
   for (const std::string& p : command.parameters) {
     const std::size_t equals = p.find('=');

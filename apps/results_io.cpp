@@ -212,4 +212,80 @@ std::string levels_csv(const std::vector<LevelResult>& rows) {
   return out.str();
 }
 
+json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& s) {
+  json j;
+  j["version"] = FICTUS_VERSION;
+  j["commit"] = FICTUS_GIT_COMMIT;
+  j["dim"] = 3;
+  j["problem"] = json::parse(spec.input_json);
+  j["problem"]["name"] = spec.name;
+  const SolverOptions& o = s.options;
+  j["options"] = {{"variant", to_string(o.variant)},
+                  {"multipliers", o.multipliers},
+                  {"offset", o.offset},
+                  {"normal_derivative", to_string(o.normal_derivative)},
+                  {"normal_shift", o.normal_shift},
+                  {"schur", to_string(o.inner)},
+                  {"rho", o.rho},
+                  {"newton_tolerance", o.newton_tolerance},
+                  {"threads", o.threads},
+                  {"boundary", to_string(spec.problem.boundary)},
+                  {"c", spec.problem.c}};
+  j["grid"] = {{"N", s.grid.nx()}, {"Ny", s.grid.ny()},           {"Nz", s.grid.nz()},
+               {"h", s.grid.h()},  {"n_nodes", s.grid.n_nodes()}, {"n_unknowns", s.grid.n_unknowns()}};
+  j["multipliers"] = s.gamma.m;
+  double area = 0;
+  for (double a : s.gamma.area) area += a;
+  j["surface"] = {{"area", area}, {"triangles", s.gamma.triangles.size()}, {"delta", s.delta}};
+  j["alpha"] = s.alpha;
+  json history = json::array();
+  for (const NewtonStep& step : s.newton.history)
+    history.push_back({{"n_active", step.n_active},
+                       {"inner_iterations", step.inner_iterations},
+                       {"residual", step.residual},
+                       {"n_changed", step.n_changed}});
+  j["newton"] = {{"iterations", s.newton.iterations},
+                 {"converged", s.newton.converged},
+                 {"residual", s.newton.residual},
+                 {"history", history}};
+  j["fast_solves"] = s.fast_solves;
+  j["inner_iterations"] = s.inner_iterations;
+  j["signorini"] = {{"min_gap", s.signorini.min_gap},
+                    {"min_normal_derivative", s.signorini.min_normal_derivative},
+                    {"max_complementarity", s.signorini.max_complementarity}};
+  double contact_area = 0, force = 0;
+  long points = 0;
+  for (int p = 0; p < s.gamma.m; ++p)
+    if (s.newton.active[p] == 1)
+      ++points, contact_area += s.gamma.area[p], force += s.normal_derivative[p] * s.gamma.area[p];
+  j["contact"] = {{"points", points}, {"area", contact_area}, {"force", force}, {"lambda_integral", s.lambda_total}};
+  if (s.errors)
+    j["errors"] = {{"l2_omega", s.errors->l2_omega},         {"h1semi_omega", s.errors->h1semi_omega},
+                   {"h1_omega", s.errors->h1_omega},         {"l2_gamma", s.errors->l2_gamma},
+                   {"rel_l2_omega", s.errors->rel_l2_omega}, {"rel_h1semi_omega", s.errors->rel_h1semi_omega},
+                   {"rel_h1_omega", s.errors->rel_h1_omega}, {"rel_l2_gamma", s.errors->rel_l2_gamma}};
+  if (s.point_errors)
+    j["point_errors"] = {{"max_trace", s.point_errors->max_trace},
+                         {"max_normal_derivative", s.point_errors->max_normal_derivative}};
+  json timings = json::object();
+  for (const auto& [phase, seconds] : s.timings.phases) timings[phase] = seconds;
+  timings["total"] = s.timings.total;
+  j["timings"] = timings;
+  j["peak_memory_bytes"] = s.peak_memory_bytes;
+  return j;
+}
+
+std::string points_csv(const SurfaceSolution& s) {
+  std::ostringstream out;
+  out.precision(17);
+  out << "patch,x,y,z,nx,ny,nz,area,u,g,dudn,lambda,contact\n";
+  for (int p = 0; p < s.gamma.m; ++p) {
+    const Point3 x = s.gamma.point[p], n = s.gamma.normal[p];
+    out << p << ',' << x.x << ',' << x.y << ',' << x.z << ',' << n.x << ',' << n.y << ',' << n.z << ','
+        << s.gamma.area[p] << ',' << s.trace[p] << ',' << s.g[p] << ',' << s.normal_derivative[p] << ',' << s.lambda[p]
+        << ',' << int(s.newton.active[p]) << '\n';
+  }
+  return out.str();
+}
+
 }  // namespace fictus::cli

@@ -11,6 +11,7 @@
 
 #include "fictus/convergence_table.hpp"
 #include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/io/problem_file.hpp"
 
 namespace fictus::cli {
 
@@ -51,5 +52,9 @@ void write_output_set(const std::filesystem::path& dir, const std::vector<Output
 
 std::string points_csv(const Solution& solution);
 std::string levels_csv(const std::vector<LevelResult>& rows);
+
+/// 3-D: results.json (with "dim": 3; keys of docs/results.md) and points.csv (one row per patch).
+nlohmann::json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& solution);
+std::string points_csv(const SurfaceSolution& solution);
 
 }  // namespace fictus::cli

@@ -356,6 +356,8 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   Clock clock(sol.timings, execution);
   Eigen::setNbThreads(options.threads);
 
+  check_inside_box(gamma, grid, 0, "geometry");  // before any work
+
   // 0. The load and u₀.
   std::unique_ptr<FastSolver<3>> fast = make_fast_solver(grid, problem.c, execution);
   GridVector u0 = assemble_load(grid, problem.f, options.load_quadrature, execution);
@@ -370,7 +372,6 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   clock.mark("u0");
 
   // 1. Geometry: the patches of γ, δ and Γ.
-  check_inside_box(gamma, grid, 0, "geometry");
   const double area = gamma.area();
   const int m = options.multipliers > 0 ? options.multipliers : default_patches(area, h, options.variant);
   if (m < minimum_multipliers)

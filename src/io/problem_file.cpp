@@ -16,6 +16,7 @@
 #include "fictus/io/expression.hpp"
 #include "fictus/options.hpp"
 #include "fictus/shapes.hpp"
+#include "fictus/surface_solver.hpp"
 
 namespace fictus {
 
@@ -250,16 +251,133 @@ const std::vector<std::string>& output_file_names() {
   return names;
 }
 
-ProblemSpec parse_problem_text(const std::string& text, const std::string& source, const ParameterValues& parameters,
-                               std::shared_ptr<const Curve> curve) {
-  toml::table root;
+namespace {
+
+toml::table parse_toml(const std::string& text, const std::string& source) {
   try {
-    root = toml::parse(text, source);
+    return toml::parse(text, source);
   } catch (const toml::parse_error& e) {
     std::ostringstream msg;
     msg << source << ":" << e.source().begin.line << ": TOML syntax error: " << e.description();
     throw std::invalid_argument(msg.str());
   }
+}
+
+}  // namespace
+
+int problem_dimension(const std::string& text, const std::string& source) {
+  const toml::table root = parse_toml(text, source);
+  const toml::table* domain = subtable(root, "domain");
+  const toml::node* dim = domain ? domain->get("dim") : nullptr;
+  if (!dim) return 2;
+  const std::optional<int64_t> value = dim->value<int64_t>();
+  if (!dim->is_integer() || !value || (*value != 2 && *value != 3)) fail("domain.dim", "expected 2 or 3");
+  return int(*value);
+}
+
+SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std::string& source) {
+  const toml::table root = parse_toml(text, source);
+  for (const auto& [k, v] : root) {
+    const std::string name(k.str());
+    if (name != "domain" && name != "geometry" && name != "formulation" && name != "data" && name != "solver" &&
+        name != "output")
+      fail(name, "unknown section of a 3-D problem (domain, geometry, formulation, data, solver, output)");
+  }
+  SurfaceProblemSpec spec;
+  SurfaceProblem& p = spec.problem;
+  SolverOptions& o = spec.options;
+  Problem plane;  // the schema's options are read into a 2-D problem; its N, boundary and c are taken over
+  plane.N = 64;
+
+  TableReader domain(subtable(root, "domain"), "domain");
+  domain.number("dim", 3);
+  const double N = domain.number("N", 64);
+  if (N != std::floor(N) || N < 8 || N > 1024) fail("domain.N", "expected a whole number of cells, 8 <= N <= 1024");
+  p.N = int(N);
+  const std::string boundary = domain.string("boundary", "dirichlet");
+  if (boundary != "dirichlet" && boundary != "periodic") fail("domain.boundary", "expected dirichlet or periodic");
+  p.boundary = boundary == "dirichlet" ? Boundary::dirichlet : Boundary::periodic;
+  const auto box = domain.numbers("box", 6, {0, 0, 0, 1, 1, 1});
+  for (int d = 0; d < 3; ++d) {
+    if (!(box[d + 3] > box[d])) fail("domain.box", "expected [x0, y0, z0, x1, y1, z1] with x0 < x1, y0 < y1, z0 < z1");
+    p.box.lower[d] = box[d], p.box.upper[d] = box[d + 3];
+  }
+  domain.finish();
+
+  const toml::table* geometry_table = subtable(root, "geometry");
+  if (!geometry_table) fail("geometry", "missing section [geometry]");
+  TableReader geometry(geometry_table, "geometry");
+  const std::string shape = geometry.required_string("shape");
+  const auto center = geometry.required_numbers("center", 3);
+  Point3 axes;
+  if (shape == "sphere") {
+    if (!geometry.has("radius")) fail("geometry.radius", "missing");
+    const double r = geometry.number("radius", 0.0);
+    if (!(r > 0)) fail("geometry.radius", "must be positive");
+    axes = {r, r, r};
+  } else if (shape == "ellipsoid") {
+    const auto a = geometry.required_numbers("semi_axes", 3);
+    axes = {a[0], a[1], a[2]};
+  } else {
+    fail("geometry.shape", "unknown 3-D shape \"" + shape.substr(0, 40) + "\" (sphere, ellipsoid)");
+  }
+  p.gamma = std::make_shared<Ellipsoid>(Point3{center[0], center[1], center[2]}, axes);
+  geometry.finish();
+
+  TableReader formulation(subtable(root, "formulation"), "formulation");
+  formulation.read_options(plane, o);
+  formulation.finish();
+
+  TableReader data(subtable(root, "data"), "data");
+  p.c = data.number("c", 1.0);
+  if (p.c < 0 || p.c > 1e12) fail("data.c", "expected 0 <= c <= 1e12");
+  const Expression f(data.required_string("f"), {"x", "y", "z"}, "data.f");
+  p.f = [f](double x, double y, double z) { return f({x, y, z}); };
+  const Expression g(data.required_string("g"), {"x", "y", "z"}, "data.g");
+  p.g = [g](double x, double y, double z) { return g({x, y, z}); };
+  if (data.has("exact")) {
+    const Expression exact(data.string("exact", ""), {"x", "y", "z"}, "data.exact");
+    p.exact = [exact](double x, double y, double z) { return exact({x, y, z}); };
+  }
+  data.finish();
+
+  TableReader solver(subtable(root, "solver"), "solver");
+  solver.read_options(plane, o);
+  solver.finish();
+  o.validate();
+
+  TableReader output(subtable(root, "output"), "output");
+  spec.output.dir = output.string("dir", spec.output.dir);
+  spec.output.files = surface_output_file_names();
+  if (const toml::array* files = output.array("files")) {
+    spec.output.files.clear();
+    for (const toml::node& file : *files) {
+      const auto name = file.value<std::string>();
+      const auto& names = surface_output_file_names();
+      if (!name || std::find(names.begin(), names.end(), *name) == names.end())
+        fail("output.files", "expected names from results.json, points.csv, solution.vti, surface.vtp");
+      spec.output.files.push_back(*name);
+    }
+  }
+  output.finish();
+  toml::table echo;
+  echo.insert("geometry", *geometry_table);
+  if (const toml::table* d = subtable(root, "data")) echo.insert("data", *d);
+  std::ostringstream json;
+  json << toml::json_formatter{echo};
+  spec.input_json = json.str();
+  spec.name = source;
+  return spec;
+}
+
+const std::vector<std::string>& surface_output_file_names() {
+  static const std::vector<std::string> names = {"results.json", "points.csv", "solution.vti", "surface.vtp"};
+  return names;
+}
+
+ProblemSpec parse_problem_text(const std::string& text, const std::string& source, const ParameterValues& parameters,
+                               std::shared_ptr<const Curve> curve) {
+  toml::table root = parse_toml(text, source);
   for (const auto& [k, v] : root) {
     const std::string name(k.str());
     if (name != "domain" && name != "geometry" && name != "formulation" && name != "data" && name != "solver" &&
@@ -273,6 +391,7 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
   SolverOptions& o = spec.options;
 
   TableReader domain(subtable(root, "domain"), "domain");
+  if (domain.number("dim", 2) != 2) fail("domain.dim", "a 3-D problem (dim = 3) is read by read_surface_problem");
   domain.read_options(p, o);
   domain.finish();
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fictus/problem.hpp"
+#include "fictus/surface_solver.hpp"
 
 namespace fictus {
 
@@ -45,5 +46,21 @@ std::string read_problem_text(const std::string& path);
 
 /// The names `[output] files` accepts.
 const std::vector<std::string>& output_file_names();
+
+/// `[domain] dim` of a problem file's text: 2 (the default) or 3; throws naming domain.dim otherwise.
+int problem_dimension(const std::string& text, const std::string& source = "problem");
+
+/// A 3-D problem file (`[domain] dim = 3`): the surface, the data in x, y, z, the options.
+struct SurfaceProblemSpec {
+  SurfaceProblem problem;
+  SolverOptions options;
+  OutputOptions output;
+  std::string name;        // the file's name without .toml
+  std::string input_json;  // [geometry] and [data] as JSON (results.json echoes it)
+};
+/// Reads and checks one; errors as read_problem_file's, naming the key.
+SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std::string& source = "problem");
+/// The names a 3-D problem's `[output] files` accepts.
+const std::vector<std::string>& surface_output_file_names();
 
 }  // namespace fictus

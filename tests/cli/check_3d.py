@@ -1,0 +1,62 @@
+#!/usr/bin/env python3
+"""A 3-D solve's output folder: results.json (dim 3, converged, errors under the bounds, the Signorini
+conditions at round-off), points.csv (one row per patch, its columns), and the ParaView files read back
+by VTK's own readers (solution.vti: (N+1)³ nodes with u, inside, u_exact, error; surface.vtp: the
+triangles of γ and Γ with per-patch cell data).
+
+usage: check_3d.py FOLDER MAX_REL_L2_OMEGA MAX_REL_L2_GAMMA
+"""
+import csv
+import json
+import os
+import sys
+
+from vtkmodules.vtkIOXML import vtkXMLImageDataReader, vtkXMLPolyDataReader
+from vtkmodules.util.numpy_support import vtk_to_numpy
+
+
+def main():
+    folder, max_l2, max_gamma = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
+    with open(os.path.join(folder, "results.json")) as f:
+        r = json.load(f)
+    assert r["dim"] == 3, r["dim"]
+    assert r["newton"]["converged"] and r["newton"]["iterations"] <= 10, r["newton"]
+    s = r["signorini"]
+    assert s["min_gap"] > -1e-12 and s["min_normal_derivative"] > -1e-10 and s["max_complementarity"] < 1e-12, s
+    e = r["errors"]
+    assert e["rel_l2_omega"] < max_l2, e
+    assert e["rel_l2_gamma"] < max_gamma, e
+    m, N = r["multipliers"], r["grid"]["N"]
+    with open(os.path.join(folder, "points.csv")) as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == m, (len(rows), m)
+    assert list(rows[0].keys()) == "patch x y z nx ny nz area u g dudn lambda contact".split(), rows[0].keys()
+    assert sum(int(row["contact"]) for row in rows) == r["contact"]["points"]
+    assert abs(sum(float(row["area"]) for row in rows) - r["surface"]["area"]) < 1e-9
+
+    image = vtkXMLImageDataReader()
+    image.SetFileName(os.path.join(folder, "solution.vti"))
+    image.Update()
+    data = image.GetOutput()
+    assert data.GetDimensions() == (N + 1, N + 1, N + 1), data.GetDimensions()
+    point_data = data.GetPointData()
+    u, inside, error = (vtk_to_numpy(point_data.GetArray(k)) for k in ("u", "inside", "error"))
+    exact = vtk_to_numpy(point_data.GetArray("u_exact"))
+    assert inside.sum() > 0 and abs(u[inside == 1] - exact[inside == 1] - error[inside == 1]).max() < 1e-12
+    # the nodal error in ω is of the size of the L² error (a field of the right shape and order)
+    assert abs(error).max() < 100 * max_l2 * abs(exact).max(), abs(error).max()
+
+    poly = vtkXMLPolyDataReader()
+    poly.SetFileName(os.path.join(folder, "surface.vtp"))
+    poly.Update()
+    surface = poly.GetOutput()
+    cells = surface.GetCellData()
+    patch, contact = vtk_to_numpy(cells.GetArray("patch")), vtk_to_numpy(cells.GetArray("contact"))
+    assert surface.GetNumberOfCells() == len(patch) > m, surface.GetNumberOfCells()
+    assert patch.max() == m - 1 and set(contact.tolist()) <= {0, 1}
+    print(f"3-D output checked: N = {N}, m = {m}, L2(omega) {e['rel_l2_omega']:.3e}, "
+          f"{surface.GetNumberOfCells()} triangles")
+
+
+if __name__ == "__main__":
+    main()
