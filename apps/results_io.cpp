@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <variant>
@@ -36,6 +38,55 @@ json options_schema_json() {
   return list;
 }
 
+namespace {
+
+json newton_json(const NewtonResult& n) {
+  json history = json::array();
+  for (const NewtonStep& step : n.history)
+    history.push_back({{"n_active", step.n_active},
+                       {"inner_iterations", step.inner_iterations},
+                       {"residual", step.residual},
+                       {"n_changed", step.n_changed}});
+  json j = {{"iterations", n.iterations},
+            {"converged", n.converged},
+            {"n_active", std::count(n.active.begin(), n.active.end(), 1)},
+            {"residual", n.residual},
+            {"history", history}};
+  if (!n.converged) j["failure"] = n.failure;
+  return j;
+}
+
+json timings_json(const Timings& t) {
+  json timings;
+  for (const auto& [phase, seconds] : t.phases) timings[phase] = seconds;
+  timings["total"] = t.total;
+  return timings;
+}
+
+json signorini_json(const SignoriniCheck& s) {
+  return {{"min_gap", s.min_gap},
+          {"min_normal_derivative", s.min_normal_derivative},
+          {"max_complementarity", s.max_complementarity}};
+}
+
+json errors_json(const ErrorNorms& e, const std::optional<PointErrors>& point_errors) {
+  json j = {{"l2_omega", e.l2_omega},
+            {"h1_omega", e.h1_omega},
+            {"h1semi_omega", e.h1semi_omega},
+            {"l2_gamma", e.l2_gamma},
+            {"rel_l2_omega", e.rel_l2_omega},
+            {"rel_h1_omega", e.rel_h1_omega},
+            {"rel_h1semi_omega", e.rel_h1semi_omega},
+            {"rel_l2_gamma", e.rel_l2_gamma}};
+  if (point_errors) {
+    j["max_trace_at_points"] = point_errors->max_trace;
+    j["max_normal_derivative_at_points"] = point_errors->max_normal_derivative;
+  }
+  return j;
+}
+
+}  // namespace
+
 json solution_to_json(const Problem& problem, const Solution& s, const json& input) {
   json j;
   j["version"] = FICTUS_VERSION;
@@ -51,29 +102,13 @@ json solution_to_json(const Problem& problem, const Solution& s, const json& inp
                {"n_unknowns", s.grid.n_unknowns()}};
   j["multipliers"] = s.collocation.m;
   j["curve"] = {{"length", s.collocation.length}, {"spacing", s.collocation.spacing}, {"delta", s.delta}};
-  json history = json::array();
-  for (const NewtonStep& step : s.newton.history)
-    history.push_back({{"n_active", step.n_active},
-                       {"inner_iterations", step.inner_iterations},
-                       {"residual", step.residual},
-                       {"n_changed", step.n_changed}});
-  j["newton"] = {{"iterations", s.newton.iterations},
-                 {"converged", s.newton.converged},
-                 {"n_active", std::count(s.newton.active.begin(), s.newton.active.end(), 1)},
-                 {"residual", s.newton.residual},
-                 {"history", history}};
-  if (!s.newton.converged) j["newton"]["failure"] = s.newton.failure;
+  j["newton"] = newton_json(s.newton);
   j["inner"] = {{"solver", to_string(s.options.inner)},
                 {"fast_solves", s.fast_solves},
                 {"krylov_iterations", s.inner_iterations}};
-  json timings;
-  for (const auto& [phase, seconds] : s.timings.phases) timings[phase] = seconds;
-  timings["total"] = s.timings.total;
-  j["timings"] = timings;
+  j["timings"] = timings_json(s.timings);
   j["condition_number"] = s.condition_number ? json(*s.condition_number) : json(nullptr);
-  j["signorini"] = {{"min_gap", s.signorini.min_gap},
-                    {"min_normal_derivative", s.signorini.min_normal_derivative},
-                    {"max_complementarity", s.signorini.max_complementarity}};
+  j["signorini"] = signorini_json(s.signorini);
   const ContactSummary contact = contact_summary(s);
   j["contact"] = {{"points", contact.points},          {"measure", contact.measure}, {"force", contact.force},
                   {"lambda_integral", contact.lambda}, {"min_gap", contact.min_gap}, {"max_gap", contact.max_gap}};
@@ -83,21 +118,7 @@ json solution_to_json(const Problem& problem, const Solution& s, const json& inp
                                {"max_complementarity", s.check->max_complementarity},
                                {"max_difference", s.check->max_difference},
                                {"rms_difference", s.check->rms_difference}};
-  if (s.errors) {
-    const ErrorNorms& e = *s.errors;
-    j["errors"] = {{"l2_omega", e.l2_omega},
-                   {"h1_omega", e.h1_omega},
-                   {"h1semi_omega", e.h1semi_omega},
-                   {"l2_gamma", e.l2_gamma},
-                   {"rel_l2_omega", e.rel_l2_omega},
-                   {"rel_h1_omega", e.rel_h1_omega},
-                   {"rel_h1semi_omega", e.rel_h1semi_omega},
-                   {"rel_l2_gamma", e.rel_l2_gamma}};
-    if (s.point_errors) {
-      j["errors"]["max_trace_at_points"] = s.point_errors->max_trace;
-      j["errors"]["max_normal_derivative_at_points"] = s.point_errors->max_normal_derivative;
-    }
-  }
+  if (s.errors) j["errors"] = errors_json(*s.errors, s.point_errors);
   j["peak_memory_bytes"] = s.peak_memory_bytes;
   return j;
 }
@@ -238,39 +259,23 @@ json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& s) 
   for (double a : s.gamma.area) area += a;
   j["surface"] = {{"area", area}, {"triangles", s.gamma.triangles.size()}, {"delta", s.delta}};
   j["alpha"] = s.alpha;
-  json history = json::array();
-  for (const NewtonStep& step : s.newton.history)
-    history.push_back({{"n_active", step.n_active},
-                       {"inner_iterations", step.inner_iterations},
-                       {"residual", step.residual},
-                       {"n_changed", step.n_changed}});
-  j["newton"] = {{"iterations", s.newton.iterations},
-                 {"converged", s.newton.converged},
-                 {"residual", s.newton.residual},
-                 {"history", history}};
-  j["fast_solves"] = s.fast_solves;
-  j["inner_iterations"] = s.inner_iterations;
-  j["signorini"] = {{"min_gap", s.signorini.min_gap},
-                    {"min_normal_derivative", s.signorini.min_normal_derivative},
-                    {"max_complementarity", s.signorini.max_complementarity}};
-  double contact_area = 0, force = 0;
+  j["newton"] = newton_json(s.newton);
+  j["inner"] = {{"solver", to_string(s.options.inner)},
+                {"fast_solves", s.fast_solves},
+                {"krylov_iterations", s.inner_iterations}};
+  j["signorini"] = signorini_json(s.signorini);
   long points = 0;
-  for (int p = 0; p < s.gamma.m; ++p)
+  double contact_area = 0, force = 0, min_gap = std::numeric_limits<double>::infinity(), max_gap = -min_gap;
+  for (int p = 0; p < s.gamma.m; ++p) {  // as contact_summary in 2-D, with patch areas for arcs
+    const double gap = s.trace[p] - s.g[p];
+    min_gap = std::min(min_gap, gap), max_gap = std::max(max_gap, gap);
     if (s.newton.active[p] == 1)
       ++points, contact_area += s.gamma.area[p], force += s.normal_derivative[p] * s.gamma.area[p];
-  j["contact"] = {{"points", points}, {"area", contact_area}, {"force", force}, {"lambda_integral", s.lambda_total}};
-  if (s.errors)
-    j["errors"] = {{"l2_omega", s.errors->l2_omega},         {"h1semi_omega", s.errors->h1semi_omega},
-                   {"h1_omega", s.errors->h1_omega},         {"l2_gamma", s.errors->l2_gamma},
-                   {"rel_l2_omega", s.errors->rel_l2_omega}, {"rel_h1semi_omega", s.errors->rel_h1semi_omega},
-                   {"rel_h1_omega", s.errors->rel_h1_omega}, {"rel_l2_gamma", s.errors->rel_l2_gamma}};
-  if (s.point_errors)
-    j["point_errors"] = {{"max_trace", s.point_errors->max_trace},
-                         {"max_normal_derivative", s.point_errors->max_normal_derivative}};
-  json timings = json::object();
-  for (const auto& [phase, seconds] : s.timings.phases) timings[phase] = seconds;
-  timings["total"] = s.timings.total;
-  j["timings"] = timings;
+  }
+  j["contact"] = {{"points", points},   {"area", contact_area}, {"force", force}, {"lambda_integral", s.lambda_total},
+                  {"min_gap", min_gap}, {"max_gap", max_gap}};
+  if (s.errors) j["errors"] = errors_json(*s.errors, s.point_errors);
+  j["timings"] = timings_json(s.timings);
   j["peak_memory_bytes"] = s.peak_memory_bytes;
   return j;
 }

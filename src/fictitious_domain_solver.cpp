@@ -15,8 +15,13 @@
 #include "fictus/load_vector.hpp"
 #include "fictus/options.hpp"
 #include "fictus/schur_complement.hpp"
+#include "solve_steps.hpp"
 
 namespace fictus {
+
+using detail::PhaseClock;
+using detail::row_sums;
+using detail::to_eigen;
 
 double Timings::operator[](const std::string& name) const {
   for (const auto& [phase, seconds] : phases)
@@ -26,41 +31,6 @@ double Timings::operator[](const std::string& name) const {
 
 namespace {
 
-class PhaseClock {
- public:
-  PhaseClock(Timings& timings, const Execution& execution)
-      : timings_(timings), execution_(execution), start_(now()), last_(start_) {}
-  void mark(const std::string& phase) {
-    const auto t = now();
-    timings_.phases.emplace_back(phase, seconds(last_, t));
-    timings_.total = seconds(start_, t);
-    last_ = t;
-    execution_.report(phase, timings_.phases.back().second);
-  }
-
- private:
-  using Clock = std::chrono::steady_clock;
-  static Clock::time_point now() { return Clock::now(); }
-  static double seconds(Clock::time_point a, Clock::time_point b) {
-    return std::chrono::duration<double>(b - a).count();
-  }
-  Timings& timings_;
-  const Execution& execution_;
-  Clock::time_point start_, last_;
-};
-
-Eigen::VectorXd to_eigen(const std::vector<double>& v) {
-  return Eigen::Map<const Eigen::VectorXd>(v.data(), Eigen::Index(v.size()));
-}
-
-/// R·1: the sum of each row's entries.
-Eigen::VectorXd row_sums(const SparseRows& rows) {
-  Eigen::VectorXd sums = Eigen::VectorXd::Zero(rows.n_rows());
-  for (int r = 0; r < rows.n_rows(); ++r)
-    for (std::size_t k = rows.row_begin[r]; k < rows.row_begin[r + 1]; ++k) sums(r) += rows.entries[k].value;
-  return sums;
-}
-
 /// The options that shape steps 1–3: a change in any of them rebuilds the curve's rows and blocks.
 bool same_curve_options(const SolverOptions& a, const SolverOptions& b) {
   return a.variant == b.variant && a.multipliers == b.multipliers && a.offset == b.offset &&
@@ -68,9 +38,7 @@ bool same_curve_options(const SolverOptions& a, const SolverOptions& b) {
          a.krylov_tolerance == b.krylov_tolerance && a.krylov_max_iterations == b.krylov_max_iterations;
 }
 
-/// The largest |u₀|, |g|, |λ| a solve accepts: the Newton residuals, the LU and the norms square
-/// these values, which must stay far from the overflow at 1.8e308.
-constexpr double largest_scale = 1e100;
+using detail::largest_scale;
 
 bool same_box(const Box2& a, const Box2& b) {
   return a.lower.x == b.lower.x && a.lower.y == b.lower.y && a.upper.x == b.upper.x && a.upper.y == b.upper.y;
@@ -207,12 +175,8 @@ void load_and_u0(State& st, PhaseClock& clock, std::size_t& fast_solves) {
 std::unique_ptr<SchurComplement> schur_blocks(State& st, const BoundaryDiscretization& boundary,
                                               const SolverOptions& options, PhaseClock& clock) {
   if (options.inner == InnerSolver::krylov) {
-    GmresOptions gmres;
-    gmres.relative_tolerance = options.krylov_tolerance;
-    gmres.max_iterations = options.krylov_max_iterations;
-    gmres.restart = boundary.n_points() + 1;
-    gmres.between_iterations = [&execution = st.execution] { execution.throw_if_interrupted(); };
-    return std::make_unique<ImplicitSchur>(*st.fast, boundary.B_gamma(), boundary.C_gamma(), boundary.loads(), gmres,
+    return std::make_unique<ImplicitSchur>(*st.fast, boundary.B_gamma(), boundary.C_gamma(), boundary.loads(),
+                                           detail::gmres_options(options, boundary.n_points(), st.execution),
                                            boundary.direct());
   }
   if (!st.green) {
@@ -286,12 +250,7 @@ std::vector<double> obstacle(const ContactData& data, const BoundaryDiscretizati
 /// Step 5: semismooth Newton on λ with the Schur blocks.
 void newton(const CurveSetup& setup, const SolverOptions& options, const Execution& execution, Solution& sol,
             std::size_t& fast_solves) {
-  NewtonOptions newton_options;
-  newton_options.between_steps = [&execution] { execution.throw_if_interrupted(); };
-  newton_options.rho = options.rho;
-  newton_options.max_iterations = options.max_newton;
-  newton_options.start_all_active = options.start_all_active;
-  newton_options.tolerance = options.newton_tolerance;
+  const NewtonOptions newton_options = detail::newton_options(options, execution);
   const std::size_t before = setup.schur->fast_solves();
   sol.newton = solve_semismooth_newton(*setup.schur, setup.b0, setup.c0, to_eigen(sol.g), newton_options,
                                        setup.mode ? &*setup.mode : nullptr);
@@ -326,14 +285,7 @@ void field(const State& st, const BoundaryDiscretization& boundary, Solution& so
 /// Step 7: the Signorini conditions at the points, and again with an independent ∂u/∂n.
 void signorini_checks(const BoundaryDiscretization& boundary, Solution& sol) {
   const int m = boundary.n_points();
-  SignoriniCheck& s = sol.signorini;
-  s.min_gap = s.min_normal_derivative = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < m; ++i) {
-    const double gap = sol.trace[i] - sol.g[i], dn = sol.normal_derivative[i];
-    s.min_gap = std::min(s.min_gap, gap);
-    s.min_normal_derivative = std::min(s.min_normal_derivative, dn);
-    s.max_complementarity = std::max(s.max_complementarity, std::abs(gap * dn));
-  }
+  sol.signorini = detail::signorini_check(sol.trace, sol.normal_derivative, sol.g);
   if (sol.u.empty()) return;
   IndependentCheck check;
   const std::optional<std::vector<double>> d = boundary.independent_normal_derivative(sol.u, check.rule);

@@ -146,6 +146,10 @@ template ExplicitSchur::ExplicitSchur(const GreenTable<3>&, const SparseRows&, c
                                       const Execution&, const DirectTerms&);
 template Eigen::MatrixXd green_block(const GreenTable<2>&, const SparseRows&, const SparseRows&, const Execution&);
 template Eigen::MatrixXd green_block(const GreenTable<3>&, const SparseRows&, const SparseRows&, const Execution&);
+template std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>&, const std::vector<const SparseRows*>&,
+                                                   const SparseRows&, const Execution&);
+template std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<3>&, const std::vector<const SparseRows*>&,
+                                                   const SparseRows&, const Execution&);
 
 void ExplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const {
   sb = S_B_ * lambda;

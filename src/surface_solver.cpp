@@ -18,6 +18,7 @@
 #include "fictus/quadrature.hpp"
 #include "fictus/schur_complement.hpp"
 #include "fictus/trace_operators.hpp"
+#include "solve_steps.hpp"
 
 namespace fictus {
 
@@ -278,22 +279,8 @@ ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surfac
 
 namespace {
 
-class Clock {
- public:
-  Clock(Timings& timings, const Execution& execution) : timings_(timings), execution_(execution) {}
-  void mark(const std::string& phase) {
-    const auto t = std::chrono::steady_clock::now();
-    timings_.phases.emplace_back(phase, std::chrono::duration<double>(t - last_).count());
-    timings_.total = std::chrono::duration<double>(t - start_).count();
-    last_ = t;
-    execution_.report(phase, timings_.phases.back().second);
-  }
-
- private:
-  Timings& timings_;
-  const Execution& execution_;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now(), last_ = start_;
-};
+using detail::row_sums;
+using detail::to_eigen;
 
 std::string format(const char* pattern, double a, double b = 0, double c = 0) {
   char buffer[256];
@@ -327,17 +314,6 @@ std::vector<Triangle3> offset_triangles(const std::vector<Triangle3>& triangles,
   return out;
 }
 
-Eigen::VectorXd row_sums(const SparseRows& rows) {
-  Eigen::VectorXd sums = Eigen::VectorXd::Zero(rows.n_rows());
-  for (int r = 0; r < rows.n_rows(); ++r)
-    for (std::size_t k = rows.row_begin[r]; k < rows.row_begin[r + 1]; ++k) sums(r) += rows.entries[k].value;
-  return sums;
-}
-
-Eigen::VectorXd to_eigen(const std::vector<double>& v) {
-  return Eigen::Map<const Eigen::VectorXd>(v.data(), Eigen::Index(v.size()));
-}
-
 }  // namespace
 
 SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
@@ -353,7 +329,7 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   const Surface& gamma = *problem.gamma;
   const double h = grid.h();
   SurfaceSolution sol(grid);
-  Clock clock(sol.timings, execution);
+  detail::PhaseClock clock(sol.timings, execution);
   Eigen::setNbThreads(options.threads);
 
   check_inside_box(gamma, grid, 0, "geometry");  // before any work
@@ -369,6 +345,12 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   clock.mark("load");
   fast->solve_in_place(u0);
   ++sol.fast_solves;
+  for (double v : u0)
+    if (!(std::abs(v) <= detail::largest_scale))
+      throw std::invalid_argument(
+          format("data.f: u0 = A^-1 f reaches %.3g, beyond %.0e: rescale the problem (u, f and g "
+                 "by one factor)",
+                 v, detail::largest_scale));
   clock.mark("u0");
 
   // 1. Geometry: the patches of γ, δ and Γ.
@@ -415,12 +397,8 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   std::unique_ptr<GreenTable<3>> green;
   std::unique_ptr<SchurComplement> schur;
   if (options.inner == InnerSolver::krylov) {
-    GmresOptions gmres;
-    gmres.relative_tolerance = options.krylov_tolerance;
-    gmres.max_iterations = options.krylov_max_iterations;
-    gmres.restart = m + 1;
-    gmres.between_iterations = [&execution] { execution.throw_if_interrupted(); };
-    schur = std::make_unique<ImplicitSchur>(*fast, B_gamma, C_gamma, B_Gamma, gmres);
+    schur =
+        std::make_unique<ImplicitSchur>(*fast, B_gamma, C_gamma, B_Gamma, detail::gmres_options(options, m, execution));
   } else {
     green = std::make_unique<GreenTable<3>>(grid, problem.c, execution);
     clock.mark("green_table");
@@ -436,6 +414,9 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
     sol.g[p] = problem.g(x.x, x.y, x.z);
     if (!std::isfinite(sol.g[p]))
       throw std::invalid_argument(format("data.g: not finite at the point (%.6g, %.6g, %.6g)", x.x, x.y, x.z));
+    if (std::abs(sol.g[p]) > detail::largest_scale)
+      throw std::invalid_argument(format("data.g: %.3g is beyond %.0e: rescale the problem (u, f and g by one factor)",
+                                         sol.g[p], detail::largest_scale));
   }
 
   // 5. Newton.
@@ -444,19 +425,19 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   C_gamma.multiply(u0, c0);
   std::optional<ConstantMode> mode;
   if (fast->singular()) mode = ConstantMode{row_sums(B_gamma), row_sums(C_gamma), row_sums(B_Gamma), load_total};
-  NewtonOptions newton_options;
-  newton_options.between_steps = [&execution] { execution.throw_if_interrupted(); };
-  newton_options.rho = options.rho;
-  newton_options.max_iterations = options.max_newton;
-  newton_options.start_all_active = options.start_all_active;
-  newton_options.tolerance = options.newton_tolerance;
-  sol.newton = solve_semismooth_newton(*schur, to_eigen(b0), to_eigen(c0), to_eigen(sol.g), newton_options,
-                                       mode ? &*mode : nullptr);
+  sol.newton = solve_semismooth_newton(*schur, to_eigen(b0), to_eigen(c0), to_eigen(sol.g),
+                                       detail::newton_options(options, execution), mode ? &*mode : nullptr);
   sol.fast_solves += schur->fast_solves();
   for (const NewtonStep& step : sol.newton.history) sol.inner_iterations += step.inner_iterations;
   sol.lambda.assign(sol.newton.lambda.data(), sol.newton.lambda.data() + m);
   sol.lambda_total = row_sums(B_Gamma).dot(sol.newton.lambda);
   sol.alpha = sol.newton.alpha;
+  for (double v : sol.lambda)
+    if (!(std::abs(v) <= detail::largest_scale) || !std::isfinite(sol.alpha))
+      throw std::invalid_argument(
+          format("data.g: the multipliers reach %.3g, beyond %.0e: rescale the problem (u, f "
+                 "and g by one factor)",
+                 v, detail::largest_scale));
   clock.mark("newton");
 
   // 6. The field.
@@ -471,15 +452,7 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   C_gamma.multiply(sol.u, sol.normal_derivative);
   clock.mark("final_solve");
 
-  // 7. Signorini conditions at the points.
-  SignoriniCheck& s = sol.signorini;
-  s.min_gap = s.min_normal_derivative = std::numeric_limits<double>::infinity();
-  for (int p = 0; p < m; ++p) {
-    const double gap = sol.trace[p] - sol.g[p], dn = sol.normal_derivative[p];
-    s.min_gap = std::min(s.min_gap, gap);
-    s.min_normal_derivative = std::min(s.min_normal_derivative, dn);
-    s.max_complementarity = std::max(s.max_complementarity, std::abs(gap * dn));
-  }
+  sol.signorini = detail::signorini_check(sol.trace, sol.normal_derivative, sol.g);  // 7
 
   // 8. Errors.
   if (problem.exact) {

@@ -198,6 +198,15 @@ dir = "results/manufactured_{p['name']}"
         out.write(text)
 
 
+def cxx_function(name, expr, parameters):
+    """An inline C++ function `name(parameters)` of expr, common subexpressions as locals t0, t1, …"""
+    printer = CxxPrinter()
+    subs, (main,) = sp.cse(expr, symbols=sp.numbered_symbols("t"), optimizations="basic")
+    return ([f"inline double {name}({parameters}) {{"]
+            + [f"  const double {printer.doprint(s)} = {printer.doprint(v)};" for s, v in subs]
+            + [f"  return {printer.doprint(main)};", "}"])
+
+
 def write_cxx(items):
     printer = CxxPrinter()
     lines = ["#pragma once",
@@ -213,12 +222,7 @@ def write_cxx(items):
         name = p["name"]
         lines.append(f"namespace {name} {{")
         for key in ("u", "ux", "uy", "f", "g"):
-            subs, (main,) = sp.cse(e[key], symbols=sp.numbered_symbols("t"), optimizations="basic")
-            body = [f"  const double {printer.doprint(s)} = {printer.doprint(v)};" for s, v in subs]
-            lines.append(f"inline double {key}(double x, double y) {{")
-            lines += body
-            lines.append(f"  return {printer.doprint(main)};")
-            lines.append("}")
+            lines += cxx_function(key, e[key], "double x, double y")
         lines.append(f"}}  // namespace {name}")
         lines.append("")
     lines.append("struct Problem { std::string name; fictus::Problem problem; };")
