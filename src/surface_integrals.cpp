@@ -87,8 +87,12 @@ std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Tr
     throw std::invalid_argument("patch_integrals: one patch per triangle is needed");
   const double h = grid.h();
   const Box<3>& box = grid.box();
-  // (patch, k, j, i) → value: sorted by patch, then by the node with i fastest.
-  std::map<std::tuple<int, int, int, int>, double> sums;
+  // (patch, k, j, i) and value, for every piece's corner; sorted and merged at the end.
+  struct Item {
+    std::tuple<int, int, int, int> key;
+    double value;
+  };
+  std::vector<Item> items;
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     const int patch = patch_of[t];
     if (patch < 0 || patch >= n_patches) throw std::invalid_argument("patch_integrals: patch out of range");
@@ -106,6 +110,7 @@ std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Tr
       Grid3::Index cell;
       for (int d = 0; d < 3; ++d)
         cell[d] = std::clamp(int(std::floor((centroid[d] - box.lower[d]) / h)), 0, grid.n(d) - 1);
+      std::array<double, 8> corner_sum{};                   // ∫_piece φ of the cell's 8 corners
       for (std::size_t f = 1; f + 1 < piece.size(); ++f) {  // the fan from the first vertex
         const Point3 &a = piece[0], &b = piece[f], &c = piece[f + 1];
         const double jacobian = 2.0 * area({a, b, c});
@@ -117,22 +122,29 @@ std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Tr
           for (int d = 0; d < 3; ++d) xi[d] = (x[d] - grid.coordinate(d, cell[d])) / h;
           for (int corner = 0; corner < 8; ++corner) {
             double phi = weight;
-            Grid3::Index node = cell;
-            for (int d = 0; d < 3; ++d) {
-              const int up = (corner >> d) & 1;
-              phi *= up ? xi[d] : 1 - xi[d];
-              node[d] += up;
-            }
-            sums[{patch, node[2], node[1], node[0]}] += phi;
+            for (int d = 0; d < 3; ++d) phi *= (corner >> d) & 1 ? xi[d] : 1 - xi[d];
+            corner_sum[corner] += phi;
           }
         }
       }
+      for (int corner = 0; corner < 8; ++corner) {
+        Grid3::Index node = cell;
+        for (int d = 0; d < 3; ++d) node[d] += (corner >> d) & 1;
+        items.push_back({{patch, node[2], node[1], node[0]}, corner_sum[corner]});
+      }
     }
   }
+  // Sorted by patch, then by the node with i fastest; the sums over equal keys in a fixed order.
+  std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.key < b.key; });
   std::vector<PatchWeight> out;
-  out.reserve(sums.size());
-  for (const auto& [key, value] : sums)
+  for (std::size_t k = 0; k < items.size();) {
+    double value = 0.0;
+    std::size_t e = k;
+    for (; e < items.size() && items[e].key == items[k].key; ++e) value += items[e].value;
+    const auto& key = items[k].key;
     if (value != 0.0) out.push_back({std::get<0>(key), {std::get<3>(key), std::get<2>(key), std::get<1>(key)}, value});
+    k = e;
+  }
   return out;
 }
 
@@ -193,14 +205,35 @@ PatchedSurface ellipsoid_patches(Point3 center, Point3 semi_axes, int m, double 
   std::vector<Point3> seeds(m);
   for (int p = 0; p < m; ++p) seeds[p] = centroid[std::size_t(p) * count / std::size_t(m)];
   s.patch_of.assign(count, 0);
+  // The nearest seed by buckets of side 2·(patch spacing): when the nearest one in the 27 buckets
+  // around a centroid is within one bucket side, no seed outside them is nearer; else all are searched.
+  double total_area = 0;
+  for (double w : weight) total_area += w;
+  const double bucket = 2 * std::sqrt(total_area / m);
+  const auto bucket_of = [&](const Point3& p) {
+    return std::array<long, 3>{long(std::floor((p.x - center.x) / bucket)), long(std::floor((p.y - center.y) / bucket)),
+                               long(std::floor((p.z - center.z) / bucket))};
+  };
   for (int iteration = 0; iteration < 30; ++iteration) {
+    std::map<std::array<long, 3>, std::vector<int>> buckets;
+    for (int p = 0; p < m; ++p) buckets[bucket_of(seeds[p])].push_back(p);
     for (std::size_t t = 0; t < count; ++t) {
       double best = 1e300;
-      for (int p = 0; p < m; ++p) {
+      const auto nearest = [&](int p) {
         const Point3 d = centroid[t] - seeds[p];
         const double distance = dot(d, d);
-        if (distance < best) best = distance, s.patch_of[t] = p;
-      }
+        if (distance < best || (distance == best && p < s.patch_of[t])) best = distance, s.patch_of[t] = p;
+      };
+      const std::array<long, 3> b = bucket_of(centroid[t]);
+      for (long dz = -1; dz <= 1; ++dz)
+        for (long dy = -1; dy <= 1; ++dy)
+          for (long dx = -1; dx <= 1; ++dx) {
+            const auto it = buckets.find({b[0] + dx, b[1] + dy, b[2] + dz});
+            if (it != buckets.end())
+              for (int p : it->second) nearest(p);
+          }
+      if (best > bucket * bucket)
+        for (int p = 0; p < m; ++p) nearest(p);
     }
     std::vector<Point3> sum(m);
     std::vector<double> total(m, 0.0);
