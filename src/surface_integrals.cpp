@@ -210,13 +210,26 @@ PatchedSurface ellipsoid_patches(Point3 center, Point3 semi_axes, int m, double 
   double total_area = 0;
   for (double w : weight) total_area += w;
   const double bucket = 2 * std::sqrt(total_area / m);
-  const auto bucket_of = [&](const Point3& p) {
-    return std::array<long, 3>{long(std::floor((p.x - center.x) / bucket)), long(std::floor((p.y - center.y) / bucket)),
-                               long(std::floor((p.z - center.z) / bucket))};
+  Point3 low = centroid[0], high = centroid[0];
+  for (const Point3& c : centroid)
+    for (int d = 0; d < 3; ++d) low[d] = std::min(low[d], c[d]), high[d] = std::max(high[d], c[d]);
+  std::array<int, 3> size;  // buckets along each axis, over the centroids' box
+  for (int d = 0; d < 3; ++d) size[d] = int(std::floor((high[d] - low[d]) / bucket)) + 1;
+  const auto bucket_of = [&](const Point3& p, int d) {  // may lie outside [0, size) for a seed
+    return int(std::floor((p[d] - low[d]) / bucket));
   };
+  std::vector<std::vector<int>> buckets(std::size_t(size[0]) * size[1] * size[2]);
   for (int iteration = 0; iteration < 30; ++iteration) {
-    std::map<std::array<long, 3>, std::vector<int>> buckets;
-    for (int p = 0; p < m; ++p) buckets[bucket_of(seeds[p])].push_back(p);
+    for (auto& b : buckets) b.clear();
+    std::vector<int> outside;  // seeds beyond the centroids' box (searched for every triangle)
+    for (int p = 0; p < m; ++p) {
+      int b[3];
+      for (int d = 0; d < 3; ++d) b[d] = bucket_of(seeds[p], d);
+      if (b[0] < 0 || b[1] < 0 || b[2] < 0 || b[0] >= size[0] || b[1] >= size[1] || b[2] >= size[2])
+        outside.push_back(p);
+      else
+        buckets[(std::size_t(b[2]) * size[1] + b[1]) * size[0] + b[0]].push_back(p);
+    }
     for (std::size_t t = 0; t < count; ++t) {
       double best = 1e300;
       const auto nearest = [&](int p) {
@@ -224,14 +237,13 @@ PatchedSurface ellipsoid_patches(Point3 center, Point3 semi_axes, int m, double 
         const double distance = dot(d, d);
         if (distance < best || (distance == best && p < s.patch_of[t])) best = distance, s.patch_of[t] = p;
       };
-      const std::array<long, 3> b = bucket_of(centroid[t]);
-      for (long dz = -1; dz <= 1; ++dz)
-        for (long dy = -1; dy <= 1; ++dy)
-          for (long dx = -1; dx <= 1; ++dx) {
-            const auto it = buckets.find({b[0] + dx, b[1] + dy, b[2] + dz});
-            if (it != buckets.end())
-              for (int p : it->second) nearest(p);
-          }
+      int b[3];
+      for (int d = 0; d < 3; ++d) b[d] = bucket_of(centroid[t], d);
+      for (int z = std::max(b[2] - 1, 0); z <= std::min(b[2] + 1, size[2] - 1); ++z)
+        for (int y = std::max(b[1] - 1, 0); y <= std::min(b[1] + 1, size[1] - 1); ++y)
+          for (int x = std::max(b[0] - 1, 0); x <= std::min(b[0] + 1, size[0] - 1); ++x)
+            for (int p : buckets[(std::size_t(z) * size[1] + y) * size[0] + x]) nearest(p);
+      for (int p : outside) nearest(p);
       if (best > bucket * bucket)
         for (int p = 0; p < m; ++p) nearest(p);
     }
