@@ -4,6 +4,9 @@
 - solution.png  û as a heat map (ω only), γ, Γ and the contact set (from solution.vti, points.csv)
 - profiles.png  u − g, ∂u/∂n and λ along γ against arc length (from points.csv)
 - convergence.png  relative errors against h with the paper's (from table1.csv / table2.csv)
+3-D solves (results.json "dim": 3):
+- slices.png   û on three orthogonal planes through the centre of ω (from solution.vti)
+- surface.png  γ coloured by contact and by λ (from surface.vtp)
 Needs numpy and matplotlib (Debian: python3-numpy, python3-matplotlib).
 """
 import csv
@@ -25,6 +28,14 @@ def plain(axis):
     formatter = ScalarFormatter(useOffset=False)
     formatter.set_powerlimits((-3, 4))
     axis.set_major_formatter(formatter)
+
+
+def dim_of(folder):
+    path = os.path.join(folder, "results.json")
+    if not os.path.exists(path):
+        return 2
+    with open(path) as handle:
+        return json.load(handle).get("dim", 2)
 
 
 def variant_of(folder):
@@ -65,11 +76,10 @@ def read_vti(path):
     for kind, name, offset in re.findall(r'type="(\w+)" Name="(\w+)" format="appended" offset="(\d+)"', text):
         dtype = {"Float64": "<f8", "UInt8": "u1"}[kind]
         values = np.frombuffer(appended_array(raw, int(offset), compressed), dtype=dtype)
-        arrays[name] = values.reshape(extent[3] + 1, extent[1] + 1)
-    nx, ny = extent[1], extent[3]
-    x = origin[0] + spacing[0] * np.arange(nx + 1)
-    y = origin[1] + spacing[1] * np.arange(ny + 1)
-    return x, y, arrays
+        shape = (extent[3] + 1, extent[1] + 1) if extent[5] == 0 else (extent[5] + 1, extent[3] + 1, extent[1] + 1)
+        arrays[name] = values.reshape(shape)
+    axes = [origin[d] + spacing[d] * np.arange(extent[2 * d + 1] + 1) for d in range(3 if extent[5] else 2)]
+    return (*axes, arrays)
 
 
 def read_csv(path):
@@ -184,8 +194,80 @@ def plot_convergence(folder):
     plt.close(fig)
 
 
+def plot_slices(folder):
+    x, y, z, arrays = read_vti(os.path.join(folder, "solution.vti"))
+    inside = arrays["inside"] > 0
+    u = np.where(inside, arrays["u"], np.nan)  # indexed [k, j, i]
+    k, j, i = (int(round(float(np.mean(np.nonzero(inside)[a])))) for a in range(3))
+    panels = [(u[k, :, :], x, y, "x", "y", f"z = {z[k]:.3g}"), (u[:, j, :], x, z, "x", "z", f"y = {y[j]:.3g}"),
+              (u[:, :, i], y, z, "y", "z", f"x = {x[i]:.3g}")]
+    low, high = np.nanmin(u), np.nanmax(u)
+    fig, axes = plt.subplots(1, 3, figsize=(15, 5), constrained_layout=True)
+    for ax, (values, a, b, la, lb, title) in zip(axes, panels):
+        image = ax.pcolormesh(a, b, values, shading="auto", cmap="viridis", vmin=low, vmax=high)
+        ax.set_aspect("equal")
+        ax.set_xlabel(la)
+        ax.set_ylabel(lb)
+        ax.set_title(title, fontsize=10)
+    bar = fig.colorbar(image, ax=axes, label="û in ω", shrink=0.8)
+    plain(bar.ax.yaxis)
+    fig.suptitle("fictus: û on three planes through the centre of ω")
+    fig.savefig(os.path.join(folder, "slices.png"), dpi=110)
+    plt.close(fig)
+
+
+def read_vtp(path):
+    """fictus's own surface.vtp (ASCII PolyData of triangles): the points and the cell arrays."""
+    with open(path) as handle:
+        text = handle.read()
+    def block(name):
+        match = re.search(r'Name="%s"[^>]*>([^<]*)<' % name, text)
+        return np.array(match.group(1).split(), dtype=float)
+    points = np.array(re.search(r"<Points>\s*<DataArray[^>]*>([^<]*)<", text).group(1).split(), dtype=float)
+    cells = {name: block(name) for name in ("surface", "contact", "lambda")}
+    return points.reshape(-1, 3, 3), cells
+
+
+def plot_surface(folder):
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    triangles, cells = read_vtp(os.path.join(folder, "surface.vtp"))
+    on_gamma = cells["surface"] == 0
+    triangles = triangles[on_gamma]
+    fig = plt.figure(figsize=(13, 6), constrained_layout=True)
+    lam = cells["lambda"][on_gamma]
+    colour_maps = [(np.where(cells["contact"][on_gamma] > 0, 1.0, 0.0), plt.get_cmap("coolwarm"), "contact (red)"),
+                   ((lam - lam.min()) / max(np.ptp(lam), 1e-300), plt.get_cmap("viridis"),
+                    f"λ per patch, {lam.min():.3g} … {lam.max():.3g}")]
+    low, high = triangles.reshape(-1, 3).min(axis=0), triangles.reshape(-1, 3).max(axis=0)
+    for k, (values, cmap, title) in enumerate(colour_maps):
+        ax = fig.add_subplot(1, 2, k + 1, projection="3d")
+        ax.add_collection3d(Poly3DCollection(triangles, facecolors=cmap(values), edgecolor="none"))
+        for setter, d in ((ax.set_xlim, 0), (ax.set_ylim, 1), (ax.set_zlim, 2)):
+            setter(low[d], high[d])
+        ax.set_box_aspect(high - low)
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        ax.set_zlabel("z")
+        ax.set_title(title, fontsize=10)
+    fig.suptitle("fictus: γ, its contact set and the multipliers")
+    fig.savefig(os.path.join(folder, "surface.png"), dpi=110)
+    plt.close(fig)
+
+
 def main(folder):
     made = []
+    if dim_of(folder) == 3:
+        if os.path.exists(os.path.join(folder, "solution.vti")):
+            plot_slices(folder)
+            made.append("slices.png")
+        if os.path.exists(os.path.join(folder, "surface.vtp")):
+            plot_surface(folder)
+            made.append("surface.png")
+        if not made:
+            print(f"fictus: error: plot: {folder} holds no solution.vti or surface.vtp", file=sys.stderr)
+            return 1
+        print("wrote " + ", ".join(os.path.join(folder, name) for name in made))
+        return 0
     if os.path.exists(os.path.join(folder, "solution.vti")) and os.path.exists(os.path.join(folder, "points.csv")):
         plot_solution(folder)
         made.append("solution.png")

