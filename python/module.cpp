@@ -1,5 +1,6 @@
 // The Python module `fictus`: Problem (from a dict, TOML text, keyword arguments or the paper),
-// Problem.solve() → Solution with numpy arrays. No numerics here: everything calls the library.
+// Problem.solve() → Solution with numpy arrays; SurfaceProblem / SurfaceSolution for 3-D. No numerics here: everything
+// calls the library.
 #include <pybind11/pybind11.h>
 
 #include "bindings.hpp"
@@ -9,4 +10,5 @@ PYBIND11_MODULE(fictus, m) {
   m.attr("__version__") = FICTUS_PY_VERSION;
   fictus::python::bind_problem(m);
   fictus::python::bind_solution(m);
+  fictus::python::bind_surface(m);
 }

@@ -77,6 +77,14 @@ void insert(toml::table& table, const std::string& key, py::handle value, const 
 
 }  // namespace
 
+std::string toml_text(py::dict sections) {
+  toml::table root;
+  for (auto [k, v] : sections) insert(root, py::str(k), v, py::str(k));
+  std::ostringstream text;
+  text << root;
+  return text.str();
+}
+
 VectorizedField PyProblem::wrap(py::function fn, const std::string& key, std::shared_ptr<CallbackErrors> errors) {
   // The callable is released under the GIL whenever the last copy of the field goes.
   std::shared_ptr<py::function> holder(new py::function(std::move(fn)), [](py::function* f) {
@@ -159,11 +167,7 @@ PyProblem PyProblem::from_config(py::dict config) {
       }
     }
   }
-  toml::table root;
-  for (auto [k, v] : sections) insert(root, py::str(k), v, py::str(k));
-  std::ostringstream text;
-  text << root;
-  p.spec = parse_problem_text(text.str(), "problem");
+  p.spec = parse_problem_text(toml_text(sections), "problem");
   return p;
 }
 

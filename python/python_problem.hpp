@@ -46,6 +46,9 @@ class PySolution {
   std::vector<bool> contact_;
 };
 
+/// A dict of sections ({"domain": {...}, "data": {...}}) as the TOML text of a problem file.
+std::string toml_text(pybind11::dict sections);
+
 struct PyProblem {
   ProblemSpec spec;
   std::map<std::string, pybind11::function> callables;  // data key ("f", "g", "exact") → numpy callable

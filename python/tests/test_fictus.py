@@ -227,3 +227,40 @@ def test_parameters_and_the_contact_summary_match_the_cli(tmp_path):
                                   "data": {"f": "-1", "g": "a * x"}}).solve()
     e = fictus.Problem.from_dict({**CIRCLE, "data": {"f": "-1", "g": "0.05 * x"}}).solve()
     np.testing.assert_array_equal(d.lambda_, e.lambda_)
+
+
+def test_surface_problem_matches_the_cli(tmp_path):
+    """3-D: the manufactured sphere from its file, by the CLI and by Python, gives the same numbers."""
+    path = os.path.join(EXAMPLES, "manufactured_sphere.toml")
+    results, points = cli_solve(tmp_path, path, "--N", "64", "--m", "129")
+    with open(path) as handle:
+        text = handle.read().replace("N = 80", "N = 64").replace('variant = "smooth"', 'variant = "smooth"\nmultipliers = 129')
+    s = fictus.SurfaceProblem.from_toml(text).solve()
+    assert results["dim"] == 3 and s.multipliers == results["multipliers"] == 129
+    assert s.iterations == results["newton"]["iterations"]
+    assert abs(s.errors["rel_l2_omega"] - results["errors"]["rel_l2_omega"]) < 1e-12
+    assert np.allclose(s.lambda_, [float(p["lambda"]) for p in points], rtol=1e-12, atol=1e-12)
+    assert s.u.shape == (65, 65, 65) and s.points.shape == (129, 3)
+    assert list(s.contact) == [p["contact"] == "1" for p in points]
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOXML import vtkXMLImageDataReader
+    reader = vtkXMLImageDataReader()
+    reader.SetFileName(str(tmp_path / "cli" / "solution.vti"))
+    reader.Update()
+    u_cli = vtk_to_numpy(reader.GetOutput().GetPointData().GetArray("u")).reshape(65, 65, 65)
+    assert np.array_equal(s.u, u_cli)  # the same field, in the same [k, j, i] order as the ParaView file
+    x, y, z = s.axes
+    assert x[0] == 0 and z[-1] == 1 and len(y) == 65
+
+
+def test_surface_problem_from_a_dict_and_its_errors():
+    config = dict(domain=dict(N=32), geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.2),
+                  formulation=dict(variant="nonsmooth", normal_derivative="shifted"), data=dict(f="-1", g="0.05 * x"))
+    s = fictus.SurfaceProblem.from_dict(config).solve()
+    assert s.signorini["min_gap"] > -1e-12 and s.signorini["max_complementarity"] < 1e-12
+    assert s.errors is None and 0 < np.count_nonzero(s.contact) < s.multipliers
+    with pytest.raises(ValueError, match="geometry.radius"):
+        fictus.SurfaceProblem(geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=-1), data=dict(f="1", g="0"))
+    with pytest.raises(ValueError, match="data.f: 3-D data are expressions"):
+        fictus.SurfaceProblem(geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.2),
+                              data=dict(f=lambda x, y, z: x, g="0"))

@@ -1,0 +1,194 @@
+// fictus.SurfaceProblem and fictus.SurfaceSolution: 3-D problems (a sphere or an ellipsoid in a box)
+// from a dict or TOML text, through the CLI's reader; û as an (N+1)³ numpy array and the per-patch
+// quantities on γ.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <memory>
+#include <stdexcept>
+
+#include "bindings.hpp"
+#include "fictus/io/problem_file.hpp"
+#include "fictus/io/process.hpp"
+#include "fictus/surface_solver.hpp"
+#include "python_problem.hpp"
+
+namespace py = pybind11;
+
+namespace fictus::python {
+
+namespace {
+
+struct PySurfaceProblem {
+  SurfaceProblemSpec spec;
+
+  static PySurfaceProblem from_config(py::dict config) {
+    py::dict sections;
+    for (auto [k, v] : config) {
+      const std::string key = py::str(k);
+      if (key != "domain" && key != "geometry" && key != "formulation" && key != "data" && key != "solver" &&
+          key != "output")
+        throw std::invalid_argument(key + ": unknown section (domain, geometry, formulation, data, solver, output)");
+      if (!py::isinstance<py::dict>(v)) throw std::invalid_argument(key + ": expected a dict");
+      sections[py::str(key)] = py::dict(v.cast<py::dict>());
+    }
+    if (!sections.contains("domain")) sections["domain"] = py::dict();
+    py::dict domain = sections["domain"];
+    if (!domain.contains("dim")) domain["dim"] = 3;
+    if (sections.contains("data"))
+      for (auto [k, v] : sections["data"].cast<py::dict>())
+        if (!py::isinstance<py::str>(v) && py::isinstance<py::function>(v))
+          throw std::invalid_argument("data." + std::string(py::str(k)) +
+                                      ": 3-D data are expressions in x, y, z (str); callables are 2-D only");
+    PySurfaceProblem p;
+    p.spec = parse_surface_problem_text(toml_text(sections), "problem");
+    return p;
+  }
+};
+
+struct PySurfaceSolution {
+  std::shared_ptr<const SurfaceSolution> s;
+  std::vector<double> points, normals;  // (m, 3), interleaved
+};
+
+PySurfaceSolution solve(const PySurfaceProblem& p) {
+  std::shared_ptr<const SurfaceSolution> solution;
+  {
+    py::gil_scoped_release release;
+    solution = std::make_shared<const SurfaceSolution>(fictus::solve(p.spec.problem, p.spec.options));
+  }
+  std::const_pointer_cast<SurfaceSolution>(solution)->peak_memory_bytes = peak_memory_bytes();
+  if (!solution->newton.converged)
+    throw std::runtime_error("solver.max_newton: Newton did not converge: " + solution->newton.failure);
+  PySurfaceSolution out{solution, {}, {}};
+  for (int i = 0; i < solution->gamma.m; ++i)
+    for (int d = 0; d < 3; ++d) {
+      out.points.push_back(solution->gamma.point[i][d]);
+      out.normals.push_back(solution->gamma.normal[i][d]);
+    }
+  return out;
+}
+
+/// A read-only view of `v` owned by `owner`, of shape (n) or (n/3, 3).
+py::array_t<double> view(const std::vector<double>& v, py::handle owner, bool triples = false) {
+  py::array_t<double> a =
+      triples ? py::array_t<double>({py::ssize_t(v.size() / 3), py::ssize_t(3)},
+                                    {py::ssize_t(3 * sizeof(double)), py::ssize_t(sizeof(double))}, v.data(), owner)
+              : py::array_t<double>({py::ssize_t(v.size())}, {py::ssize_t(sizeof(double))}, v.data(), owner);
+  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return a;
+}
+
+const SurfaceSolution& of(py::handle self) { return *self.cast<const PySurfaceSolution&>().s; }
+
+}  // namespace
+
+void bind_surface(py::module_& m) {
+  py::class_<PySurfaceProblem>(m, "SurfaceProblem", R"doc(A 3-D Signorini problem: a sphere or an ellipsoid in a box.
+
+    SurfaceProblem(domain=..., geometry=..., formulation=..., data=..., solver=...)
+        Sections as dicts with the keys of a 3-D problem file (docs/problem_files.md, "3-D problems");
+        domain.dim = 3 is implied. f, g, exact: expressions in x, y, z (str).
+    SurfaceProblem.from_dict(d), SurfaceProblem.from_toml(text)
+)doc")
+      .def(py::init([](py::kwargs kwargs) { return PySurfaceProblem::from_config(kwargs); }))
+      .def_static(
+          "from_dict", [](py::dict d) { return PySurfaceProblem::from_config(d); }, py::arg("config"))
+      .def_static(
+          "from_toml",
+          [](const std::string& text) { return PySurfaceProblem{parse_surface_problem_text(text, "problem")}; },
+          py::arg("text"))
+      .def_property_readonly("N", [](const PySurfaceProblem& p) { return p.spec.problem.N; })
+      .def("solve", &solve,
+           "Solves (the GIL is released meanwhile) and returns a SurfaceSolution; raises ValueError on bad input "
+           "and RuntimeError when Newton does not converge, with the CLI's messages.");
+
+  py::class_<PySurfaceSolution>(m, "SurfaceSolution", "The result of SurfaceProblem.solve(); arrays are numpy arrays.")
+      .def_property_readonly(
+          "u",
+          [](py::object self) {
+            const SurfaceSolution& s = of(self);
+            const Grid3& g = s.grid;
+            py::array_t<double> u({g.nz() + 1, g.ny() + 1, g.nx() + 1});
+            auto a = u.mutable_unchecked<3>();
+            for (int k = 0; k <= g.nz(); ++k)
+              for (int j = 0; j <= g.ny(); ++j)
+                for (int i = 0; i <= g.nx(); ++i) {
+                  const Grid3::Index node{i, j, k};
+                  a(k, j, i) = g.has_unknown(node) ? s.u[g.index(node)] : 0.0;
+                }
+            return u;
+          },
+          "û at all (N+1)³ nodes, indexed [k, j, i] = (z, y, x) (zero on a Dirichlet boundary)")
+      .def_property_readonly(
+          "axes",
+          [](py::object self) {
+            const Grid3& g = of(self).grid;
+            py::list axes;
+            for (int d = 0; d < 3; ++d) {
+              py::array_t<double> x(g.n(d) + 1);
+              for (int i = 0; i <= g.n(d); ++i) x.mutable_data()[i] = g.coordinate(d, i);
+              axes.append(x);
+            }
+            return py::tuple(axes);
+          },
+          "the node coordinates (x, y, z)")
+      .def_property_readonly(
+          "points", [](py::object self) { return view(self.cast<const PySurfaceSolution&>().points, self, true); },
+          "the collocation point of each patch, (m, 3)")
+      .def_property_readonly(
+          "normals", [](py::object self) { return view(self.cast<const PySurfaceSolution&>().normals, self, true); })
+      .def_property_readonly("area", [](py::object self) { return view(of(self).gamma.area, self); })
+      .def_property_readonly("g", [](py::object self) { return view(of(self).g, self); })
+      .def_property_readonly("u_gamma", [](py::object self) { return view(of(self).trace, self); })
+      .def_property_readonly("dudn", [](py::object self) { return view(of(self).normal_derivative, self); })
+      .def_property_readonly("lambda_", [](py::object self) { return view(of(self).lambda, self); })
+      .def_property_readonly("contact",
+                             [](py::object self) {
+                               const SurfaceSolution& s = of(self);
+                               py::array_t<bool> c(s.gamma.m);
+                               for (int i = 0; i < s.gamma.m; ++i) c.mutable_data()[i] = s.newton.active[i] == 1;
+                               return c;
+                             })
+      .def_property_readonly("iterations", [](py::object self) { return of(self).newton.iterations; })
+      .def_property_readonly("multipliers", [](py::object self) { return of(self).gamma.m; })
+      .def_property_readonly("delta", [](py::object self) { return of(self).delta; })
+      .def_property_readonly("peak_memory_bytes", [](py::object self) { return of(self).peak_memory_bytes; })
+      .def_property_readonly("timings",
+                             [](py::object self) {
+                               py::dict d;
+                               for (const auto& [phase, seconds] : of(self).timings.phases) d[py::str(phase)] = seconds;
+                               d["total"] = of(self).timings.total;
+                               return d;
+                             })
+      .def_property_readonly("signorini",
+                             [](py::object self) {
+                               const SignoriniCheck& c = of(self).signorini;
+                               py::dict d;
+                               d["min_gap"] = c.min_gap;
+                               d["min_normal_derivative"] = c.min_normal_derivative;
+                               d["max_complementarity"] = c.max_complementarity;
+                               return d;
+                             })
+      .def_property_readonly("errors",
+                             [](py::object self) -> py::object {
+                               const auto& e = of(self).errors;
+                               if (!e) return py::none();
+                               py::dict d;
+                               d["l2_omega"] = e->l2_omega, d["h1_omega"] = e->h1_omega;
+                               d["h1semi_omega"] = e->h1semi_omega, d["l2_gamma"] = e->l2_gamma;
+                               d["rel_l2_omega"] = e->rel_l2_omega, d["rel_h1_omega"] = e->rel_h1_omega;
+                               d["rel_h1semi_omega"] = e->rel_h1semi_omega, d["rel_l2_gamma"] = e->rel_l2_gamma;
+                               return d;
+                             })
+      .def("__repr__", [](py::object self) {
+        const SurfaceSolution& s = of(self);
+        return "<fictus.SurfaceSolution N=" + std::to_string(s.grid.nx()) + " m=" + std::to_string(s.gamma.m) +
+               " newton=" + std::to_string(s.newton.iterations) +
+               " active=" + std::to_string(std::count(s.newton.active.begin(), s.newton.active.end(), 1)) + ">";
+      });
+}
+
+}  // namespace fictus::python
