@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <stdexcept>
 #include <tuple>
 
@@ -167,30 +168,7 @@ void icosahedron(std::vector<Point3>& vertices, std::vector<std::array<int, 3>>&
 
 }  // namespace
 
-PatchedSurface ellipsoid_patches(Point3 center, Point3 semi_axes, int m, double edge) {
-  for (int d = 0; d < 3; ++d)
-    if (!(semi_axes[d] > 0) || !std::isfinite(semi_axes[d]))
-      throw std::invalid_argument("geometry.semi_axes: must be positive and finite");
-  if (!(edge > 0)) throw std::invalid_argument("ellipsoid_patches: the edge length must be positive");
-  std::vector<Point3> vertices;
-  std::vector<std::array<int, 3>> faces;
-  icosahedron(vertices, faces);
-  const double largest = std::max({semi_axes.x, semi_axes.y, semi_axes.z});
-  const int n = std::max(1, int(std::ceil(1.1 * largest / edge)));  // icosahedron edge 1.05 on the unit sphere
-  const auto on_ellipsoid = [&](Point3 p) {
-    p = (1.0 / norm(p)) * p;
-    return Point3{center.x + semi_axes.x * p.x, center.y + semi_axes.y * p.y, center.z + semi_axes.z * p.z};
-  };
-  PatchedSurface s;
-  for (const auto& f : faces) {
-    const Point3 &a = vertices[f[0]], &b = vertices[f[1]], &c = vertices[f[2]];
-    auto at = [&](int i, int j) { return on_ellipsoid(a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a)); };
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; i + j < n; ++j) {
-        s.triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
-        if (i + j + 1 < n) s.triangles.push_back({at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
-      }
-  }
+std::vector<Point3> split_into_patches(PatchedSurface& s, int m) {
   const std::size_t count = s.triangles.size();
   if (m < 1 || std::size_t(m) > count / 4)
     throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) + " needs 1 <= m <= " +
@@ -201,7 +179,7 @@ PatchedSurface ellipsoid_patches(Point3 center, Point3 semi_axes, int m, double 
     centroid[t] = (1.0 / 3) * (s.triangles[t].a + s.triangles[t].b + s.triangles[t].c);
     weight[t] = area(s.triangles[t]);
   }
-  // Lloyd's iteration from m triangles spread over the list (the faces of the icosahedron in turn).
+  // Lloyd's iteration from m triangles spread over the list.
   std::vector<Point3> seeds(m);
   for (int p = 0; p < m; ++p) seeds[p] = centroid[std::size_t(p) * count / std::size_t(m)];
   s.patch_of.assign(count, 0);
@@ -261,8 +239,37 @@ PatchedSurface ellipsoid_patches(Point3 center, Point3 semi_axes, int m, double 
   s.normal.resize(m);
   s.area.assign(m, 0.0);
   for (std::size_t t = 0; t < count; ++t) s.area[s.patch_of[t]] += weight[t];
+  for (int p = 0; p < m; ++p)
+    if (s.area[p] == 0.0) throw std::runtime_error("surface patches: an empty patch (use a smaller edge)");
+  return seeds;
+}
+
+PatchedSurface ellipsoid_patches(Point3 center, Point3 semi_axes, int m, double edge) {
+  for (int d = 0; d < 3; ++d)
+    if (!(semi_axes[d] > 0) || !std::isfinite(semi_axes[d]))
+      throw std::invalid_argument("geometry.semi_axes: must be positive and finite");
+  if (!(edge > 0)) throw std::invalid_argument("ellipsoid_patches: the edge length must be positive");
+  std::vector<Point3> vertices;
+  std::vector<std::array<int, 3>> faces;
+  icosahedron(vertices, faces);
+  const double largest = std::max({semi_axes.x, semi_axes.y, semi_axes.z});
+  const int n = std::max(1, int(std::ceil(1.1 * largest / edge)));  // icosahedron edge 1.05 on the unit sphere
+  const auto on_ellipsoid = [&](Point3 p) {
+    p = (1.0 / norm(p)) * p;
+    return Point3{center.x + semi_axes.x * p.x, center.y + semi_axes.y * p.y, center.z + semi_axes.z * p.z};
+  };
+  PatchedSurface s;
+  for (const auto& f : faces) {
+    const Point3 &a = vertices[f[0]], &b = vertices[f[1]], &c = vertices[f[2]];
+    auto at = [&](int i, int j) { return on_ellipsoid(a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a)); };
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; i + j < n; ++j) {
+        s.triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
+        if (i + j + 1 < n) s.triangles.push_back({at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+      }
+  }
+  const std::vector<Point3> seeds = split_into_patches(s, m);
   for (int p = 0; p < m; ++p) {
-    if (s.area[p] == 0.0) throw std::runtime_error("ellipsoid_patches: an empty patch (use a smaller edge)");
     const Point3 q = on_ellipsoid(Point3{(seeds[p].x - center.x) / semi_axes.x, (seeds[p].y - center.y) / semi_axes.y,
                                          (seeds[p].z - center.z) / semi_axes.z});
     const Point3 gradient{(q.x - center.x) / (semi_axes.x * semi_axes.x),
@@ -270,6 +277,35 @@ PatchedSurface ellipsoid_patches(Point3 center, Point3 semi_axes, int m, double 
                           (q.z - center.z) / (semi_axes.z * semi_axes.z)};
     s.point[p] = q;
     s.normal[p] = (1.0 / norm(gradient)) * gradient;
+  }
+  return s;
+}
+
+PatchedSurface torus_patches(Point3 center, double R, double r, int m, double edge) {
+  if (!(r > 0) || !(R > r) || !std::isfinite(R)) throw std::invalid_argument("geometry.radii: need 0 < r < R, finite");
+  if (!(edge > 0)) throw std::invalid_argument("torus_patches: the edge length must be positive");
+  const int around = std::max(3, int(std::ceil(2 * std::numbers::pi * (R + r) / edge)));  // along the core circle
+  const int across = std::max(3, int(std::ceil(2 * std::numbers::pi * r / edge)));        // around the tube
+  const auto at = [&](int i, int j) {
+    const double theta = 2 * std::numbers::pi * i / around, phi = 2 * std::numbers::pi * j / across;
+    const double rho = R + r * std::cos(phi);
+    return Point3{center.x + rho * std::cos(theta), center.y + rho * std::sin(theta), center.z + r * std::sin(phi)};
+  };
+  PatchedSurface s;
+  for (int i = 0; i < around; ++i)
+    for (int j = 0; j < across; ++j) {  // outward: (θ, φ) is a right-handed chart for the outer normal
+      s.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      s.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  const std::vector<Point3> seeds = split_into_patches(s, m);
+  for (int p = 0; p < m; ++p) {  // the nearest point of the torus: through the nearest point of the core circle
+    const Point3 d = seeds[p] - center;
+    const double planar = std::hypot(d.x, d.y);
+    const Point3 core = planar > 0 ? center + (R / planar) * Point3{d.x, d.y, 0.0} : center + Point3{R, 0.0, 0.0};
+    Point3 n = seeds[p] - core;
+    n = norm(n) > 0 ? (1.0 / norm(n)) * n : (1.0 / R) * (core - center);
+    s.point[p] = core + r * n;
+    s.normal[p] = n;
   }
   return s;
 }

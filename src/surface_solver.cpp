@@ -63,6 +63,36 @@ Box3 Ellipsoid::bounds() const {
   return box;
 }
 
+Torus::Torus(Point3 center, double R, double r) : center_(center), R_(R), r_(r) {
+  for (int d = 0; d < 3; ++d)
+    if (!std::isfinite(center[d])) throw std::invalid_argument("geometry.center: must be finite");
+  if (!(r > 0 && R > r && std::isfinite(R))) throw std::invalid_argument("geometry.radii: need 0 < r < R, finite");
+}
+
+double Torus::level(const Point3& p) const {
+  const Point3 d = p - center_;
+  const double planar = std::hypot(d.x, d.y) - R_;
+  return (planar * planar + d.z * d.z - r_ * r_) / (2 * r_);  // ≈ the signed distance near γ
+}
+
+Point3 Torus::level_gradient(const Point3& p) const {
+  const Point3 d = p - center_;
+  const double rho = std::hypot(d.x, d.y);
+  const double scale = rho > 0 ? (rho - R_) / rho : 0.0;  // the z-axis, far inside the hole: no radial part
+  return (1.0 / r_) * Point3{scale * d.x, scale * d.y, d.z};
+}
+
+PatchedSurface Torus::patches(int m, double edge) const { return torus_patches(center_, R_, r_, m, edge); }
+
+double Torus::area() const { return 4 * std::numbers::pi * std::numbers::pi * R_ * r_; }
+
+Box3 Torus::bounds() const {
+  Box3 box;
+  box.lower = center_ - Point3{R_ + r_, R_ + r_, r_};
+  box.upper = center_ + Point3{R_ + r_, R_ + r_, r_};
+  return box;
+}
+
 int default_patches(double area, double h, Variant variant) {
   const double s = (variant == Variant::smooth ? default_patch_cells_smooth_3d : default_patch_cells_nonsmooth_3d) * h;
   return std::max(minimum_multipliers, int(std::lround(area / (s * s))));
@@ -373,6 +403,12 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
           format("formulation.offset: Γ at δ = offset·s = %.2f h is within reach of the C_γ "
                  "stencil (need δ >= 4h: a larger offset or a smaller m)",
                  sol.delta / h));
+    if (sol.delta > gamma.reach() - 2 * h)
+      throw std::invalid_argument(
+          format("formulation.offset: the offset surface at δ = %.3g would come within 2h of "
+                 "touching itself (the surface allows offsets up to %.3g): a larger N or a "
+                 "smaller formulation.offset",
+                 sol.delta, gamma.reach()));
     check_inside_box(gamma, grid, sol.delta, "formulation.offset");
     sol.Gamma.triangles = offset_triangles(sol.gamma.triangles, gamma, sol.delta);
     for (int p = 0; p < m; ++p) sol.Gamma.point[p] = sol.gamma.point[p] + sol.delta * sol.gamma.normal[p];

@@ -52,4 +52,14 @@ struct PatchedSurface {
 /// ellipsoid along the ray from the center.
 PatchedSurface ellipsoid_patches(Point3 center, Point3 semi_axes, int m, double edge);
 
+/// Splits the triangles of `s` into m patches of nearly equal area (Lloyd's iteration on the area-weighted
+/// triangle centroids): sets patch_of, m and area, sizes point and normal, and returns each patch's
+/// centroid for the caller to move onto the surface.
+std::vector<Point3> split_into_patches(PatchedSurface& s, int m);
+
+/// A torus about the z-axis through `center`: core radius R, tube radius r (0 < r < R), triangulated
+/// by its angle chart with edges about `edge`, split into m patches (the nearest points of the torus to
+/// the patch centroids, with the outward normals).
+PatchedSurface torus_patches(Point3 center, double R, double r, int m, double edge);
+
 }  // namespace fictus

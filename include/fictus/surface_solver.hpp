@@ -6,6 +6,7 @@
 // at distance δ outside (smooth), one collocation point per patch, and the same Schur complement and
 // semismooth Newton code as in 2-D (schur_complement.hpp, semismooth_newton.hpp).
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -38,6 +39,8 @@ class Surface {
   virtual double area() const = 0;
   /// A box holding γ.
   virtual Box3 bounds() const = 0;
+  /// The largest outward offset whose surface does not touch itself (infinite for a convex γ).
+  virtual double reach() const { return std::numeric_limits<double>::infinity(); }
 };
 
 /// (x − c)ᵀ diag(a)⁻² (x − c) < 1, axis-aligned; a sphere when the semi-axes are equal.
@@ -55,6 +58,24 @@ class Ellipsoid final : public Surface {
 
  private:
   Point3 center_, semi_axes_;
+};
+
+/// ((x − c)_xy distance from the z-axis through c − R)² + (z − c_z)² < r², 0 < r < R: a torus
+/// about the z-axis (genus one).
+class Torus final : public Surface {
+ public:
+  /// Throws std::invalid_argument naming geometry.center or geometry.radii.
+  Torus(Point3 center, double R, double r);
+  double level(const Point3& p) const override;
+  Point3 level_gradient(const Point3& p) const override;
+  PatchedSurface patches(int m, double edge) const override;
+  double area() const override;
+  Box3 bounds() const override;
+  double reach() const override { return R_ - r_; }
+
+ private:
+  Point3 center_;
+  double R_, r_;
 };
 
 struct SurfaceProblem {

@@ -310,7 +310,13 @@ SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std
   const std::string shape = geometry.required_string("shape");
   const auto center = geometry.required_numbers("center", 3);
   Point3 axes;
-  if (shape == "sphere") {
+  if (shape == "torus") {
+    if (!geometry.has("major_radius")) fail("geometry.major_radius", "missing");
+    if (!geometry.has("minor_radius")) fail("geometry.minor_radius", "missing");
+    const double R = geometry.number("major_radius", 0.0), r = geometry.number("minor_radius", 0.0);
+    if (!(r > 0 && R > r)) fail("geometry.minor_radius", "need 0 < minor_radius < major_radius");
+    p.gamma = std::make_shared<Torus>(Point3{center[0], center[1], center[2]}, R, r);
+  } else if (shape == "sphere") {
     if (!geometry.has("radius")) fail("geometry.radius", "missing");
     const double r = geometry.number("radius", 0.0);
     if (!(r > 0)) fail("geometry.radius", "must be positive");
@@ -319,9 +325,9 @@ SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std
     const auto a = geometry.required_numbers("semi_axes", 3);
     axes = {a[0], a[1], a[2]};
   } else {
-    fail("geometry.shape", "unknown 3-D shape \"" + shape.substr(0, 40) + "\" (sphere, ellipsoid)");
+    fail("geometry.shape", "unknown 3-D shape \"" + shape.substr(0, 40) + "\" (sphere, ellipsoid, torus)");
   }
-  p.gamma = std::make_shared<Ellipsoid>(Point3{center[0], center[1], center[2]}, axes);
+  if (shape != "torus") p.gamma = std::make_shared<Ellipsoid>(Point3{center[0], center[1], center[2]}, axes);
   geometry.finish();
 
   TableReader formulation(subtable(root, "formulation"), "formulation");

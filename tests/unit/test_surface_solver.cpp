@@ -13,6 +13,8 @@ namespace {
 
 using fictus::Point3;
 
+std::string error_of(const fictus::SurfaceProblem& p, const fictus::SolverOptions& o);
+
 double apply_row(const fictus::SparseRows& rows, int r, const fictus::Grid3& grid,
                  double (*u)(double, double, double)) {
   double sum = 0;
@@ -94,6 +96,30 @@ TEST(OmegaQuadrature, VolumeOfASphereAndAnEllipsoid) {
   const fictus::Ellipsoid ellipsoid({0.5, 0.5, 0.5}, {0.34, 0.26, 0.2});
   const double volume = 4.0 / 3.0 * std::numbers::pi * 0.34 * 0.26 * 0.2;
   EXPECT_NEAR(fictus::omega_volume(fictus::Grid3(fictus::Box3{}, 48), ellipsoid, 4) / volume, 1.0, 2e-6);
+}
+
+TEST(Torus, PatchesQuadratureAndOffsetLimit) {
+  const fictus::Torus torus({0.5, 0.5, 0.5}, 0.25, 0.1);
+  const double R = 0.25, r = 0.1, pi = std::numbers::pi;
+  // A tube of 9.6 cells (at N = 48, 4.8 cells: 9.5e-6).
+  EXPECT_NEAR(fictus::omega_volume(fictus::Grid3(fictus::Box3{}, 96), torus) / (2 * pi * pi * R * r * r), 1.0, 2e-6);
+  const fictus::PatchedSurface patches = torus.patches(60, 1.0 / 64);
+  double area = 0;
+  for (double a : patches.area) area += a;
+  EXPECT_NEAR(area / torus.area(), 1.0, 2e-3);  // the chart's flat triangles, edges h/4 of the tube
+  for (int p = 0; p < patches.m; ++p) {
+    EXPECT_NEAR(torus.level(patches.point[p]), 0.0, 1e-14);
+    const Point3 g = torus.level_gradient(patches.point[p]);
+    EXPECT_NEAR(fictus::dot(g, patches.normal[p]) / fictus::norm(g), 1.0, 1e-12);  // outward
+  }
+  // Γ may not go round the tube past the axis: the offset is limited by R − r.
+  fictus::SurfaceProblem p;
+  p.N = 64;
+  p.gamma = std::make_shared<fictus::Torus>(Point3{0.5, 0.5, 0.5}, 0.25, 0.1);
+  p.f = [](double, double, double) { return 1.0; };
+  p.g = [](double, double, double) { return 0.0; };
+  EXPECT_EQ(error_of(p, fictus::SolverOptions{}).rfind("formulation.offset: the offset surface at", 0), 0u);
+  EXPECT_THROW(fictus::Torus({0.5, 0.5, 0.5}, 0.1, 0.2), std::invalid_argument);
 }
 
 TEST(OmegaQuadrature, ErrorsOfTheInterpolantOfATrilinearFunctionVanish) {
