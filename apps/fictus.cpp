@@ -133,6 +133,8 @@ int run_solve_surface(const std::string& text, const SolveCommand& command) {
   fictus::SurfaceProblemSpec spec = fictus::parse_surface_problem_text(text, command.problem_path);
   std::string name = command.problem_path.substr(command.problem_path.find_last_of('/') + 1);
   spec.name = name.substr(0, name.rfind(".toml"));
+  if (command.flags.given("box"))
+    throw std::invalid_argument("--box: a 3-D box is domain.box = [x0, y0, z0, x1, y1, z1] in the problem file");
   fictus::Problem plane;  // the flags set N, boundary and c through a 2-D problem: taken over when given
   plane.N = spec.problem.N;
   plane.boundary = spec.problem.boundary;
@@ -156,6 +158,10 @@ int run_solve_surface(const std::string& text, const SolveCommand& command) {
   // Memory before anything is allocated: u₀, the field, the Green's table and the load (8 bytes a node).
   const double nodes = std::pow(double(spec.problem.N) + 1, 3);
   const double needed = 4 * 8 * nodes + (64 << 20);
+  if (spec.options.max_memory > 0 && needed > spec.options.max_memory * double(1 << 30))
+    throw std::invalid_argument("solver.max_memory: N = " + std::to_string(spec.problem.N) + " needs about " +
+                                std::to_string(needed / double(1 << 30)).substr(0, 5) + " GiB, more than the " +
+                                std::to_string(spec.options.max_memory).substr(0, 5) + " GiB allowed");
   if (needed > 0.9 * double(fictus::available_memory_bytes()))
     throw std::invalid_argument("domain.N: N = " + std::to_string(spec.problem.N) + " needs about " +
                                 std::to_string(int(needed / (1 << 30) + 1)) + " GiB; less is available");

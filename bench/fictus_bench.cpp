@@ -2,8 +2,6 @@
 // path on larger grids, the time of one DST-I of each grid measured in the same run, 1 vs 2
 // threads per phase, parameter sweeps, and the trace rules and m rule compared in one run. Writes a Markdown report
 // (machine, compiler, threads, commit beside every figure). Not part of the test suite: `make bench`.
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -21,28 +19,15 @@
 #include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/io/process.hpp"
 #include "fictus/paper_problem.hpp"
+#include "report.hpp"
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-std::string format(const char* f, auto... args) {
-  char buffer[1024];
-  std::snprintf(buffer, sizeof buffer, f, args...);
-  return buffer;
-}
-
-std::string command_output(const char* command) {
-  std::string out;
-  if (FILE* p = popen(command, "r")) {
-    char buffer[256];
-    while (std::fgets(buffer, sizeof buffer, p)) out += buffer;
-    pclose(p);
-  }
-  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
-  return out.empty() ? "unknown" : out;
-}
+using bench::command_output;
+using bench::format;
 
 /// Best of `repeats` in-place 2-D DST-I (RODFT00) of the grid's unknowns.
 double dst1_seconds(int N, int threads, int repeats = 3) {
@@ -121,9 +106,7 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  const std::string machine = format(
-      "%s, %ld cores, %.0f GiB", command_output("sed -n 's/^model name\\s*: //p' /proc/cpuinfo | head -1").c_str(),
-      sysconf(_SC_NPROCESSORS_ONLN), sysconf(_SC_PHYS_PAGES) * double(sysconf(_SC_PAGESIZE)) / (1 << 30));
+  const std::string machine = bench::machine();
   const std::string commit = command_output("git rev-parse --short HEAD 2>/dev/null");
   const std::string compiler = std::string("g++ ") + __VERSION__ + " -O3 (Release)";
   char date[32];

@@ -2,8 +2,6 @@
 // variant, end to end per phase with peak memory at N = 64 … --max-N, and the green and krylov inner
 // solvers compared in the same run. Writes a Markdown report (machine, compiler, threads, commit beside
 // the figures). Not part of the test suite: `make bench`.
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -15,25 +13,12 @@
 
 #include "fictus/io/process.hpp"
 #include "manufactured_solutions_3d.hpp"
+#include "report.hpp"
 
 namespace {
 
-std::string format(const char* f, auto... args) {
-  char buffer[1024];
-  std::snprintf(buffer, sizeof buffer, f, args...);
-  return buffer;
-}
-
-std::string command_output(const char* command) {
-  std::string out;
-  if (FILE* p = popen(command, "r")) {
-    char buffer[256];
-    while (std::fgets(buffer, sizeof buffer, p)) out += buffer;
-    pclose(p);
-  }
-  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
-  return out.empty() ? "unknown" : out;
-}
+using bench::command_output;
+using bench::format;
 
 fictus::SurfaceSolution run(int N, fictus::SolverOptions o) {
   const fictus::SurfaceProblem p = manufactured3d::all(N).front().problem;  // the sphere
@@ -63,9 +48,7 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  const std::string machine = format(
-      "%s, %ld cores, %.0f GiB", command_output("sed -n 's/^model name\\s*: //p' /proc/cpuinfo | head -1").c_str(),
-      sysconf(_SC_NPROCESSORS_ONLN), sysconf(_SC_PHYS_PAGES) * double(sysconf(_SC_PAGESIZE)) / (1 << 30));
+  const std::string machine = bench::machine();
   char date[32];
   const std::time_t now = std::time(nullptr);
   std::strftime(date, sizeof date, "%Y-%m-%d", std::gmtime(&now));
