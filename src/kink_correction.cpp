@@ -226,25 +226,6 @@ SparseRows merge_rows(const std::vector<std::vector<RowEntry>>& by_cell, int m, 
 
 }  // namespace
 
-SparseRows add_rows(const SparseRows& a, const SparseRows& b) {
-  SparseRows out;
-  for (int r = 0; r < a.n_rows(); ++r) {
-    std::vector<SparseRows::Entry> row(a.entries.begin() + std::ptrdiff_t(a.row_begin[r]),
-                                       a.entries.begin() + std::ptrdiff_t(a.row_begin[r + 1]));
-    for (std::size_t k = b.row_begin[r]; k < b.row_begin[r + 1]; ++k) {
-      const auto& e = b.entries[k];
-      auto same = std::find_if(row.begin(), row.end(), [&](const SparseRows::Entry& x) { return x.index == e.index; });
-      if (same != row.end())
-        same->value += e.value;
-      else
-        row.push_back(e);
-    }
-    out.entries.insert(out.entries.end(), row.begin(), row.end());
-    out.row_begin.push_back(out.entries.size());
-  }
-  return out;
-}
-
 struct KinkCorrection::State {
   State(const CurveGridIntersection& g, const Collocation& a)
       : gamma(g), arcs(a), arc_of(a), nodes(g.curve(), g.grid()) {}

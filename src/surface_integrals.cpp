@@ -83,7 +83,7 @@ const std::vector<TrianglePoint>& degree4_rule() {
 double area(const Triangle3& t) { return 0.5 * norm(cross(t.b - t.a, t.c - t.a)); }
 
 std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Triangle3>& triangles,
-                                         const std::vector<int>& patch_of, int n_patches) {
+                                         const std::vector<int>& patch_of, int n_patches, const SurfaceMap& onto) {
   if (patch_of.size() != triangles.size())
     throw std::invalid_argument("patch_integrals: one patch per triangle is needed");
   const double h = grid.h();
@@ -114,11 +114,17 @@ std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Tr
       std::array<double, 8> corner_sum{};                   // ∫_piece φ of the cell's 8 corners
       for (std::size_t f = 1; f + 1 < piece.size(); ++f) {  // the fan from the first vertex
         const Point3 &a = piece[0], &b = piece[f], &c = piece[f + 1];
-        const double jacobian = 2.0 * area({a, b, c});
+        const Point3 normal_area = cross(b - a, c - a);
+        const double jacobian = norm(normal_area);
         if (jacobian == 0.0) continue;
         for (const TrianglePoint& q : degree4_rule()) {
-          const Point3 x = q.l0 * a + q.l1 * b + q.l2 * c;
-          const double weight = 0.5 * q.w * jacobian;
+          Point3 x = q.l0 * a + q.l1 * b + q.l2 * c;
+          double weight = 0.5 * q.w * jacobian;
+          if (onto) {
+            double factor = 1.0;
+            x = onto(x, (1.0 / jacobian) * normal_area, factor);
+            weight *= factor;
+          }
           double xi[3];  // local coordinates in the cell, in [0, 1]
           for (int d = 0; d < 3; ++d) xi[d] = (x[d] - grid.coordinate(d, cell[d])) / h;
           for (int corner = 0; corner < 8; ++corner) {

@@ -17,13 +17,30 @@
 #include "fictus/q1_element.hpp"
 #include "fictus/quadrature.hpp"
 #include "fictus/schur_complement.hpp"
+#include "fictus/surface_kink.hpp"
 #include "fictus/trace_operators.hpp"
 #include "solve_steps.hpp"
 
 namespace fictus {
 
 // ---------------------------------------------------------------------------------------------
-// Ellipsoid
+// Surfaces
+
+Matrix3 Surface::level_hessian(const Point3& p) const {
+  const Box3 box = bounds();
+  const double step = 1e-5 * std::max({box.width(0), box.width(1), box.width(2)});
+  Matrix3 H;
+  for (int d = 0; d < 3; ++d) {
+    Point3 plus = p, minus = p;
+    plus[d] += step;
+    minus[d] -= step;
+    const Point3 column = (0.5 / step) * (level_gradient(plus) - level_gradient(minus));
+    for (int e = 0; e < 3; ++e) H[e][d] = column[e];
+  }
+  for (int d = 0; d < 3; ++d)  // symmetric
+    for (int e = 0; e < d; ++e) H[d][e] = H[e][d] = 0.5 * (H[d][e] + H[e][d]);
+  return H;
+}
 
 Ellipsoid::Ellipsoid(Point3 center, Point3 semi_axes) : center_(center), semi_axes_(semi_axes) {
   for (int d = 0; d < 3; ++d) {
@@ -46,6 +63,12 @@ Point3 Ellipsoid::level_gradient(const Point3& p) const {
   Point3 g;
   for (int d = 0; d < 3; ++d) g[d] = 2 * (p[d] - center_[d]) / (semi_axes_[d] * semi_axes_[d]);
   return g;
+}
+
+Matrix3 Ellipsoid::level_hessian(const Point3&) const {
+  Matrix3 H{};
+  for (int d = 0; d < 3; ++d) H[d][d] = 2 / (semi_axes_[d] * semi_axes_[d]);
+  return H;
 }
 
 PatchedSurface Ellipsoid::patches(int m, double edge) const { return ellipsoid_patches(center_, semi_axes_, m, edge); }
@@ -80,6 +103,19 @@ Point3 Torus::level_gradient(const Point3& p) const {
   const double rho = std::hypot(d.x, d.y);
   const double scale = rho > 0 ? (rho - R_) / rho : 0.0;  // the z-axis, far inside the hole: no radial part
   return (1.0 / r_) * Point3{scale * d.x, scale * d.y, d.z};
+}
+
+Matrix3 Torus::level_hessian(const Point3& p) const {
+  const Point3 d = p - center_;
+  const double rho = std::hypot(d.x, d.y);
+  Matrix3 H{};
+  H[2][2] = 1 / r_;
+  if (rho == 0) return H;  // the axis, far inside the hole
+  const double radial = (1 - R_ / rho) / r_, bend = R_ / (rho * rho * rho * r_);
+  H[0][0] = radial + bend * d.x * d.x;
+  H[1][1] = radial + bend * d.y * d.y;
+  H[0][1] = H[1][0] = bend * d.x * d.y;
+  return H;
 }
 
 PatchedSurface Torus::patches(int m, double edge) const { return torus_patches(center_, R_, r_, m, edge); }
@@ -179,13 +215,40 @@ void cut_cube(const Surface& gamma, const Point3& lower, double side, const Gaus
     }
 }
 
+/// The rule's points in ω ∩ one voxel: q³ Gauss points when γ stays away from it, else its eight
+/// half-voxels by cut_cube.
+template <class Visit>
+void omega_part(const Grid3& grid, const Surface& gamma, const Grid3::Index& cell, const GaussRule& rule, Visit&& visit,
+                int cut_depth = 0) {  // deeper splits cost 8× per level, gain little on volumes
+  const double h = grid.h();
+  const int q = int(rule.nodes.size());
+  const Point3 lower{grid.x(cell[0]), grid.y(cell[1]), grid.z(cell[2])};
+  const Point3 center = lower + Point3{h / 2, h / 2, h / 2};
+  if (!near_surface(gamma, center, 0.87 * h)) {
+    if (gamma.level(center) > 0) return;
+    for (int c = 0; c < q; ++c)
+      for (int b = 0; b < q; ++b)
+        for (int a = 0; a < q; ++a)
+          visit(lower + h * Point3{rule.nodes[a], rule.nodes[b], rule.nodes[c]},
+                rule.weights[a] * rule.weights[b] * rule.weights[c] * h * h * h);
+    return;
+  }
+  for (int k = 0; k < 8; ++k) {  // eight half-voxels
+    const Point3 sub = lower + (h / 2) * Point3{double(k & 1), double((k >> 1) & 1), double((k >> 2) & 1)};
+    cut_cube(gamma, sub, h / 2, rule, cut_depth, visit);
+  }
+}
+
 }  // namespace
+
+void for_each_omega_point_in_voxel(const Grid3& grid, const Surface& gamma, const Grid3::Index& cell, int q,
+                                   const std::function<void(const Point3&, double)>& visit, int depth) {
+  omega_part(grid, gamma, cell, gauss_legendre(q), visit, depth);
+}
 
 void for_each_omega_point(const Grid3& grid, const Surface& gamma, int q, const Execution& execution,
                           const OmegaVisitor& visit) {
-  constexpr int cut_depth = 0;  // deeper splits cost 8× per level and gained little (volume to ~1e-6)
   const GaussRule& rule = gauss_legendre(q);
-  const double h = grid.h();
   const Box3 bounds = gamma.bounds();
   std::array<int, 3> first, last;
   for (int d = 0; d < 3; ++d) {
@@ -201,21 +264,7 @@ void for_each_omega_point(const Grid3& grid, const Surface& gamma, int q, const 
     for (int iy = first[1]; iy <= last[1]; ++iy)
       for (int ix = first[0]; ix <= last[0]; ++ix) {
         const Grid3::Index cell{ix, iy, iz};
-        const Point3 lower{grid.x(ix), grid.y(iy), grid.z(iz)};
-        const Point3 center = lower + Point3{h / 2, h / 2, h / 2};
-        if (!near_surface(gamma, center, 0.87 * h)) {
-          if (gamma.level(center) > 0) continue;
-          for (int c = 0; c < q; ++c)
-            for (int b = 0; b < q; ++b)
-              for (int a = 0; a < q; ++a)
-                visit(thread, cell, lower + h * Point3{rule.nodes[a], rule.nodes[b], rule.nodes[c]},
-                      rule.weights[a] * rule.weights[b] * rule.weights[c] * h * h * h);
-          continue;
-        }
-        for (int k = 0; k < 8; ++k) {  // eight half-voxels
-          const Point3 sub = lower + (h / 2) * Point3{double(k & 1), double((k >> 1) & 1), double((k >> 2) & 1)};
-          cut_cube(gamma, sub, h / 2, rule, cut_depth, [&](const Point3& x, double w) { visit(thread, cell, x, w); });
-        }
+        omega_part(grid, gamma, cell, rule, [&](const Point3& x, double w) { visit(thread, cell, x, w); });
       }
   }
   if (stop) throw Interrupted();
@@ -417,28 +466,44 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   for (std::size_t t = 0; t < sol.Gamma.triangles.size(); ++t)
     sol.Gamma.area[sol.Gamma.patch_of[t]] += fictus::area(sol.Gamma.triangles[t]);
 
-  // 2. Trace rows.
+  // 2. Trace rows: B_γ trilinear, C_γ triquadratic (reconstructed) or the shifted voxel gradient, B_Γ
+  //    the patch integrals; in the non-smooth variant with reconstructed traces, the kink correction
+  //    (its rows r_j join B_Γ as the loads, and D_B, D_C act on λ directly).
   const SparseRows B_gamma = point_value_rows(grid, sol.gamma.point);
-  const bool centered =
-      options.variant == Variant::smooth && options.normal_derivative == NormalDerivative::reconstructed;
+  const bool reconstructed = options.normal_derivative == NormalDerivative::reconstructed;
   const SparseRows C_gamma =
-      centered ? normal_derivative_rows_centered(grid, sol.gamma.point, sol.gamma.normal)
-               : normal_derivative_rows(grid, sol.gamma.point, sol.gamma.normal, options.normal_shift * h);
-  const SparseRows B_Gamma =
-      patch_integral_rows(grid, patch_integrals(grid, sol.Gamma.triangles, sol.Gamma.patch_of, m), m);
+      reconstructed ? normal_derivative_rows_centered(grid, sol.gamma.point, sol.gamma.normal)
+                    : normal_derivative_rows(grid, sol.gamma.point, sol.gamma.normal, options.normal_shift * h);
+  // Non-smooth: λ lives on γ itself, where the kink of û must sit to O(h³) for C_γ (which reaches across
+  // γ): the triangles' points are mapped onto γ (their O(h²) sag would be a double layer, an O(h) error).
+  const SparseRows B_Gamma = patch_integral_rows(
+      grid,
+      patch_integrals(grid, sol.Gamma.triangles, sol.Gamma.patch_of, m,
+                      options.variant == Variant::nonsmooth ? onto_surface(gamma, 1e-13 * h) : SurfaceMap{}),
+      m);
   clock.mark("geometry");
   execution.throw_if_interrupted();
+  std::unique_ptr<SurfaceKink> kink;
+  DirectTerms direct;
+  if (options.variant == Variant::nonsmooth && reconstructed) {
+    kink = std::make_unique<SurfaceKink>(grid, gamma, sol.gamma, problem.c, execution);
+    direct.trace = kink->direct(B_gamma);
+    direct.normal_derivative = kink->direct(C_gamma);
+    clock.mark("kink_correction");
+    execution.throw_if_interrupted();
+  }
+  const SparseRows loads = kink ? add_rows(B_Gamma, kink->galerkin()) : B_Gamma;
 
   // 3. Schur blocks.
   std::unique_ptr<GreenTable<3>> green;
   std::unique_ptr<SchurComplement> schur;
   if (options.inner == InnerSolver::krylov) {
-    schur =
-        std::make_unique<ImplicitSchur>(*fast, B_gamma, C_gamma, B_Gamma, detail::gmres_options(options, m, execution));
+    schur = std::make_unique<ImplicitSchur>(*fast, B_gamma, C_gamma, loads,
+                                            detail::gmres_options(options, m, execution), direct);
   } else {
     green = std::make_unique<GreenTable<3>>(grid, problem.c, execution);
     clock.mark("green_table");
-    schur = std::make_unique<ExplicitSchur>(*green, B_gamma, C_gamma, B_Gamma, execution);
+    schur = std::make_unique<ExplicitSchur>(*green, B_gamma, C_gamma, loads, execution, direct);
     green.reset();
     clock.mark("schur");
   }
@@ -478,10 +543,11 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
 
   // 6. The field.
   GridVector u(grid.n_unknowns(), 0.0);
-  B_Gamma.add_transposed(sol.lambda, u);
+  loads.add_transposed(sol.lambda, u);
   fast->solve_in_place(u);
   ++sol.fast_solves;
   for (std::size_t k = 0; k < u.size(); ++k) u[k] += u0[k] + sol.alpha;
+  if (kink) kink->add_kinks(sol.lambda, u);  // the kink-corrected field I_h w
   u0 = GridVector();
   sol.u = std::move(u);
   B_gamma.multiply(sol.u, sol.trace);

@@ -42,7 +42,4 @@ class KinkCorrection {
   std::unique_ptr<State> state_;
 };
 
-/// Row-wise sum a + b of two sets of rows with the same number of rows (entries of a node merged).
-SparseRows add_rows(const SparseRows& a, const SparseRows& b);
-
 }  // namespace fictus

@@ -4,6 +4,7 @@
 // convex pieces inside one voxel; on a piece the trilinear basis is a cubic polynomial of the plane, so
 // a degree-4 triangle rule on a fan of the piece integrates it exactly (to round-off).
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include "fictus/grid.hpp"
@@ -26,8 +27,12 @@ struct PatchWeight {
 /// The nonzero ∫_{patch p} φ_k dS, sorted by patch, then by node in the grid's storage order (i fastest). `patch_of[t]`
 /// is the patch of triangle t, in 0 … n_patches − 1. Throws std::invalid_argument for a triangle that is not finite or
 /// leaves the box.
+/// With `onto`, the integrals are over the curved surface the triangles approximate: `onto(x, n, factor)`
+/// maps a point x of a triangle with unit normal n to the surface and sets factor = dS_surface/dS_triangle
+/// there (the quadrature stays the pieces' rule: exact no longer, but free of the triangles' O(h²) offset).
+using SurfaceMap = std::function<Point3(const Point3& x, const Point3& normal, double& factor)>;
 std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Triangle3>& triangles,
-                                         const std::vector<int>& patch_of, int n_patches);
+                                         const std::vector<int>& patch_of, int n_patches, const SurfaceMap& onto = {});
 
 /// The area of a triangle.
 double area(const Triangle3& t);

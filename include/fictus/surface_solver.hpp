@@ -24,6 +24,8 @@
 namespace fictus {
 
 using GradientField3 = std::function<Point3(double x, double y, double z)>;
+/// A symmetric 3 × 3 matrix by rows.
+using Matrix3 = std::array<Point3, 3>;
 
 /// A closed surface γ = ∂ω given by a level-set function: level(x) < 0 in ω, > 0 outside, with a
 /// triangulation split into patches on demand.
@@ -32,6 +34,8 @@ class Surface {
   virtual ~Surface() = default;
   virtual double level(const Point3& p) const = 0;
   virtual Point3 level_gradient(const Point3& p) const = 0;
+  /// The Hessian of the level function (default: central differences of level_gradient).
+  virtual Matrix3 level_hessian(const Point3& p) const;
   /// γ triangulated with edges of about `edge` or less, split into m patches of nearly equal area,
   /// with a point on γ and its outward normal per patch.
   virtual PatchedSurface patches(int m, double edge) const = 0;
@@ -50,6 +54,7 @@ class Ellipsoid final : public Surface {
   Ellipsoid(Point3 center, Point3 semi_axes);
   double level(const Point3& p) const override;
   Point3 level_gradient(const Point3& p) const override;
+  Matrix3 level_hessian(const Point3& p) const override;
   PatchedSurface patches(int m, double edge) const override;
   double area() const override;
   Box3 bounds() const override;
@@ -68,6 +73,7 @@ class Torus final : public Surface {
   Torus(Point3 center, double R, double r);
   double level(const Point3& p) const override;
   Point3 level_gradient(const Point3& p) const override;
+  Matrix3 level_hessian(const Point3& p) const override;
   PatchedSurface patches(int m, double edge) const override;
   double area() const override;
   Box3 bounds() const override;
@@ -91,7 +97,7 @@ struct SurfaceProblem {
 
 /// Default patch size s (the side of a square of the patch's area) in cells: m = area/(s·h)².
 inline constexpr double default_patch_cells_smooth_3d = 8.0;
-inline constexpr double default_patch_cells_nonsmooth_3d = 3.0;
+inline constexpr double default_patch_cells_nonsmooth_3d = 4.0;
 /// Default m for a surface of `area` on a grid of cell h.
 int default_patches(double area, double h, Variant variant);
 
@@ -129,6 +135,11 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
 using OmegaVisitor = std::function<void(int thread, const Grid3::Index& cell, const Point3& x, double weight)>;
 void for_each_omega_point(const Grid3& grid, const Surface& gamma, int q, const Execution& execution,
                           const OmegaVisitor& visit);
+
+/// The points of that rule in one voxel (none for a voxel outside ω), on the calling thread.
+/// `depth` > 0 splits the half-voxels where γ meets the faces across the line direction up to that many times more.
+void for_each_omega_point_in_voxel(const Grid3& grid, const Surface& gamma, const Grid3::Index& cell, int q,
+                                   const std::function<void(const Point3& x, double weight)>& visit, int depth = 0);
 
 /// The volume of ω by that rule (a test of it).
 double omega_volume(const Grid3& grid, const Surface& gamma, int q = 3, const Execution& execution = Execution{});

@@ -30,6 +30,9 @@ struct SparseRows {
   void add_transposed(const std::vector<double>& lambda, GridVector& u) const;
 };
 
+/// Row-wise sum a + b of two sets of rows with the same number of rows (entries of a node merged).
+SparseRows add_rows(const SparseRows& a, const SparseRows& b);
+
 SparseRows point_value_rows(const Grid2& grid, const std::vector<Point2>& points);
 
 /// shift: distance (length units) from x_i into ω along −n_i where the gradient is taken.

@@ -1,7 +1,7 @@
 // 3-D: the manufactured Signorini solutions of manufactured3d.py (∂²u/∂n² ≠ 0 on the free part, the
 // contact boundary a plane section in general position) converge at the smooth variant's order on a
-// sphere and an ellipsoid; Newton stays short; the discrete Signorini conditions hold to round-off;
-// the two inner solvers agree. Small N here (the large ones are in the benchmark).
+// sphere and an ellipsoid (the non-smooth variant on the sphere); Newton stays short; the discrete Signorini conditions
+// hold to round-off; the two inner solvers agree. Small N here (the large ones are in the benchmark).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -38,30 +38,42 @@ void expect_signorini_at_round_off(const fictus::SurfaceSolution& s) {
   EXPECT_LT(s.signorini.max_complementarity, 1e-12);
 }
 
-void converges(const std::string& name, const std::vector<int>& sizes, double highest_rate) {
+struct Bands {
+  double lowest_rate, highest_rate;  // L²(ω)
+  double lowest_h1_rate, lowest_gamma_rate;
+  int fewest_active_tenths;  // at least m·fewest/10 points in contact (the contact set is there)
+};
+
+void converges(const std::string& name, const std::vector<int>& sizes, fictus::Variant variant, const Bands& bands) {
   std::vector<fictus::LevelResult> rows;
   for (int N : sizes) {
     fictus::SolverOptions o;
     o.threads = 2;
+    o.variant = variant;
     const fictus::SurfaceSolution s = fictus::solve(problem(name, N), o);
     ASSERT_TRUE(s.newton.converged) << "N = " << N << ": " << s.newton.failure;
     EXPECT_LE(s.newton.iterations, 10);
     expect_signorini_at_round_off(s);
     int active = 0;
     for (char a : s.newton.active) active += a;
-    EXPECT_GT(active, s.options.multipliers / 5);  // both parts of γ are there
+    EXPECT_GT(10 * active, s.options.multipliers * bands.fewest_active_tenths);  // both parts of γ are there
     EXPECT_LT(active, s.options.multipliers * 4 / 5);
     rows.push_back(level_of(s));
   }
-  std::cout << fictus::format_convergence_table(name + ", smooth, 3-D", rows, std::nullopt);
+  const char* label = variant == fictus::Variant::smooth ? ", smooth, 3-D" : ", non-smooth, 3-D";
+  std::cout << fictus::format_convergence_table(name + label, rows, std::nullopt);
   const auto fit = fictus::fitted_rates(rows);
-  // At these N the contact set (patches of 8h) is still being resolved and the L²(ω) rate is above
-  // its asymptotic 2 (sphere: 2.5 over N = 96 … 160, 2.02 over 128 … 256 in the benchmark).
-  EXPECT_GE(fit[0], 1.8);
-  EXPECT_LE(fit[0], highest_rate);
-  EXPECT_GE(fit[1], 0.85);
-  EXPECT_GE(fit[2], 1.8);
+  EXPECT_GE(fit[0], bands.lowest_rate);
+  EXPECT_LE(fit[0], bands.highest_rate);
+  EXPECT_GE(fit[1], bands.lowest_h1_rate);
+  EXPECT_GE(fit[2], bands.lowest_gamma_rate);
   EXPECT_LE(rows.back().it0, rows.front().it0 + 2);  // Newton does not grow with N
+}
+
+// At these N the contact set (patches of 8h) is still being resolved and the L²(ω) rate is above its
+// asymptotic 2 (sphere: 2.5 over N = 96 … 160, 2.02 over 128 … 256 in the benchmark).
+void converges(const std::string& name, const std::vector<int>& sizes, double highest_rate) {
+  converges(name, sizes, fictus::Variant::smooth, {1.8, highest_rate, 0.85, 1.8, 2});
 }
 
 TEST(Manufactured3d, SphereConvergesAtSecondOrder) { converges("sphere", {96, 128, 160}, 3.0); }
@@ -91,10 +103,16 @@ TEST(Manufactured3d, GreenAndKrylovAgree) {
   EXPECT_GT(krylov.fast_solves, 20u);
 }
 
-TEST(Manufactured3d, NonSmoothVariantSolvesButStallsWithoutAKinkCorrection) {
-  // The non-smooth variant with the shifted C_γ (the paper's rule; 3-D has no kink correction yet):
-  // Newton and the discrete conditions are fine, the error does not converge (docs/math.md), as with
-  // the 2-D shifted rule on such problems.
+TEST(Manufactured3d, NonSmoothVariantConvergesWithTheKinkCorrection) {
+  // Multipliers on γ itself, traces of the kink-corrected field (surface_kink.hpp), patches of 4h. The
+  // contact set is under-resolved at small N (fewer points in contact than the smooth variant finds),
+  // so the rate here is above its asymptotic value; the issue asks for about 1.
+  converges("sphere", {64, 80, 96}, fictus::Variant::nonsmooth, {1.0, 5.0, 0.7, 1.0, 1});
+}
+
+TEST(Manufactured3d, NonSmoothShiftedRuleStallsWithoutTheKinkCorrection) {
+  // The paper's shifted C_γ on the same problem: Newton and the discrete conditions are fine, the
+  // error does not converge (docs/math.md), as with the 2-D shifted rule on such problems.
   fictus::SolverOptions o;
   o.threads = 2;
   o.variant = fictus::Variant::nonsmooth;
@@ -103,6 +121,7 @@ TEST(Manufactured3d, NonSmoothVariantSolvesButStallsWithoutAKinkCorrection) {
   ASSERT_TRUE(s.newton.converged);
   EXPECT_LE(s.newton.iterations, 10);
   expect_signorini_at_round_off(s);
+  EXPECT_GT(s.errors->rel_l2_omega, 5e-3);
   EXPECT_LT(s.errors->rel_l2_omega, 0.05);
 }
 

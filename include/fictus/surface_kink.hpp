@@ -1,0 +1,68 @@
+#pragma once
+// 3-D: traces of a grid function that is kinked on a closed surface γ (the non-smooth variant,
+// docs/math.md "Three dimensions"), the surface form of kink_correction.hpp.
+//
+// With multipliers on the patches of γ itself, û has a jump λ_j in its normal derivative across patch
+// j. Near γ write
+//   û = w − Σ_j λ_j ψ_j,   ψ_j = q(d)⁺ where the nearest point of γ lies on patch j,
+// d the signed distance to γ (> 0 outside ω), q(d) = d − H d²/2, H = κ₁ + κ₂ the mean curvature sum
+// at the nearest point (q″ + H q′ = O(d): w solves the same equation to that order), w smooth across
+// γ. The Q1 Galerkin solution û_h is related to I_h w by
+//   I_h w ≈ û_h + Σ_j λ_j (I_hψ_j + A⁻¹ r_j),   r_j,k = a(ψ_j − I_hψ_j, φ_k)   (on the cut voxels),
+// so a trace row R of I_h w is R û_h + R A⁻¹ Σ_j λ_j r_j + D λ with D_ij = Σ_k R_ik ψ_j(x_k).
+#include <memory>
+#include <vector>
+
+#include <Eigen/SparseCore>
+
+#include "fictus/execution.hpp"
+#include "fictus/grid.hpp"
+#include "fictus/surface_solver.hpp"
+#include "fictus/trace_operators.hpp"
+
+namespace fictus {
+
+/// The nearest point of γ to a point x near γ, and the kink function there.
+struct SurfaceFoot {
+  Point3 foot, normal;                                      // the nearest point and the outward unit normal there
+  double d = 0.0;                                           // signed distance, > 0 outside ω
+  double H = 0.0;                                           // κ₁ + κ₂ there (> 0 on a convex γ)
+  double q() const { return d - 0.5 * H * d * d; }          // ψ outside ω, extended smoothly inside
+  double psi() const { return d > 0 ? q() : 0.0; }          // q(d)⁺
+  Point3 grad_q() const { return (1.0 - H * d) * normal; }  // ∇q, H taken constant
+};
+
+/// The nearest point of γ to x (within a few cells of γ), by Newton's method from `start` (a point
+/// near the answer; x itself will do): projection onto γ along the level gradient, then a tangential
+/// step (I + d·W)δ = t, W the shape operator, until the tangential residual is below `tolerance`.
+SurfaceFoot nearest_point(const Surface& gamma, const Point3& x, const Point3& start, double tolerance);
+
+/// The map of patch_integrals onto γ itself: a point x of a triangle (unit normal n) goes to its nearest
+/// point of γ, with dS_γ/dS_triangle = |n·n_γ|/(1 + H d) there (d the distance of x, O(h²)).
+SurfaceMap onto_surface(const Surface& gamma, double tolerance);
+
+class SurfaceKink {
+ public:
+  /// The kink model for the patches of γ on `grid`; computes r_j for A = K + cM.
+  SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedSurface& patches, double c,
+              const Execution& execution = Execution{});
+  ~SurfaceKink();
+  SurfaceKink(SurfaceKink&&) noexcept;
+  SurfaceKink& operator=(SurfaceKink&&) noexcept;
+
+  /// r_j over the grid nodes, one row per patch (m rows): added to B_Γ in the Schur complement.
+  const SparseRows& galerkin() const;
+  /// D (rows × m) for trace rows R on the same grid: D_ij = Σ_k R_ik ψ_j(x_k).
+  Eigen::SparseMatrix<double> direct(const SparseRows& rows) const;
+  /// u += Σ_j λ_j ψ_j at the nodes of the band (0 < d ≤ 3h: every trace stencil and cut voxel
+  /// stays in it): turns u₀ + A⁻¹(B_Γ + R)ᵀλ into the kink-corrected field I_h w.
+  void add_kinks(const std::vector<double>& lambda, GridVector& u) const;
+  /// The number of cut voxels (for reports).
+  std::size_t cut_voxels() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace fictus
