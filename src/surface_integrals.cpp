@@ -202,7 +202,7 @@ std::vector<Point3> split_into_patches(PatchedSurface& s, int m) {
   const auto bucket_of = [&](const Point3& p, int d) {  // may lie outside [0, size) for a seed
     return int(std::floor((p[d] - low[d]) / bucket));
   };
-  std::vector<std::vector<int>> buckets(std::size_t(size[0]) * size[1] * size[2]);
+  std::vector<std::vector<int>> buckets(static_cast<std::size_t>(size[0]) * size[1] * size[2]);
   for (int iteration = 0; iteration < 30; ++iteration) {
     for (auto& b : buckets) b.clear();
     std::vector<int> outside;  // seeds beyond the centroids' box (searched for every triangle)

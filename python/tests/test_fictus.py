@@ -255,7 +255,7 @@ def test_surface_problem_matches_the_cli(tmp_path):
 
 def test_surface_problem_from_a_dict_and_its_errors():
     config = dict(domain=dict(N=32), geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.2),
-                  formulation=dict(variant="nonsmooth", normal_derivative="shifted"), data=dict(f="-1", g="0.05 * x"))
+                  formulation=dict(variant="nonsmooth"), data=dict(f="-1", g="0.2 * (x - 0.5)"))
     s = fictus.SurfaceProblem.from_dict(config).solve()
     assert s.signorini["min_gap"] > -1e-12 and s.signorini["max_complementarity"] < 1e-12
     assert s.errors is None and 0 < np.count_nonzero(s.contact) < s.multipliers
