@@ -84,6 +84,34 @@ class Torus final : public Surface {
   double R_, r_;
 };
 
+/// level(x) < 0 in ω, any smooth function with a nonzero gradient on its zero set, inside a box that
+/// holds γ: triangulated by marching tetrahedra on a lattice of cubes of side `edge` (the crossings on the
+/// tetrahedra's edges by root finding), split into patches as the built-in shapes are. Derivatives by
+/// central differences (steps 1e-5 and 1e-4 of the box's largest side).
+class ImplicitSurface final : public Surface {
+ public:
+  /// Throws std::invalid_argument naming geometry.bounds (not a box, or γ reaches its faces) or
+  /// geometry.level (not finite, no surface inside the box, or a vanishing gradient on γ).
+  ImplicitSurface(ScalarField3 level, Box3 bounds);
+  double level(const Point3& p) const override;
+  Point3 level_gradient(const Point3& p) const override;
+  Matrix3 level_hessian(const Point3& p) const override;
+  PatchedSurface patches(int m, double edge) const override;
+  /// From a triangulation with cubes of 1/96 of the box's largest side (relative error O((edge·κ)²)).
+  double area() const override { return area_; }
+  /// The box of that triangulation's vertices grown by 1/20 of its cube side, within the given box.
+  Box3 bounds() const override { return tight_; }
+  /// 1/(the largest principal curvature of the concave side) on that triangulation's vertices: where
+  /// outward offsets first fold. A neck between two distant parts of γ is not seen.
+  double reach() const override { return reach_; }
+
+ private:
+  std::vector<Triangle3> triangulate(double edge) const;
+  ScalarField3 level_;
+  Box3 bounds_, tight_;
+  double area_ = 0, reach_ = 0;
+};
+
 struct SurfaceProblem {
   Box3 box;  // Ω
   int N = 64;

@@ -308,9 +308,19 @@ SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std
   if (!geometry_table) fail("geometry", "missing section [geometry]");
   TableReader geometry(geometry_table, "geometry");
   const std::string shape = geometry.required_string("shape");
-  const auto center = geometry.required_numbers("center", 3);
+  if (shape == "implicit") {
+    const Expression level(geometry.required_string("level"), {"x", "y", "z"}, "geometry.level");
+    const auto b = geometry.required_numbers("bounds", 6);
+    p.gamma = std::make_shared<ImplicitSurface>(
+        [level](double x, double y, double z) {
+          return level({x, y, z});
+        },
+        Box3{{b[0], b[1], b[2]}, {b[3], b[4], b[5]}});
+  }
+  const auto center = shape == "implicit" ? std::vector<double>(3, 0.0) : geometry.required_numbers("center", 3);
   Point3 axes;
-  if (shape == "torus") {
+  if (shape == "implicit") {
+  } else if (shape == "torus") {
     if (!geometry.has("major_radius")) fail("geometry.major_radius", "missing");
     if (!geometry.has("minor_radius")) fail("geometry.minor_radius", "missing");
     const double R = geometry.number("major_radius", 0.0), r = geometry.number("minor_radius", 0.0);
@@ -325,9 +335,10 @@ SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std
     const auto a = geometry.required_numbers("semi_axes", 3);
     axes = {a[0], a[1], a[2]};
   } else {
-    fail("geometry.shape", "unknown 3-D shape \"" + shape.substr(0, 40) + "\" (sphere, ellipsoid, torus)");
+    fail("geometry.shape", "unknown 3-D shape \"" + shape.substr(0, 40) + "\" (sphere, ellipsoid, torus, implicit)");
   }
-  if (shape != "torus") p.gamma = std::make_shared<Ellipsoid>(Point3{center[0], center[1], center[2]}, axes);
+  if (shape == "sphere" || shape == "ellipsoid")
+    p.gamma = std::make_shared<Ellipsoid>(Point3{center[0], center[1], center[2]}, axes);
   geometry.finish();
 
   TableReader formulation(subtable(root, "formulation"), "formulation");

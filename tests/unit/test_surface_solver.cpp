@@ -199,3 +199,69 @@ TEST(SurfaceSolver, PeriodicBoxWithoutReactionSolves) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(ImplicitSurface, SphereAndTorusFromTheirLevelFunctions) {
+  // A sphere: the area from the marching-tetrahedra triangulation, no fold for outward offsets, the
+  // points of the patches on γ with unit outward normals.
+  const Point3 c{0.5, 0.5, 0.5};
+  const fictus::ImplicitSurface sphere(
+      [c](double x, double y, double z) {
+        return (x - c.x) * (x - c.x) + (y - c.y) * (y - c.y) + (z - c.z) * (z - c.z) - 0.09;
+      },
+      fictus::Box3{{0.1, 0.1, 0.1}, {0.9, 0.9, 0.9}});
+  EXPECT_NEAR(sphere.area(), 4 * std::numbers::pi * 0.09, 2e-3 * 4 * std::numbers::pi * 0.09);
+  EXPECT_TRUE(std::isinf(sphere.reach()));
+  EXPECT_NEAR(sphere.bounds().lower.x, 0.2, 1e-3);
+  EXPECT_NEAR(sphere.bounds().upper.z, 0.8, 1e-3);
+  const fictus::PatchedSurface patches = sphere.patches(50, 1.0 / 64);
+  ASSERT_EQ(patches.m, 50);
+  double total = 0;
+  for (int p = 0; p < patches.m; ++p) {
+    EXPECT_NEAR(norm(patches.point[p] - c), 0.3, 1e-12);
+    EXPECT_NEAR(dot(patches.normal[p], (1 / 0.3) * (patches.point[p] - c)), 1.0, 1e-9);
+    total += patches.area[p];
+  }
+  EXPECT_NEAR(total, 4 * std::numbers::pi * 0.09, 2e-3);
+  // A torus: its offsets fold at the axis, R − r from the inner equator (the concave side's largest
+  // principal curvature 1/(R − r)), and the implicit torus solves the built-in torus's problem alike.
+  const double R = 0.25, r = 0.1;
+  const fictus::ImplicitSurface torus(
+      [c, R, r](double x, double y, double z) {
+        const double planar = std::hypot(x - c.x, y - c.y) - R;
+        return planar * planar + (z - c.z) * (z - c.z) - r * r;
+      },
+      fictus::Box3{{0.05, 0.05, 0.3}, {0.95, 0.95, 0.7}});
+  EXPECT_NEAR(torus.reach(), R - r, 0.02 * (R - r));
+  EXPECT_NEAR(torus.area(), 4 * std::numbers::pi * std::numbers::pi * R * r, 3e-3);
+}
+
+TEST(ImplicitSurface, NamesWhatIsWrongWithTheLevelFunction) {
+  const fictus::Box3 box{{0.1, 0.1, 0.1}, {0.9, 0.9, 0.9}};
+  const auto message = [&](fictus::ScalarField3 level, fictus::Box3 b) {
+    try {
+      fictus::ImplicitSurface s(std::move(level), b);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const auto ball = [](double x, double y, double z) {
+    return (x - .5) * (x - .5) + (y - .5) * (y - .5) + (z - .5) * (z - .5) - 0.09;
+  };
+  EXPECT_NE(message(ball, {{0.25, 0.1, 0.1}, {0.9, 0.9, 0.9}}).find("geometry.bounds: the surface reaches"),
+            std::string::npos);
+  EXPECT_NE(message(ball, {{0.9, 0.1, 0.1}, {0.1, 0.9, 0.9}}).find("geometry.bounds: expected"), std::string::npos);
+  EXPECT_NE(message([&](double x, double y, double z) { return std::pow(ball(x, y, z), 3); }, box)
+                .find("geometry.level: the gradient vanishes"),
+            std::string::npos);
+  EXPECT_NE(message([&](double x, double y, double z) { return ball(x, y, z) + 0.1; }, box)
+                .find("geometry.level: no surface"),
+            std::string::npos);
+  EXPECT_NE(message([&](double x, double y, double z) { return x > 0.5 ? std::nan("") : ball(x, y, z); }, box)
+                .find("geometry.level: not finite"),
+            std::string::npos);
+}
+
+}  // namespace
