@@ -32,7 +32,8 @@ constexpr int tetrahedra[6][4] = {{0, 1, 3, 7}, {0, 3, 2, 7}, {0, 2, 6, 7}, {0, 
 ImplicitSurface::ImplicitSurface(ScalarField3 level, Box3 bounds) : level_(std::move(level)), bounds_(bounds) {
   if (!level_) throw std::invalid_argument("geometry.level: not given");
   for (int d = 0; d < 3; ++d)
-    if (!std::isfinite(bounds.lower[d]) || !std::isfinite(bounds.upper[d]) || !(bounds.upper[d] > bounds.lower[d]))
+    if (!std::isfinite(bounds.lower[d]) || !std::isfinite(bounds.upper[d]) || !(bounds.upper[d] > bounds.lower[d]) ||
+        !std::isfinite(bounds.width(d)))
       throw std::invalid_argument(
           "geometry.bounds: expected [x0, y0, z0, x1, y1, z1], finite, x0 < x1, y0 < y1, z0 < z1");
   // γ must stay inside the bounds: level > 0 on their faces (sampled on a 33 × 33 lattice each).
@@ -52,24 +53,30 @@ ImplicitSurface::ImplicitSurface(ScalarField3 level, Box3 bounds) : level_(std::
             throw std::invalid_argument("geometry.bounds: the surface reaches the bounding box (level <= 0 at " +
                                         at(p) + "): larger bounds");
         }
-  // The area, the checks of the gradient and the curvature from one triangulation.
+  // The tight box, the area, the checks of the gradient and the curvature from one triangulation.
   const double edge = largest_side(bounds) / 96;
-  const std::vector<Triangle3> triangles = triangulate(edge);
+  const std::vector<Triangle3> triangles = triangulate(bounds, edge);
   if (triangles.empty())
     throw std::invalid_argument("geometry.level: no surface inside geometry.bounds (level > 0 at every sample)");
-  double typical_slope = 0;  // |level| at the box's corners over its size: the scale of the level function
+  tight_.lower = tight_.upper = triangles.front().a;
+  for (const Triangle3& t : triangles)
+    for (const Point3& v : {t.a, t.b, t.c})
+      for (int d = 0; d < 3; ++d)
+        tight_.lower[d] = std::min(tight_.lower[d], v[d]), tight_.upper[d] = std::max(tight_.upper[d], v[d]);
+  for (int d = 0; d < 3; ++d) {  // the vertices lie on γ; between them it bulges by about edge²κ/8
+    tight_.lower[d] = std::max(bounds.lower[d], tight_.lower[d] - 0.05 * edge);
+    tight_.upper[d] = std::min(bounds.upper[d], tight_.upper[d] + 0.05 * edge);
+  }
+  scale_ = largest_side(tight_);  // the steps of the derivatives scale with γ, not with the given box
+  double typical_slope = 0;       // |level| at the box's corners over its size: the scale of the level function
   for (int c = 0; c < 8; ++c) {
     const Point3 corner{c & 1 ? bounds.upper.x : bounds.lower.x, c & 2 ? bounds.upper.y : bounds.lower.y,
                         c & 4 ? bounds.upper.z : bounds.lower.z};
     typical_slope = std::max(typical_slope, std::abs(level_(corner.x, corner.y, corner.z)) / largest_side(bounds));
   }
   double largest_concave = 0;
-  tight_.lower = tight_.upper = triangles.front().a;
   for (const Triangle3& t : triangles) {
     area_ += fictus::area(t);
-    for (const Point3& v : {t.a, t.b, t.c})
-      for (int d = 0; d < 3; ++d)
-        tight_.lower[d] = std::min(tight_.lower[d], v[d]), tight_.upper[d] = std::max(tight_.upper[d], v[d]);
     const Point3 g = level_gradient(t.a);
     const double slope = norm(g);
     if (!(slope > 1e-6 * typical_slope))
@@ -93,17 +100,13 @@ ImplicitSurface::ImplicitSurface(ScalarField3 level, Box3 bounds) : level_(std::
     for (int k = 0; k < 3; ++k)
       if (k != along_normal) largest_concave = std::max(largest_concave, -shape.eigenvalues()[k]);
   }
-  for (int d = 0; d < 3; ++d) {  // the vertices lie on γ; between them it bulges by about edge²κ/8
-    tight_.lower[d] = std::max(bounds.lower[d], tight_.lower[d] - 0.05 * edge);
-    tight_.upper[d] = std::min(bounds.upper[d], tight_.upper[d] + 0.05 * edge);
-  }
   reach_ = largest_concave > 0 ? 1 / largest_concave : std::numeric_limits<double>::infinity();
 }
 
 double ImplicitSurface::level(const Point3& p) const { return level_(p.x, p.y, p.z); }
 
 Point3 ImplicitSurface::level_gradient(const Point3& p) const {
-  const double step = 1e-5 * largest_side(bounds_);
+  const double step = 1e-5 * scale_;
   Point3 g;
   for (int d = 0; d < 3; ++d) {
     Point3 plus = p, minus = p;
@@ -115,7 +118,7 @@ Point3 ImplicitSurface::level_gradient(const Point3& p) const {
 }
 
 Matrix3 ImplicitSurface::level_hessian(const Point3& p) const {
-  const double step = 1e-4 * largest_side(bounds_);
+  const double step = 1e-4 * scale_;
   const auto shifted = [&](int d, double a, int e, double b) {
     Point3 q = p;
     q[d] += a * step;
@@ -133,12 +136,17 @@ Matrix3 ImplicitSurface::level_hessian(const Point3& p) const {
   return H;
 }
 
-std::vector<Triangle3> ImplicitSurface::triangulate(double edge) const {
+std::vector<Triangle3> ImplicitSurface::triangulate(const Box3& box, double edge) const {
   std::array<int, 3> cells;
-  for (int d = 0; d < 3; ++d) cells[d] = std::max(2, int(std::ceil(bounds_.width(d) / edge)));
+  for (int d = 0; d < 3; ++d) {
+    const double n = std::ceil(box.width(d) / edge);
+    if (!(n <= 4096))
+      throw std::invalid_argument("geometry.level: the surface would need more than 4096 cubes along an axis");
+    cells[d] = std::max(2, int(n));
+  }
   const auto node = [&](int i, int j, int k) {
-    return Point3{bounds_.lower.x + bounds_.width(0) * i / cells[0], bounds_.lower.y + bounds_.width(1) * j / cells[1],
-                  bounds_.lower.z + bounds_.width(2) * k / cells[2]};
+    return Point3{box.lower.x + box.width(0) * i / cells[0], box.lower.y + box.width(1) * j / cells[1],
+                  box.lower.z + box.width(2) * k / cells[2]};
   };
   const std::size_t nx = std::size_t(cells[0] + 1), ny = std::size_t(cells[1] + 1);
   std::vector<double> values(nx * ny * std::size_t(cells[2] + 1));
@@ -148,6 +156,10 @@ std::vector<Triangle3> ImplicitSurface::triangulate(double edge) const {
         const Point3 p = node(i, j, k);
         const double value = level(p);
         if (!std::isfinite(value)) throw std::invalid_argument("geometry.level: not finite at " + at(p));
+        const bool face = i == 0 || j == 0 || k == 0 || i == cells[0] || j == cells[1] || k == cells[2];
+        if (face && !(value > 0))  // a closed triangulation needs ω inside the lattice
+          throw std::invalid_argument("geometry.bounds: the surface reaches the bounding box (level <= 0 at " + at(p) +
+                                      "): larger bounds");
         values[(std::size_t(k) * ny + std::size_t(j)) * nx + std::size_t(i)] = value;
       }
   // The crossing on the edge a–b (f(a) < 0 ≤ f(b)) by safeguarded regula falsi.
@@ -202,11 +214,16 @@ std::vector<Triangle3> ImplicitSurface::triangulate(double edge) const {
 PatchedSurface ImplicitSurface::patches(int m, double edge) const {
   if (!(edge > 0)) throw std::invalid_argument("ImplicitSurface::patches: the edge length must be positive");
   PatchedSurface s;
-  s.triangles = triangulate(edge);
+  Box3 region = tight_;  // a margin of two cubes, so that the lattice's faces stay outside γ
+  for (int d = 0; d < 3; ++d) {
+    region.lower[d] = std::max(bounds_.lower[d], region.lower[d] - 2 * edge);
+    region.upper[d] = std::min(bounds_.upper[d], region.upper[d] + 2 * edge);
+  }
+  s.triangles = triangulate(region, edge);
   if (int(s.triangles.size()) < m)
     throw std::invalid_argument("formulation.multipliers: more patches than triangles of the surface");
   const std::vector<Point3> seeds = split_into_patches(s, m);
-  const double tolerance = 1e-13 * largest_side(bounds_);
+  const double tolerance = 1e-13 * scale_;
   for (int q = 0; q < m; ++q) {
     const SurfaceFoot foot = nearest_point(*this, seeds[q], seeds[q], tolerance);
     s.point[q] = foot.foot;

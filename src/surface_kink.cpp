@@ -3,6 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+#include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -34,6 +39,7 @@ Point3 drop_onto(const Surface& gamma, Point3 p, double tolerance) {
 
 SurfaceFoot nearest_point(const Surface& gamma, const Point3& x, const Point3& start, double tolerance) {
   Point3 p = drop_onto(gamma, start, tolerance);
+  double previous = std::numeric_limits<double>::infinity();
   for (int it = 0; it < 20; ++it) {
     const Point3 g = gamma.level_gradient(p);
     const double slope = norm(g);
@@ -42,7 +48,9 @@ SurfaceFoot nearest_point(const Surface& gamma, const Point3& x, const Point3& s
     const Point3 r = x - p;
     const double d = dot(r, n);
     const Point3 t = r - d * n;
-    if (norm(t) <= tolerance) break;
+    // Converged, or no longer converging (derivatives by differences stop it near their accuracy).
+    if (norm(t) <= tolerance || (it >= 3 && norm(t) > 0.5 * previous)) break;
+    previous = norm(t);
     // (I + d W) δ = t with W = P Hess P / |∇level| the shape operator (P the tangent projector): the
     // step that keeps x − p along the normal to first order; the normal direction is left as is.
     const Matrix3 hessian = gamma.level_hessian(p);
@@ -66,6 +74,12 @@ SurfaceFoot nearest_point(const Surface& gamma, const Point3& x, const Point3& s
   const Matrix3 hessian = gamma.level_hessian(p);
   const double trace = hessian[0][0] + hessian[1][1] + hessian[2][2];
   k.H = (trace * slope * slope - dot(g, times(hessian, g))) / (slope * slope * slope);
+  if (!std::isfinite(k.d) || !std::isfinite(k.H) || !std::isfinite(k.normal.x + k.normal.y + k.normal.z)) {
+    char where[96];
+    std::snprintf(where, sizeof where, "(%.4g, %.4g, %.4g)", x.x, x.y, x.z);
+    throw std::invalid_argument(std::string("geometry: no nearest point of the surface to ") + where +
+                                " (a vanishing or non-finite gradient of the level function there)");
+  }
   return k;
 }
 
@@ -100,11 +114,11 @@ class PatchLocator {
   /// within the longest edge + reach of p).
   void near(const Point3& p, std::vector<int>& out) const {
     out.clear();
-    const std::array<long, 3> b = bucket(p);
-    for (long dz = -1; dz <= 1; ++dz)
-      for (long dy = -1; dy <= 1; ++dy)
-        for (long dx = -1; dx <= 1; ++dx) {
-          const long k = key({b[0] + dx, b[1] + dy, b[2] + dz});
+    const std::array<std::int64_t, 3> b = bucket(p);
+    for (std::int64_t dz = -1; dz <= 1; ++dz)
+      for (std::int64_t dy = -1; dy <= 1; ++dy)
+        for (std::int64_t dx = -1; dx <= 1; ++dx) {
+          const std::int64_t k = key({b[0] + dx, b[1] + dy, b[2] + dz});
           auto it = std::lower_bound(buckets_.begin(), buckets_.end(), std::make_pair(k, -1));
           for (; it != buckets_.end() && it->first == k; ++it)
             if (norm(centroids_[std::size_t(it->second)] - p) <= side_) out.push_back(it->second);
@@ -136,14 +150,17 @@ class PatchLocator {
 
  private:
   static Point3 centroid(const Triangle3& t) { return (1.0 / 3.0) * (t.a + t.b + t.c); }
-  std::array<long, 3> bucket(const Point3& p) const {
-    return {long(std::floor(p.x / side_)), long(std::floor(p.y / side_)), long(std::floor(p.z / side_))};
+  std::array<std::int64_t, 3> bucket(const Point3& p) const {
+    return {std::int64_t(std::floor(p.x / side_)), std::int64_t(std::floor(p.y / side_)),
+            std::int64_t(std::floor(p.z / side_))};
   }
-  static long key(const std::array<long, 3>& b) { return ((b[2] + 4096) * 8192 + (b[1] + 4096)) * 8192 + b[0] + 4096; }
+  static std::int64_t key(const std::array<std::int64_t, 3>& b) {
+    return ((b[2] + 4096) * 8192 + (b[1] + 4096)) * 8192 + b[0] + 4096;
+  }
   const PatchedSurface& surface_;
   double side_ = 1;
   std::vector<Point3> centroids_;
-  std::vector<std::pair<long, int>> buckets_;  // (bucket, triangle), sorted
+  std::vector<std::pair<std::int64_t, int>> buckets_;  // (bucket, triangle), sorted
 };
 
 /// A node of the band: its key (i + (n0+1)(j + (n1+1)k)), patch and ψ.
@@ -175,6 +192,8 @@ struct SurfaceKink::State {
            std::size_t(i[0]);
   }
   const BandNode* find(const Grid3::Index& i) const {
+    for (int d = 0; d < 3; ++d)
+      if (i[d] < 0 || i[d] > grid.n(d)) return nullptr;
     const std::size_t k = key(i);
     const auto it =
         std::lower_bound(band.begin(), band.end(), k, [](const BandNode& b, std::size_t v) { return b.key < v; });
@@ -319,7 +338,7 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
       const Point3 center = lower + Point3{h / 2, h / 2, h / 2};
       const SurfaceFoot centre = nearest_point(gamma, center, center, tolerance);
       locate.near(centre.foot, near);
-      bool one_patch = true;
+      bool one_patch = !near.empty();
       for (int t : near)
         one_patch = one_patch && patches.patch_of[std::size_t(t)] == patches.patch_of[std::size_t(near[0])];
       // Sums per patch met in this voxel for its eight nodes.
@@ -331,7 +350,9 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
       };
       auto add_point = [&](const Point3& x, double w) {
         const SurfaceFoot foot = nearest_point(gamma, x, centre.foot, tolerance);
-        const int patch = one_patch ? patches.patch_of[std::size_t(near[0])] : locate.patch(foot.foot, near);
+        const int patch = one_patch      ? patches.patch_of[std::size_t(near[0])]
+                          : near.empty() ? locate.patch(foot.foot)
+                                         : locate.patch(foot.foot, near);
         Point3 xi;
         for (int d = 0; d < 3; ++d) xi[d] = (x[d] - lower[d]) / h;
         const Q1Element<3> basis(xi, h);

@@ -486,6 +486,11 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   std::unique_ptr<SurfaceKink> kink;
   DirectTerms direct;
   if (options.variant == Variant::nonsmooth && reconstructed) {
+    if (!(gamma.reach() > 6 * h))  // the kink band reaches 6h outside γ: its nearest points must be unique
+      throw std::invalid_argument(
+          format("formulation.variant: the surface folds within %.3g of itself outside, "
+                 "inside the non-smooth variant's band of 6h = %.3g: a larger N",
+                 gamma.reach(), 6 * h));
     kink = std::make_unique<SurfaceKink>(grid, gamma, sol.gamma, problem.c, execution);
     direct.trace = kink->direct(B_gamma);
     direct.normal_derivative = kink->direct(C_gamma);

@@ -87,7 +87,7 @@ class Torus final : public Surface {
 /// level(x) < 0 in ω, any smooth function with a nonzero gradient on its zero set, inside a box that
 /// holds γ: triangulated by marching tetrahedra on a lattice of cubes of side `edge` (the crossings on the
 /// tetrahedra's edges by root finding), split into patches as the built-in shapes are. Derivatives by
-/// central differences (steps 1e-5 and 1e-4 of the box's largest side).
+/// central differences (steps 1e-5 and 1e-4 of the largest side of γ's box).
 class ImplicitSurface final : public Surface {
  public:
   /// Throws std::invalid_argument naming geometry.bounds (not a box, or γ reaches its faces) or
@@ -106,10 +106,10 @@ class ImplicitSurface final : public Surface {
   double reach() const override { return reach_; }
 
  private:
-  std::vector<Triangle3> triangulate(double edge) const;
+  std::vector<Triangle3> triangulate(const Box3& box, double edge) const;
   ScalarField3 level_;
   Box3 bounds_, tight_;
-  double area_ = 0, reach_ = 0;
+  double scale_ = 1, area_ = 0, reach_ = 0;
 };
 
 struct SurfaceProblem {

@@ -44,7 +44,8 @@ struct Bands {
   int fewest_active_tenths;  // at least m·fewest/10 points in contact (the contact set is there)
 };
 
-void converges(const std::string& name, const std::vector<int>& sizes, fictus::Variant variant, const Bands& bands) {
+void converges(const std::string& name, const std::vector<int>& sizes, fictus::Variant variant, const Bands& bands,
+               double largest_finest_error = 1.0) {
   std::vector<fictus::LevelResult> rows;
   for (int N : sizes) {
     fictus::SolverOptions o;
@@ -63,6 +64,7 @@ void converges(const std::string& name, const std::vector<int>& sizes, fictus::V
   const char* label = variant == fictus::Variant::smooth ? ", smooth, 3-D" : ", non-smooth, 3-D";
   std::cout << fictus::format_convergence_table(name + label, rows, std::nullopt);
   const auto fit = fictus::fitted_rates(rows);
+  EXPECT_LT(rows.back().l2_omega, largest_finest_error);
   EXPECT_GE(fit[0], bands.lowest_rate);
   EXPECT_LE(fit[0], bands.highest_rate);
   EXPECT_GE(fit[1], bands.lowest_h1_rate);
@@ -107,7 +109,7 @@ TEST(Manufactured3d, NonSmoothVariantConvergesWithTheKinkCorrection) {
   // Multipliers on γ itself, traces of the kink-corrected field (surface_kink.hpp), patches of 4h. The
   // contact set is under-resolved at small N (fewer points in contact than the smooth variant finds),
   // so the rate here is above its asymptotic value; the issue asks for about 1.
-  converges("sphere", {64, 80, 96}, fictus::Variant::nonsmooth, {1.0, 5.0, 0.7, 1.0, 1});
+  converges("sphere", {64, 80, 96}, fictus::Variant::nonsmooth, {1.0, 5.0, 0.7, 1.0, 1}, 4.5e-4);
 }
 
 TEST(Manufactured3d, NonSmoothShiftedRuleStallsWithoutTheKinkCorrection) {

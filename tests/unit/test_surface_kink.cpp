@@ -1,5 +1,6 @@
 // 3-D kink correction (the non-smooth variant's traces): the nearest point of γ and its curvature,
-// the Galerkin rows r_j, and the corrected traces of a layer potential with a known solution.
+// and the corrected traces of a layer potential with a known solution (through the kink values, the
+// Galerkin rows r_j and the patch integrals over γ: uncorrected, the mean error is 0.58).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -62,26 +63,6 @@ TEST(SurfaceKink, NearestPointDistanceAndCurvature) {
   const fictus::SurfaceFoot inner = fictus::nearest_point(torus, inner_x, inner_x, 1e-15);
   EXPECT_NEAR(inner.d, 0.01, 1e-13);
   EXPECT_NEAR(inner.H, 1 / rt - 1 / (R - rt), 1e-9);
-}
-
-TEST(SurfaceKink, GalerkinRowsSumToZeroWithoutReaction) {
-  // r_j,k = a(ψ_j − I_hψ_j, φ_k) and a(·, 1) = 0 for c = 0: every row sums to zero.
-  const fictus::Ellipsoid gamma({0.5, 0.5, 0.5}, {0.3, 0.25, 0.2});
-  const fictus::Grid3 grid(fictus::Box3{{0, 0, 0}, {1, 1, 1}}, 32);
-  const fictus::PatchedSurface patches = gamma.patches(60, grid.h());
-  const fictus::SurfaceKink kink(grid, gamma, patches, 0.0);
-  const fictus::SparseRows& rows = kink.galerkin();
-  ASSERT_EQ(rows.n_rows(), 60);
-  EXPECT_GT(kink.cut_voxels(), 500u);
-  double largest_row = 0;
-  for (int r = 0; r < rows.n_rows(); ++r) {
-    double sum = 0, size = 0;
-    for (std::size_t k = rows.row_begin[r]; k < rows.row_begin[r + 1]; ++k)
-      sum += rows.entries[k].value, size += std::abs(rows.entries[k].value);
-    EXPECT_NEAR(sum, 0.0, 1e-14);
-    largest_row = std::max(largest_row, size);
-  }
-  EXPECT_GT(largest_row, 1e-5);
 }
 
 /// The mean and the largest error over the points of ∂û/∂n inside γ for a layer of density 1 on a
