@@ -83,14 +83,7 @@ ImplicitSurface::ImplicitSurface(ScalarField3 level, Box3 bounds) : level_(std::
       throw std::invalid_argument("geometry.level: the gradient vanishes on the surface near " + at(t.a) +
                                   " (a singular point): a level function with a nonzero gradient on its zero set");
     // Principal curvatures: the eigenvalues of P∇²φP/|∇φ| on the tangent plane.
-    const Matrix3 hessian = level_hessian(t.a);
-    Eigen::Matrix3d P = Eigen::Matrix3d::Identity(), H;
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) {
-        P(a, b) -= g[a] * g[b] / (slope * slope);
-        H(a, b) = hessian[a][b];
-      }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> shape(P * H * P / slope);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> shape(shape_operator(g, level_hessian(t.a)));
     const Eigen::Vector3d normal(g.x / slope, g.y / slope, g.z / slope);
     int along_normal = 0;  // its eigenvalue is 0: not a curvature
     for (int k = 1; k < 3; ++k)

@@ -37,6 +37,17 @@ Point3 drop_onto(const Surface& gamma, Point3 p, double tolerance) {
 
 }  // namespace
 
+Eigen::Matrix3d shape_operator(const Point3& gradient, const Matrix3& hessian) {
+  const double slope = norm(gradient);
+  Eigen::Matrix3d P = Eigen::Matrix3d::Identity(), H;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) {
+      P(a, b) -= gradient[a] * gradient[b] / (slope * slope);
+      H(a, b) = hessian[a][b];
+    }
+  return P * H * P / slope;
+}
+
 SurfaceFoot nearest_point(const Surface& gamma, const Point3& x, const Point3& start, double tolerance) {
   Point3 p = drop_onto(gamma, start, tolerance);
   double previous = std::numeric_limits<double>::infinity();
@@ -53,15 +64,7 @@ SurfaceFoot nearest_point(const Surface& gamma, const Point3& x, const Point3& s
     previous = norm(t);
     // (I + d W) δ = t with W = P Hess P / |∇level| the shape operator (P the tangent projector): the
     // step that keeps x − p along the normal to first order; the normal direction is left as is.
-    const Matrix3 hessian = gamma.level_hessian(p);
-    Eigen::Matrix3d P = Eigen::Matrix3d::Identity(), Hs;
-    for (int a = 0; a < 3; ++a) {
-      for (int b = 0; b < 3; ++b) {
-        P(a, b) -= n[a] * n[b];
-        Hs(a, b) = hessian[a][b];
-      }
-    }
-    const Eigen::Matrix3d M = Eigen::Matrix3d::Identity() + (d / slope) * P * Hs * P;
+    const Eigen::Matrix3d M = Eigen::Matrix3d::Identity() + d * shape_operator(g, gamma.level_hessian(p));
     const Eigen::Vector3d step = M.partialPivLu().solve(Eigen::Vector3d(t.x, t.y, t.z));
     p = drop_onto(gamma, p + Point3{step[0], step[1], step[2]}, tolerance);
   }
@@ -271,8 +274,7 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
     for (int j = first[1]; j < last[1]; ++j)
       for (int i = first[0]; i < last[0]; ++i) {
         const Point3 center{grid.x(i) + h / 2, grid.y(j) + h / 2, grid.z(k) + h / 2};
-        if (std::abs(gamma.level(center)) <= 2 * 0.87 * h * norm(gamma.level_gradient(center)))
-          near_voxels.push_back({i, j, k});
+        if (near_surface(gamma, center, 0.87 * h)) near_voxels.push_back({i, j, k});
       }
   std::vector<char> is_cut(near_voxels.size(), 0);
 #pragma omp parallel for num_threads(execution.threads()) schedule(dynamic, 64)

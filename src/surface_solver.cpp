@@ -137,14 +137,13 @@ int default_patches(double area, double h, Variant variant) {
 // ---------------------------------------------------------------------------------------------
 // Quadrature over ω
 
-namespace {
-
-/// The distance of p from γ is at least about |level|/|∇level| near γ.
 bool near_surface(const Surface& gamma, const Point3& center, double radius) {
   const double value = gamma.level(center);
   const double slope = norm(gamma.level_gradient(center));
   return !(std::abs(value) > 2.0 * radius * slope);
 }
+
+namespace {
 
 /// The cube [lower, lower + side]³ ∩ ω by lines along the axis where γ is steepest. The inside
 /// length of a line is smooth across the cube while γ leaves through the four faces parallel to the

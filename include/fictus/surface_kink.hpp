@@ -13,6 +13,7 @@
 #include <memory>
 #include <vector>
 
+#include <Eigen/Core>
 #include <Eigen/SparseCore>
 
 #include "fictus/execution.hpp"
@@ -31,6 +32,10 @@ struct SurfaceFoot {
   double psi() const { return d > 0 ? q() : 0.0; }          // q(d)⁺
   Point3 grad_q() const { return (1.0 - H * d) * normal; }  // ∇q, H taken constant
 };
+
+/// W = P∇²φP/|∇φ| (P the projector onto the tangent plane) from the level function's gradient and
+/// Hessian at a point of γ: the shape operator, whose tangential eigenvalues are the principal curvatures.
+Eigen::Matrix3d shape_operator(const Point3& gradient, const Matrix3& hessian);
 
 /// The nearest point of γ to x (within a few cells of γ), by Newton's method from `start` (a point
 /// near the answer; x itself will do): projection onto γ along the level gradient, then a tangential

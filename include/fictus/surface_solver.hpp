@@ -164,6 +164,10 @@ using OmegaVisitor = std::function<void(int thread, const Grid3::Index& cell, co
 void for_each_omega_point(const Grid3& grid, const Surface& gamma, int q, const Execution& execution,
                           const OmegaVisitor& visit);
 
+/// May γ come within `radius` of `center`? (|level| ≤ 2·radius·|∇level| there: the distance is about
+/// |level|/|∇level| near γ, with a factor 2 to spare.)
+bool near_surface(const Surface& gamma, const Point3& center, double radius);
+
 /// The points of that rule in one voxel (none for a voxel outside ω), on the calling thread.
 /// `depth` > 0 splits the half-voxels where γ meets the faces across the line direction up to that many times more.
 void for_each_omega_point_in_voxel(const Grid3& grid, const Surface& gamma, const Grid3::Index& cell, int q,
