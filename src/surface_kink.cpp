@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <exception>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -219,8 +220,7 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
   State& st = *state_;
   st.m = patches.m;
   const double h = grid.h();
-  const double band_width = 6 * h;  // the nodes of the two rings of voxels around the cut ones (≤ 5.2h)  // the nodes
-                                    // of the voxels around the cut ones, and of every trace stencil
+  const double band_width = 6 * h;  // the nodes of the two rings of voxels around the cut ones (≤ 5.2h)
   const double tolerance = 1e-13 * h;
   const PatchLocator locate(patches, h);  // the feet of a voxel's points lie within 0.9h of its centre's
   const Box3 bounds = gamma.bounds();
@@ -230,25 +230,39 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
     last[d] = std::min(grid.n(d), grid.cell(d, bounds.upper[d] + band_width) + 2);
   }
 
-  // 1. The band: the nodes outside ω within 3h of γ, with ψ and the patch of their nearest point.
+  // nearest_point throws on a vanishing gradient: kept here and thrown after each parallel loop.
+  std::exception_ptr failure;
+  const auto keep = [&failure] {
+#pragma omp critical(fictus_surface_kink_failure)
+    if (!failure) failure = std::current_exception();
+  };
+
+  // 1. The band: the nodes outside ω within 6h of γ, with ψ and the patch of their nearest point.
   std::vector<std::vector<BandNode>> band_by_z(std::size_t(last[2] - first[2] + 1));
 #pragma omp parallel for num_threads(execution.threads()) schedule(dynamic, 1)
-  for (int k = first[2]; k <= last[2]; ++k)
-    for (int j = first[1]; j <= last[1]; ++j)
-      for (int i = first[0]; i <= last[0]; ++i) {
-        const Point3 x{grid.x(i), grid.y(j), grid.z(k)};
-        const double level = gamma.level(x);
-        if (!(level > 0) || level > 2 * band_width * norm(gamma.level_gradient(x))) continue;
-        const SurfaceFoot foot = nearest_point(gamma, x, x, tolerance);
-        if (!(foot.d > 0 && foot.d <= band_width)) continue;
-        const Grid3::Index node{i, j, k};
-        band_by_z[std::size_t(k - first[2])].push_back({st.key(node), node, locate.patch(foot.foot), foot.psi()});
-      }
+  for (int k = first[2]; k <= last[2]; ++k) {
+    try {
+      for (int j = first[1]; j <= last[1]; ++j)
+        for (int i = first[0]; i <= last[0]; ++i) {
+          const Point3 x{grid.x(i), grid.y(j), grid.z(k)};
+          const double level = gamma.level(x);
+          if (!(level > 0) || level > 2 * band_width * norm(gamma.level_gradient(x))) continue;
+          const SurfaceFoot foot = nearest_point(gamma, x, x, tolerance);
+          if (!(foot.d > 0 && foot.d <= band_width)) continue;
+          const Grid3::Index node{i, j, k};
+          band_by_z[std::size_t(k - first[2])].push_back({st.key(node), node, locate.patch(foot.foot), foot.psi()});
+        }
+    } catch (...) {
+      keep();
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
   for (auto& layer : band_by_z) st.band.insert(st.band.end(), layer.begin(), layer.end());
   std::sort(st.band.begin(), st.band.end(), [](const BandNode& a, const BandNode& b) { return a.key < b.key; });
 
-  // 2. r_j,k = a(ψ_j − I_hψ_j, φ_k) on every cut voxel: the part outside ω is the whole voxel minus
-  //    its part in ω (ψ_j's smooth extension q(d) on both), and I_hψ_j takes the element matrix.
+  // 2. r_j,k = a(ψ_j − I_hψ_j, φ_k) on every cut voxel (the part outside ω is the whole voxel minus
+  //    its part in ω, ψ_j's smooth extension q(d) on both) and on two rings of outside voxels around
+  //    them; I_hψ_j takes the element matrix.
   //    Each quadrature point goes to the patch its nearest point of γ lies on.
   const GaussRule& rule = gauss_legendre(3);  // q(d) is smooth on the voxel: degree-5 exactness suffices
   constexpr int cut_q = 3;
@@ -331,60 +345,63 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
     std::vector<int> near;
     std::vector<std::pair<Point3, double>> inside;
 #pragma omp for schedule(dynamic, 16)
-    for (std::size_t n = 0; n < voxels.size(); ++n) {
-      const Grid3::Index cell = voxels[n];
-      const Point3 lower{grid.x(cell[0]), grid.y(cell[1]), grid.z(cell[2])};
-      inside.clear();
-      for_each_omega_point_in_voxel(grid, gamma, cell, cut_q,
-                                    [&](const Point3& x, double w) { inside.emplace_back(x, w); });
-      const Point3 center = lower + Point3{h / 2, h / 2, h / 2};
-      const SurfaceFoot centre = nearest_point(gamma, center, center, tolerance);
-      locate.near(centre.foot, near);
-      bool one_patch = !near.empty();
-      for (int t : near)
-        one_patch = one_patch && patches.patch_of[std::size_t(t)] == patches.patch_of[std::size_t(near[0])];
-      // Sums per patch met in this voxel for its eight nodes.
-      std::vector<std::pair<int, std::array<double, 8>>> sums;
-      auto sums_of = [&](int patch) -> std::array<double, 8>& {
-        for (auto& [p, v] : sums)
-          if (p == patch) return v;
-        return sums.emplace_back(patch, std::array<double, 8>{}).second;
-      };
-      auto add_point = [&](const Point3& x, double w) {
-        const SurfaceFoot foot = nearest_point(gamma, x, centre.foot, tolerance);
-        const int patch = one_patch      ? patches.patch_of[std::size_t(near[0])]
-                          : near.empty() ? locate.patch(foot.foot)
-                                         : locate.patch(foot.foot, near);
-        Point3 xi;
-        for (int d = 0; d < 3; ++d) xi[d] = (x[d] - lower[d]) / h;
-        const Q1Element<3> basis(xi, h);
-        const double q = foot.q();
-        const Point3 grad = foot.grad_q();
-        std::array<double, 8>& v = sums_of(patch);
-        for (int l = 0; l < 8; ++l) v[l] += w * (dot(grad, basis.gradient(l)) + c * q * basis.value[l]);
-      };
-      for (std::size_t c3 = 0; c3 < rule.nodes.size(); ++c3)
-        for (std::size_t b = 0; b < rule.nodes.size(); ++b)
-          for (std::size_t a = 0; a < rule.nodes.size(); ++a)
-            add_point(lower + h * Point3{rule.nodes[a], rule.nodes[b], rule.nodes[c3]},
-                      rule.weights[a] * rule.weights[b] * rule.weights[c3] * h * h * h);
-      for (const auto& [x, w] : inside) add_point(x, -w);
-      for (int l = 0; l < 8; ++l) {
-        const Grid3::Index node{cell[0] + Q1Element<3>::offset(l, 0), cell[1] + Q1Element<3>::offset(l, 1),
-                                cell[2] + Q1Element<3>::offset(l, 2)};
-        const BandNode* b = st.find(node);
-        if (!b || b->patch < 0) continue;
-        std::array<double, 8>& v = sums_of(b->patch);
-        for (int k = 0; k < 8; ++k) v[k] -= b->psi * (K[l][k] + c * M[l][k]);
-      }
-      for (const auto& [patch, v] : sums)
-        for (int k = 0; k < 8; ++k) {
-          const Grid3::Index node{cell[0] + Q1Element<3>::offset(k, 0), cell[1] + Q1Element<3>::offset(k, 1),
-                                  cell[2] + Q1Element<3>::offset(k, 2)};
-          if (patch >= 0) by_voxel[n].push_back({patch, node, v[k]});
+    for (std::size_t n = 0; n < voxels.size(); ++n) try {
+        const Grid3::Index cell = voxels[n];
+        const Point3 lower{grid.x(cell[0]), grid.y(cell[1]), grid.z(cell[2])};
+        inside.clear();
+        for_each_omega_point_in_voxel(grid, gamma, cell, cut_q,
+                                      [&](const Point3& x, double w) { inside.emplace_back(x, w); });
+        const Point3 center = lower + Point3{h / 2, h / 2, h / 2};
+        const SurfaceFoot centre = nearest_point(gamma, center, center, tolerance);
+        locate.near(centre.foot, near);
+        bool one_patch = !near.empty();
+        for (int t : near)
+          one_patch = one_patch && patches.patch_of[std::size_t(t)] == patches.patch_of[std::size_t(near[0])];
+        // Sums per patch met in this voxel for its eight nodes.
+        std::vector<std::pair<int, std::array<double, 8>>> sums;
+        auto sums_of = [&](int patch) -> std::array<double, 8>& {
+          for (auto& [p, v] : sums)
+            if (p == patch) return v;
+          return sums.emplace_back(patch, std::array<double, 8>{}).second;
+        };
+        auto add_point = [&](const Point3& x, double w) {
+          const SurfaceFoot foot = nearest_point(gamma, x, centre.foot, tolerance);
+          const int patch = one_patch      ? patches.patch_of[std::size_t(near[0])]
+                            : near.empty() ? locate.patch(foot.foot)
+                                           : locate.patch(foot.foot, near);
+          Point3 xi;
+          for (int d = 0; d < 3; ++d) xi[d] = (x[d] - lower[d]) / h;
+          const Q1Element<3> basis(xi, h);
+          const double q = foot.q();
+          const Point3 grad = foot.grad_q();
+          std::array<double, 8>& v = sums_of(patch);
+          for (int l = 0; l < 8; ++l) v[l] += w * (dot(grad, basis.gradient(l)) + c * q * basis.value[l]);
+        };
+        for (std::size_t c3 = 0; c3 < rule.nodes.size(); ++c3)
+          for (std::size_t b = 0; b < rule.nodes.size(); ++b)
+            for (std::size_t a = 0; a < rule.nodes.size(); ++a)
+              add_point(lower + h * Point3{rule.nodes[a], rule.nodes[b], rule.nodes[c3]},
+                        rule.weights[a] * rule.weights[b] * rule.weights[c3] * h * h * h);
+        for (const auto& [x, w] : inside) add_point(x, -w);
+        for (int l = 0; l < 8; ++l) {
+          const Grid3::Index node{cell[0] + Q1Element<3>::offset(l, 0), cell[1] + Q1Element<3>::offset(l, 1),
+                                  cell[2] + Q1Element<3>::offset(l, 2)};
+          const BandNode* b = st.find(node);
+          if (!b || b->patch < 0) continue;
+          std::array<double, 8>& v = sums_of(b->patch);
+          for (int k = 0; k < 8; ++k) v[k] -= b->psi * (K[l][k] + c * M[l][k]);
         }
-    }
+        for (const auto& [patch, v] : sums)
+          for (int k = 0; k < 8; ++k) {
+            const Grid3::Index node{cell[0] + Q1Element<3>::offset(k, 0), cell[1] + Q1Element<3>::offset(k, 1),
+                                    cell[2] + Q1Element<3>::offset(k, 2)};
+            if (patch >= 0) by_voxel[n].push_back({patch, node, v[k]});
+          }
+      } catch (...) {
+        keep();
+      }
   }
+  if (failure) std::rethrow_exception(failure);
 
   // The rows: entries merged per (patch, node) in voxel order, nodes without an unknown dropped.
   std::vector<RowEntry> entries;

@@ -65,6 +65,31 @@ TEST(SurfaceKink, NearestPointDistanceAndCurvature) {
   EXPECT_NEAR(inner.H, 1 / rt - 1 / (R - rt), 1e-9);
 }
 
+/// A sphere whose level gradient vanishes on part of it (a singular level function).
+class BrokenGradient final : public fictus::Surface {
+ public:
+  double level(const Point3& p) const override { return e_.level(p); }
+  Point3 level_gradient(const Point3& p) const override { return p.x > 0.75 ? Point3{} : e_.level_gradient(p); }
+  fictus::PatchedSurface patches(int m, double edge) const override { return e_.patches(m, edge); }
+  double area() const override { return e_.area(); }
+  fictus::Box3 bounds() const override { return e_.bounds(); }
+
+ private:
+  fictus::Ellipsoid e_{{0.5, 0.5, 0.5}, {0.3, 0.3, 0.3}};
+};
+
+TEST(SurfaceKink, AVanishingGradientIsAnErrorNotACrash) {
+  // nearest_point throws inside the parallel loops; the exception must reach the caller.
+  const BrokenGradient gamma;
+  const fictus::Grid3 grid(fictus::Box3{{0, 0, 0}, {1, 1, 1}}, 32);
+  try {
+    const fictus::SurfaceKink kink(grid, gamma, gamma.patches(40, grid.h()), 1.0, fictus::Execution(2));
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("geometry: no nearest point of the surface"), std::string::npos) << e.what();
+  }
+}
+
 /// The mean and the largest error over the points of ∂û/∂n inside γ for a layer of density 1 on a
 /// sphere of radius 0.3 with −Δu + k²u = 0 (k = 20, the box far away in units of 1/k): û = A i₀(kr)
 /// inside, B k₀(kr) outside, with ∂û/∂n jumping by −1 across γ. corrected = false: the Q1 field
