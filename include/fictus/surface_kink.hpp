@@ -8,7 +8,8 @@
 // d the signed distance to γ (> 0 outside ω), q(d) = d − H d²/2, H = κ₁ + κ₂ the mean curvature sum
 // at the nearest point (q″ + H q′ = O(d): w solves the same equation to that order), w smooth across
 // γ. The Q1 Galerkin solution û_h is related to I_h w by
-//   I_h w ≈ û_h + Σ_j λ_j (I_hψ_j + A⁻¹ r_j),   r_j,k = a(ψ_j − I_hψ_j, φ_k)   (on the cut voxels),
+//   I_h w ≈ û_h + Σ_j λ_j (I_hψ_j + A⁻¹ r_j),   r_j,k = a(ψ_j − I_hψ_j, φ_k)   (on the cut voxels
+//   and two rings of voxels around them),
 // so a trace row R of I_h w is R û_h + R A⁻¹ Σ_j λ_j r_j + D λ with D_ij = Σ_k R_ik ψ_j(x_k).
 #include <memory>
 #include <vector>
@@ -59,8 +60,8 @@ class SurfaceKink {
   const SparseRows& galerkin() const;
   /// D (rows × m) for trace rows R on the same grid: D_ij = Σ_k R_ik ψ_j(x_k).
   Eigen::SparseMatrix<double> direct(const SparseRows& rows) const;
-  /// u += Σ_j λ_j ψ_j at the nodes of the band (0 < d ≤ 3h: every trace stencil and cut voxel
-  /// stays in it): turns u₀ + A⁻¹(B_Γ + R)ᵀλ into the kink-corrected field I_h w.
+  /// u += Σ_j λ_j ψ_j at the nodes of the band (0 < d ≤ 6h: every trace stencil and the voxels of
+  /// r stay in it): turns u₀ + A⁻¹(B_Γ + R)ᵀλ into the kink-corrected field I_h w.
   void add_kinks(const std::vector<double>& lambda, GridVector& u) const;
   /// The number of cut voxels (for reports).
   std::size_t cut_voxels() const;
