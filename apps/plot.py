@@ -257,28 +257,26 @@ def plot_surface(folder):
 def main(folder):
     made = []
     if dim_of(folder) == 3:
+        inputs = "solution.vti or surface.vtp"
         if os.path.exists(os.path.join(folder, "solution.vti")):
             plot_slices(folder)
             made.append("slices.png")
         if os.path.exists(os.path.join(folder, "surface.vtp")):
             plot_surface(folder)
             made.append("surface.png")
-        if not made:
-            print(f"fictus: error: plot: {folder} holds no solution.vti or surface.vtp", file=sys.stderr)
-            return 1
-        print("wrote " + ", ".join(os.path.join(folder, name) for name in made))
-        return 0
-    if os.path.exists(os.path.join(folder, "solution.vti")) and os.path.exists(os.path.join(folder, "points.csv")):
-        plot_solution(folder)
-        made.append("solution.png")
-    if os.path.exists(os.path.join(folder, "points.csv")):
-        plot_profiles(folder)
-        made.append("profiles.png")
-    if any(os.path.exists(os.path.join(folder, f"table{k}.csv")) for k in (1, 2)):
-        plot_convergence(folder)
-        made.append("convergence.png")
+    else:
+        inputs = "solution.vti, points.csv or table<k>.csv"
+        if os.path.exists(os.path.join(folder, "solution.vti")) and os.path.exists(os.path.join(folder, "points.csv")):
+            plot_solution(folder)
+            made.append("solution.png")
+        if os.path.exists(os.path.join(folder, "points.csv")):
+            plot_profiles(folder)
+            made.append("profiles.png")
+        if any(os.path.exists(os.path.join(folder, f"table{k}.csv")) for k in (1, 2)):
+            plot_convergence(folder)
+            made.append("convergence.png")
     if not made:
-        print(f"fictus: error: plot: {folder} holds no solution.vti, points.csv or table<k>.csv", file=sys.stderr)
+        print(f"fictus: error: plot: {folder} holds no {inputs}", file=sys.stderr)
         return 1
     print("wrote " + ", ".join(os.path.join(folder, name) for name in made))
     return 0
