@@ -1,11 +1,6 @@
 #include "fictus/schur_complement.hpp"
 
-#include <omp.h>
-
-#include <atomic>
-
 #include <algorithm>
-#include <unordered_map>
 #include <utility>
 
 namespace fictus {
@@ -37,101 +32,69 @@ void ImplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Ei
   }
 }
 
-LinearSolveReport ImplicitSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
-                                       Eigen::VectorXd& lambda, double& alpha) const {
-  const Eigen::Index m = lambda.size();
-  Eigen::VectorXd sb, sc, lam;
-  const LinearOperator op = [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-    lam = x.head(m);
-    apply(lam, sb, sc);
-    y.resize(x.size());
-    for (Eigen::Index i = 0; i < m; ++i) y(i) = active[i] ? sb(i) : sc(i);
-    if (mode) {
-      for (Eigen::Index i = 0; i < m; ++i) y(i) += x(m) * (active[i] ? mode->trace_B(i) : mode->trace_C(i));
-      y(m) = mode->arc_weights.dot(lam);
-    }
-  };
-  Eigen::VectorXd x(m + (mode ? 1 : 0)), rhs(x.size());
-  x.head(m) = lambda;
-  rhs.head(m) = d;
-  if (mode) x(m) = alpha, rhs(m) = -mode->load_total;
-  const GmresReport g = gmres(op, rhs, x, options_);
-  lambda = x.head(m);
-  if (mode) alpha = x(m);
-  return {g.iterations, g.relative_residual, g.converged};
+void ImplicitSchur::apply_newton(const ActiveSet& active, const ConstantMode* mode, const Eigen::VectorXd& x,
+                                 Eigen::VectorXd& y) const {
+  const Eigen::Index m = size();
+  Eigen::VectorXd sb, sc;
+  apply(x.head(m), sb, sc);
+  y.resize(x.size());
+  for (Eigen::Index i = 0; i < m; ++i) y(i) = active[i] ? sb(i) : sc(i);
+  if (mode) {
+    for (Eigen::Index i = 0; i < m; ++i) y(i) += x(m) * (active[i] ? mode->trace_B(i) : mode->trace_C(i));
+    y(m) = mode->arc_weights.dot(x.head(m));
+  }
 }
 
 namespace {
 
-/// G between the nodes of two entries.
-double green_between(const GreenTable<2>& green, const SparseRows::Entry& a, const SparseRows::Entry& b) {
-  return green.G(a.i, a.j, b.i, b.j);
+/// The right-hand side (d, −F) and the unknowns (λ, α) of a Newton step, bordered by `mode`.
+std::pair<Eigen::VectorXd, Eigen::VectorXd> newton_system(const Eigen::VectorXd& d, const ConstantMode* mode,
+                                                          const Eigen::VectorXd& lambda, double alpha) {
+  const Eigen::Index m = lambda.size();
+  Eigen::VectorXd rhs(m + (mode ? 1 : 0)), x(rhs.size());
+  rhs.head(m) = d;
+  x.head(m) = lambda;
+  if (mode) rhs(m) = -mode->load_total, x(m) = alpha;
+  return {rhs, x};
 }
-double green_between(const GreenTable<3>& green, const SparseRows::Entry& a, const SparseRows::Entry& b) {
-  return green.G({a.i, a.j, a.k}, b.i, b.j, b.k);
+
+void unpack(const Eigen::VectorXd& x, const ConstantMode* mode, Eigen::VectorXd& lambda, double& alpha) {
+  lambda = x.head(lambda.size());
+  if (mode) alpha = x(lambda.size());
 }
 
 }  // namespace
 
-template <int dim>
-Eigen::MatrixXd green_block(const GreenTable<dim>& green, const SparseRows& R, const SparseRows& Q,
-                            const Execution& execution) {
-  return green_blocks(green, {&R}, Q, execution).front();
+LinearSolveReport ImplicitSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
+                                       Eigen::VectorXd& lambda, double& alpha) const {
+  auto [rhs, x] = newton_system(d, mode, lambda, alpha);
+  const LinearOperator op = [&](const Eigen::VectorXd& v, Eigen::VectorXd& y) { apply_newton(active, mode, v, y); };
+  const GmresReport g = gmres(op, rhs, x, options_);
+  unpack(x, mode, lambda, alpha);
+  return {g.iterations, g.relative_residual, g.converged};
 }
 
-template <int dim>
-std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
-                                          const SparseRows& Q, const Execution& execution) {
-  // The distinct nodes of all row sets, and every entry as (node slot, weight).
-  std::vector<std::size_t> slot_of;  // by entry, over all row sets in order
-  std::vector<SparseRows::Entry> nodes;
-  {
-    std::unordered_map<std::size_t, std::size_t> slots;
-    for (const SparseRows* R : row_sets)
-      for (const auto& e : R->entries) {
-        const auto [it, added] = slots.emplace(e.index, nodes.size());
-        if (added) nodes.push_back(e);
-        slot_of.push_back(it->second);
-      }
-  }
-  std::vector<Eigen::MatrixXd> blocks;
-  for (const SparseRows* R : row_sets) blocks.emplace_back(R->n_rows(), Q.n_rows());
-  std::atomic<bool> stop = false;  // an interruption seen by thread 0 (the caller's) ends every thread's work
-#pragma omp parallel num_threads(execution.threads())
-  {
-    std::vector<double> column(nodes.size());  // (G Qᵀ)(node, col) for the nodes of the rows
-#pragma omp for schedule(dynamic, 4)
-    for (int col = 0; col < Q.n_rows(); ++col) {
-      if (omp_get_thread_num() == 0 && col % 8 == 0 && execution.interrupt_requested()) stop = true;
-      if (stop) continue;
-      for (std::size_t u = 0; u < nodes.size(); ++u) {
-        double sum = 0.0;
-        for (std::size_t b = Q.row_begin[col]; b < Q.row_begin[col + 1]; ++b) {
-          const auto& qb = Q.entries[b];
-          sum += green_between(green, nodes[u], qb) * qb.value;
-        }
-        column[u] = sum;
-      }
-      std::size_t entry = 0;
-      for (std::size_t set = 0; set < row_sets.size(); ++set) {
-        const SparseRows& R = *row_sets[set];
-        for (int row = 0; row < R.n_rows(); ++row) {
-          double sum = 0.0;
-          for (std::size_t a = R.row_begin[row]; a < R.row_begin[row + 1]; ++a, ++entry)
-            sum += R.entries[a].value * column[slot_of[entry]];
-          blocks[set](row, col) = sum;
-        }
-      }
-    }
-  }
-  if (stop) throw Interrupted();
-  return blocks;
+LinearSolveReport PreconditionedSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d,
+                                             const ConstantMode* mode, Eigen::VectorXd& lambda, double& alpha) const {
+  const Eigen::MatrixXd S = approximate_.newton_matrix(active, mode);
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(S);
+  auto [rhs, x] = newton_system(d, mode, lambda, alpha);
+  // S_𝒜 S̃_𝒜⁻¹ z = rhs from z = S̃_𝒜 x (the given start), then x = S̃_𝒜⁻¹ z.
+  Eigen::VectorXd z = S * x, v;
+  const LinearOperator op = [&](const Eigen::VectorXd& w, Eigen::VectorXd& y) {
+    v = lu.solve(w);
+    exact_.apply_newton(active, mode, v, y);
+  };
+  const GmresReport g = gmres(op, rhs, z, options_);
+  unpack(lu.solve(z), mode, lambda, alpha);
+  return {g.iterations, g.relative_residual, g.converged};
 }
 
 template <int dim>
 ExplicitSchur::ExplicitSchur(const GreenTable<dim>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
-                             const SparseRows& loads, const Execution& execution, const DirectTerms& direct) {
-  std::vector<Eigen::MatrixXd> blocks = green_blocks(green, {&B_gamma, &C_gamma}, loads, execution);
+                             const SparseRows& loads, const Execution& execution, const DirectTerms& direct,
+                             const FarField& far_field, FarFieldReport* report) {
+  std::vector<Eigen::MatrixXd> blocks = green_blocks(green, {&B_gamma, &C_gamma}, loads, execution, far_field, report);
   S_B_ = std::move(blocks[0]);
   S_C_ = std::move(blocks[1]);
   if (!direct.empty()) {
@@ -141,15 +104,9 @@ ExplicitSchur::ExplicitSchur(const GreenTable<dim>& green, const SparseRows& B_g
 }
 
 template ExplicitSchur::ExplicitSchur(const GreenTable<2>&, const SparseRows&, const SparseRows&, const SparseRows&,
-                                      const Execution&, const DirectTerms&);
+                                      const Execution&, const DirectTerms&, const FarField&, FarFieldReport*);
 template ExplicitSchur::ExplicitSchur(const GreenTable<3>&, const SparseRows&, const SparseRows&, const SparseRows&,
-                                      const Execution&, const DirectTerms&);
-template Eigen::MatrixXd green_block(const GreenTable<2>&, const SparseRows&, const SparseRows&, const Execution&);
-template Eigen::MatrixXd green_block(const GreenTable<3>&, const SparseRows&, const SparseRows&, const Execution&);
-template std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>&, const std::vector<const SparseRows*>&,
-                                                   const SparseRows&, const Execution&);
-template std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<3>&, const std::vector<const SparseRows*>&,
-                                                   const SparseRows&, const Execution&);
+                                      const Execution&, const DirectTerms&, const FarField&, FarFieldReport*);
 
 void ExplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const {
   sb = S_B_ * lambda;
@@ -171,13 +128,9 @@ Eigen::MatrixXd ExplicitSchur::newton_matrix(const ActiveSet& active, const Cons
 LinearSolveReport ExplicitSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
                                        Eigen::VectorXd& lambda, double& alpha) const {
   const Eigen::MatrixXd S = newton_matrix(active, mode);
-  const Eigen::Index m = lambda.size();
-  Eigen::VectorXd rhs(S.rows());
-  rhs.head(m) = d;
-  if (mode) rhs(m) = -mode->load_total;
+  const Eigen::VectorXd rhs = newton_system(d, mode, lambda, alpha).first;
   const Eigen::VectorXd x = S.partialPivLu().solve(rhs);
-  lambda = x.head(m);
-  if (mode) alpha = x(m);
+  unpack(x, mode, lambda, alpha);
   LinearSolveReport report;
   const double rn = rhs.norm();
   report.relative_residual = rn > 0 ? (S * x - rhs).norm() / rn : 0.0;

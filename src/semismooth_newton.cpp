@@ -19,6 +19,13 @@ NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::
   ActiveSet active(m, 1);
   if (!options.start_all_active)
     for (int i = 0; i < m; ++i) active[i] = (c0(i) - rho * (b0(i) - g(i))) > 0;
+  if (options.start) {
+    if (options.start->lambda.size() != m || Eigen::Index(options.start->active.size()) != m)
+      throw std::invalid_argument("solve_semismooth_newton: the start is of another size");
+    active = options.start->active;
+    result.lambda = options.start->lambda;
+    result.alpha = options.start->alpha;
+  }
   std::vector<ActiveSet> seen{active};
 
   Eigen::VectorXd d(m), sb, sc;
@@ -56,6 +63,11 @@ NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::
     result.inner_failed = result.inner_failed || !linear.converged;
 
     // 4. Stopping test.
+    if (changed <= options.hand_on_at_changes) {
+      result.active = next;
+      result.handed_on = true;
+      return result;
+    }
     if (changed == 0) {
       result.active = active;
       if (result.residual <= options.tolerance * scale) {

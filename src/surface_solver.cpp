@@ -501,14 +501,22 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   // 3. Schur blocks.
   std::unique_ptr<GreenTable<3>> green;
   std::unique_ptr<SchurComplement> schur;
+  std::unique_ptr<ImplicitSchur> exact;  // the exact S behind an interpolated far field
   if (options.inner == InnerSolver::krylov) {
     schur = std::make_unique<ImplicitSchur>(*fast, B_gamma, C_gamma, loads,
                                             detail::gmres_options(options, m, execution), direct);
   } else {
     green = std::make_unique<GreenTable<3>>(grid, problem.c, execution);
     clock.mark("green_table");
-    schur = std::make_unique<ExplicitSchur>(*green, B_gamma, C_gamma, loads, execution, direct);
+    FarFieldReport report;
+    schur = std::make_unique<ExplicitSchur>(*green, B_gamma, C_gamma, loads, execution, direct,
+                                            options.far_field ? default_far_field_3d : FarField{}, &report);
     green.reset();
+    if (report.far_pairs > 0) {
+      sol.far_field = SurfaceSolution::FarFieldUse{report, 0};
+      exact = std::make_unique<ImplicitSchur>(*fast, B_gamma, C_gamma, loads,
+                                              detail::gmres_options(options, m, execution), direct);
+    }
     clock.mark("schur");
   }
 
@@ -530,8 +538,26 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   C_gamma.multiply(u0, c0);
   std::optional<ConstantMode> mode;
   if (fast->singular()) mode = ConstantMode{row_sums(B_gamma), row_sums(C_gamma), row_sums(B_Gamma), load_total};
-  sol.newton = solve_semismooth_newton(*schur, to_eigen(b0), to_eigen(c0), to_eigen(sol.g),
-                                       detail::newton_options(options, execution), mode ? &*mode : nullptr);
+  const NewtonOptions newton_options = detail::newton_options(options, execution);
+  NewtonOptions first = newton_options;
+  if (exact) first.hand_on_at_changes = std::max(1, int(far_field_hand_on * m));
+  sol.newton =
+      solve_semismooth_newton(*schur, to_eigen(b0), to_eigen(c0), to_eigen(sol.g), first, mode ? &*mode : nullptr);
+  if (exact) {  // on with the exact S from where S̃ left the active set nearly settled
+    GmresOptions polish = detail::gmres_options(options, m, execution);
+    polish.relative_tolerance = far_field_gmres_tolerance;
+    const PreconditionedSchur preconditioned(static_cast<const ExplicitSchur&>(*schur), *exact, polish);
+    NewtonOptions from_there = newton_options;
+    from_there.start = &sol.newton;
+    NewtonResult second = solve_semismooth_newton(preconditioned, to_eigen(b0), to_eigen(c0), to_eigen(sol.g),
+                                                  from_there, mode ? &*mode : nullptr);
+    sol.far_field->exact_steps = second.iterations;
+    second.iterations += sol.newton.iterations;
+    second.history.insert(second.history.begin(), sol.newton.history.begin(), sol.newton.history.end());
+    second.inner_failed = second.inner_failed || sol.newton.inner_failed;
+    sol.newton = std::move(second);
+    sol.fast_solves += exact->fast_solves();
+  }
   sol.fast_solves += schur->fast_solves();
   for (const NewtonStep& step : sol.newton.history) sol.inner_iterations += step.inner_iterations;
   sol.lambda.assign(sol.newton.lambda.data(), sol.newton.lambda.data() + m);

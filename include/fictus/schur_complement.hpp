@@ -41,6 +41,24 @@ struct DirectTerms {
   bool empty() const { return trace.nonZeros() == 0 && normal_derivative.nonZeros() == 0; }
 };
 
+/// How the explicit assembly treats the far field (docs/math.md, "Assembling the Schur complement").
+/// The rows and the columns are split into binary cluster trees; a pair of clusters whose node boxes
+/// lie apart, max(radius) ≤ eta·distance (the nearest image of the box counted), is interpolated:
+///   G(a, b) ≈ Σ_k Σ_l L_k(a) G(p_k, p_l) L_l(b),
+/// L tensor Lagrange polynomials on `order` grid nodes per axis near the Chebyshev points of each box,
+/// so the block is (R L) G(P, P') (Q L')ᵀ; every other pair is exact. order = 0: all of it exact.
+struct FarField {
+  int order = 0;
+  double eta = 0.5;
+  int leaf = 32;  // rows per leaf cluster
+};
+
+/// What the assembly did: entries of the blocks computed exactly (near) and interpolated (far).
+struct FarFieldReport {
+  double near_pairs = 0, far_pairs = 0;
+  int near_blocks = 0, far_blocks = 0;
+};
+
 struct LinearSolveReport {
   int inner_iterations = 0;  // Krylov operator applications (0 for a direct solve)
   double relative_residual = 0.0;
@@ -81,6 +99,9 @@ class ImplicitSchur final : public SchurComplement {
                           Eigen::VectorXd& lambda, double& alpha) const override;
   std::size_t fast_solves() const override { return fast_solves_; }
   std::optional<double> condition_number(const ActiveSet&) const override { return std::nullopt; }
+  /// y = S_𝒜 x: the Newton matrix of `active` (bordered by `mode` when given: x = (λ, α)).
+  void apply_newton(const ActiveSet& active, const ConstantMode* mode, const Eigen::VectorXd& x,
+                    Eigen::VectorXd& y) const;
 
  private:
   std::function<void(GridVector&)> solve_in_place_;
@@ -97,7 +118,8 @@ class ExplicitSchur final : public SchurComplement {
   /// Assembles S_B and S_C from the Green's table (threaded over columns); `loads` as above.
   template <int dim>
   ExplicitSchur(const GreenTable<dim>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
-                const SparseRows& loads, const Execution& execution = Execution{}, const DirectTerms& direct = {});
+                const SparseRows& loads, const Execution& execution = Execution{}, const DirectTerms& direct = {},
+                const FarField& far_field = {}, FarFieldReport* report = nullptr);
   /// From given blocks (tests).
   ExplicitSchur(Eigen::MatrixXd S_B, Eigen::MatrixXd S_C) : S_B_(std::move(S_B)), S_C_(std::move(S_C)) {}
   int size() const override { return int(S_B_.rows()); }
@@ -108,20 +130,50 @@ class ExplicitSchur final : public SchurComplement {
   std::optional<double> condition_number(const ActiveSet& active) const override;
   const Eigen::MatrixXd& S_B() const { return S_B_; }
   const Eigen::MatrixXd& S_C() const { return S_C_; }
+  /// S_𝒜: row i of S_B (i ∈ 𝒜) or of S_C, bordered by `mode` when given.
+  Eigen::MatrixXd newton_matrix(const ActiveSet& active, const ConstantMode* mode = nullptr) const;
 
  private:
-  Eigen::MatrixXd newton_matrix(const ActiveSet& active, const ConstantMode* mode = nullptr) const;
   Eigen::MatrixXd S_B_, S_C_;
+};
+
+/// The exact S with the interpolated one as its preconditioner: `apply` is the exact S (one fast
+/// solve, ImplicitSchur), `solve` runs GMRES on the exact S_𝒜 right-preconditioned by the LU of
+/// S̃_𝒜 (ExplicitSchur with a far field), to `options`' tolerance. Newton runs first on S̃ alone (no
+/// fast solve), then on this from where it ended: the answer is that of the exact S, the cost a
+/// few fast solves.
+class PreconditionedSchur final : public SchurComplement {
+ public:
+  PreconditionedSchur(const ExplicitSchur& approximate, const ImplicitSchur& exact, const GmresOptions& options)
+      : approximate_(approximate), exact_(exact), options_(options) {}
+  int size() const override { return exact_.size(); }
+  void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override {
+    exact_.apply(lambda, sb, sc);
+  }
+  LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
+                          Eigen::VectorXd& lambda, double& alpha) const override;
+  std::size_t fast_solves() const override { return exact_.fast_solves(); }
+  /// That of S̃_𝒜 (to the interpolation's accuracy).
+  std::optional<double> condition_number(const ActiveSet& active) const override {
+    return approximate_.condition_number(active);
+  }
+
+ private:
+  const ExplicitSchur& approximate_;
+  const ImplicitSchur& exact_;
+  GmresOptions options_;
 };
 
 /// Dense (rows × cols) block R G Qᵀ from sparse rows and the Green's table (dim = 2 or 3).
 template <int dim>
 Eigen::MatrixXd green_block(const GreenTable<dim>& green, const SparseRows& R, const SparseRows& Q,
-                            const Execution& execution = Execution{});
-/// The blocks R_k G Qᵀ of several row sets at once: (G Qᵀ) is evaluated once per distinct node of
-/// the R_k (B_γ's four nodes of x_i lie in C_γ's 3×3), so the cost is (distinct nodes)·nnz(Q) lookups.
+                            const Execution& execution = Execution{}, const FarField& far_field = {});
+/// The blocks R_k G Qᵀ of several row sets with the same number of rows at once: (G Qᵀ) is evaluated
+/// once per distinct node of the R_k (B_γ's nodes of x_i lie in C_γ's), so the exact cost is
+/// (distinct nodes)·nnz(Q) lookups.
 template <int dim>
 std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
-                                          const SparseRows& Q, const Execution& execution = Execution{});
+                                          const SparseRows& Q, const Execution& execution = Execution{},
+                                          const FarField& far_field = {}, FarFieldReport* report = nullptr);
 
 }  // namespace fictus

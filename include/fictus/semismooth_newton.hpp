@@ -23,12 +23,18 @@
 namespace fictus {
 
 /// The Newton part of SolverOptions (its defaults).
+struct NewtonResult;
+
 struct NewtonOptions {
   double rho = SolverOptions{}.rho;                 // ρ > 0 of the projection
   int max_iterations = SolverOptions{}.max_newton;  // linear solves
   bool start_all_active = SolverOptions{}.start_all_active;
   double tolerance = SolverOptions{}.newton_tolerance;  // ‖F‖∞ ≤ tolerance · max(‖b‖∞, ‖c‖∞, ‖g‖∞)
   std::function<void()> between_steps;                  // called before each linear solve (may throw)
+  const NewtonResult* start = nullptr;                  // go on from an earlier run's active set, λ and α (not owned)
+  /// Hand on (stop, not converged, `active` the next set to try) once a step changes at most this
+  /// many points; negative: never.
+  int hand_on_at_changes = -1;
 };
 
 struct NewtonStep {
@@ -45,6 +51,7 @@ struct NewtonResult {
   ActiveSet active;
   int iterations = 0;  // linear solves (the paper's it₀)
   bool converged = false;
+  bool handed_on = false;     // stopped by hand_on_at_changes
   std::string failure;        // why not, when not converged
   bool inner_failed = false;  // some step's inner (Krylov) solve stopped at its cap or tolerance short
   double residual = 0.0;

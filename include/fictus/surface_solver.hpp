@@ -126,6 +126,13 @@ struct SurfaceProblem {
 /// Default patch size s (the side of a square of the patch's area) in cells: m = area/(s·h)².
 inline constexpr double default_patch_cells_smooth_3d = 8.0;
 inline constexpr double default_patch_cells_nonsmooth_3d = 4.0;
+/// The far field of the 3-D explicit assembly (solver.far_field): chosen by measurement (docs/math.md).
+inline constexpr FarField default_far_field_3d{6, 2.0, 2};
+/// Newton runs on S̃ until a step changes at most this fraction of the points (at least one), then
+/// on the exact S.
+inline constexpr double far_field_hand_on = 0.05;
+/// GMRES's relative residual for the Newton steps on the exact S behind an interpolated far field.
+inline constexpr double far_field_gmres_tolerance = 1e-13;
 /// Default m for a surface of `area` on a grid of cell h.
 int default_patches(double area, double h, Variant variant);
 
@@ -143,6 +150,13 @@ struct SurfaceSolution {
   NewtonResult newton;
   std::size_t fast_solves = 0;
   int inner_iterations = 0;
+  /// With solver.far_field: what the assembly interpolated, and the Newton steps run on the exact S
+  /// (preconditioned by S̃) after those on S̃ (all counted in newton.iterations).
+  struct FarFieldUse {
+    FarFieldReport assembly;
+    int exact_steps = 0;
+  };
+  std::optional<FarFieldUse> far_field;
   SignoriniCheck signorini;
   std::optional<ErrorNorms> errors;
   std::optional<PointErrors> point_errors;

@@ -1,0 +1,438 @@
+// Dense blocks R G Qᵀ from sparse rows and the Green's table: exact, or with the far field
+// interpolated (schur_complement.hpp, docs/math.md "Assembling the Schur complement").
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <climits>
+#include <cmath>
+#include <memory>
+#include <numeric>
+#include <unordered_map>
+
+#include "fictus/schur_complement.hpp"
+
+namespace fictus {
+namespace {
+
+template <int dim>
+using Index = std::array<int, dim>;
+
+template <int dim>
+Index<dim> node_of(const SparseRows::Entry& e) {
+  if constexpr (dim == 2)
+    return {e.i, e.j};
+  else
+    return {e.i, e.j, e.k};
+}
+
+/// G between two nodes (the written-out forms of the table's inner loop).
+double green_between(const GreenTable<2>& green, const Index<2>& a, const Index<2>& b) {
+  return green.G(a[0], a[1], b[0], b[1]);
+}
+double green_between(const GreenTable<3>& green, const Index<3>& a, const Index<3>& b) {
+  return green.G(a, b[0], b[1], b[2]);
+}
+
+/// Inclusive ranges of node indices.
+template <int dim>
+struct NodeBox {
+  Index<dim> lo, hi;
+  NodeBox() {
+    lo.fill(INT_MAX);
+    hi.fill(INT_MIN);
+  }
+  void add(const Index<dim>& a) {
+    for (int d = 0; d < dim; ++d) lo[d] = std::min(lo[d], a[d]), hi[d] = std::max(hi[d], a[d]);
+  }
+  void add(const NodeBox& b) {
+    add(b.lo);
+    add(b.hi);
+  }
+  double center(int d) const { return 0.5 * (double(lo[d]) + double(hi[d])); }
+  /// Half the diagonal.
+  double radius() const {
+    double s = 0;
+    for (int d = 0; d < dim; ++d) s += double(hi[d] - lo[d]) * double(hi[d] - lo[d]);
+    return 0.5 * std::sqrt(s);
+  }
+};
+
+/// Distance between two boxes, the nearest image of `b` counted: the singularities of G(·, b) lie at
+/// b and, in a Dirichlet box, at its reflections −b and 2n − b along each axis (period 2n); in a
+/// periodic box at b ± n.
+template <int dim>
+double image_distance(const NodeBox<dim>& a, const NodeBox<dim>& b, const Grid<dim>& grid) {
+  double sum = 0;
+  for (int d = 0; d < dim; ++d) {
+    const double n = grid.n(d);
+    double nearest = INFINITY;
+    const auto gap = [&](double lo, double hi) {
+      nearest = std::min(nearest, std::max({0.0, lo - a.hi[d], a.lo[d] - hi}));
+    };
+    if (grid.periodic()) {
+      for (int shift = -1; shift <= 1; ++shift) gap(b.lo[d] + shift * n, b.hi[d] + shift * n);
+    } else {
+      gap(b.lo[d], b.hi[d]);
+      gap(-double(b.hi[d]), -double(b.lo[d]));
+      gap(2 * n - b.hi[d], 2 * n - b.lo[d]);
+    }
+    sum += nearest * nearest;
+  }
+  return std::sqrt(sum);
+}
+
+/// A binary tree of items (rows) split at the median of their centers along the longest axis.
+template <int dim>
+struct ClusterTree {
+  struct Cluster {
+    int begin, end, left = -1, right = -1;
+    NodeBox<dim> box;  // of the items' nodes
+    double work = 0;   // entries (exact cost of a block with this cluster)
+  };
+  std::vector<int> item;  // items in cluster order
+  std::vector<Cluster> clusters;
+  bool leaf(int c) const { return clusters[std::size_t(c)].left < 0; }
+
+  ClusterTree(const std::vector<NodeBox<dim>>& boxes, const std::vector<double>& work, int leaf_size)
+      : item(boxes.size()) {
+    std::iota(item.begin(), item.end(), 0);
+    if (!boxes.empty()) build(boxes, work, 0, int(boxes.size()), leaf_size);
+  }
+
+ private:
+  int build(const std::vector<NodeBox<dim>>& boxes, const std::vector<double>& work, int begin, int end,
+            int leaf_size) {
+    const int c = int(clusters.size());
+    clusters.push_back({begin, end, -1, -1, NodeBox<dim>(), 0.0});
+    NodeBox<dim> box, centers;
+    double sum = 0;
+    for (int k = begin; k < end; ++k) {
+      const NodeBox<dim>& b = boxes[std::size_t(item[std::size_t(k)])];
+      box.add(b);
+      Index<dim> mid;
+      for (int d = 0; d < dim; ++d) mid[d] = int(std::lround(b.center(d)));
+      centers.add(mid);
+      sum += work[std::size_t(item[std::size_t(k)])];
+    }
+    clusters[std::size_t(c)].box = box;
+    clusters[std::size_t(c)].work = sum;
+    if (end - begin <= leaf_size) return c;
+    int axis = 0;
+    for (int d = 1; d < dim; ++d)
+      if (centers.hi[d] - centers.lo[d] > centers.hi[axis] - centers.lo[axis]) axis = d;
+    const int mid = begin + (end - begin) / 2;
+    std::nth_element(item.begin() + begin, item.begin() + mid, item.begin() + end, [&](int p, int q) {
+      return boxes[std::size_t(p)].center(axis) < boxes[std::size_t(q)].center(axis);
+    });
+    const int left = build(boxes, work, begin, mid, leaf_size);
+    const int right = build(boxes, work, mid, end, leaf_size);
+    clusters[std::size_t(c)].left = left;
+    clusters[std::size_t(c)].right = right;
+    return c;
+  }
+};
+
+/// Tensor Lagrange interpolation on grid nodes in a box: along each axis min(order, width) nodes
+/// near the Chebyshev points of the box's range (all of its nodes when it is narrower).
+template <int dim>
+struct Interpolation {
+  NodeBox<dim> box;
+  std::array<std::vector<int>, dim> nodes;
+  std::array<std::vector<double>, dim> weights;  // weights[d][(t − lo)·p + k] = L_k(t)
+
+  Interpolation(const NodeBox<dim>& b, int order) : box(b) {
+    for (int d = 0; d < dim; ++d) {
+      const int lo = b.lo[d], hi = b.hi[d], width = hi - lo + 1;
+      std::vector<int>& x = nodes[std::size_t(d)];
+      if (width <= order) {
+        for (int t = lo; t <= hi; ++t) x.push_back(t);
+      } else {
+        for (int k = order - 1; k >= 0; --k)
+          x.push_back(int(std::lround(0.5 * (lo + hi) + 0.5 * (hi - lo) * std::cos((2 * k + 1) * M_PI / (2 * order)))));
+        for (int k = 1; k < order; ++k) x[std::size_t(k)] = std::max(x[std::size_t(k)], x[std::size_t(k - 1)] + 1);
+        for (int k = order - 2; k >= 0; --k) x[std::size_t(k)] = std::min(x[std::size_t(k)], x[std::size_t(k + 1)] - 1);
+      }
+      const int p = int(x.size());
+      std::vector<double>& w = weights[std::size_t(d)];
+      w.assign(std::size_t(width * p), 0.0);
+      for (int t = lo; t <= hi; ++t)
+        for (int k = 0; k < p; ++k) {
+          double v = 1;
+          for (int l = 0; l < p; ++l)
+            if (l != k) v *= double(t - x[std::size_t(l)]) / double(x[std::size_t(k)] - x[std::size_t(l)]);
+          w[std::size_t((t - lo) * p + k)] = v;
+        }
+    }
+  }
+  int size() const {
+    int s = 1;
+    for (int d = 0; d < dim; ++d) s *= int(nodes[std::size_t(d)].size());
+    return s;
+  }
+  Index<dim> node(int flat) const {
+    Index<dim> a;
+    for (int d = 0; d < dim; ++d) {
+      const int p = int(nodes[std::size_t(d)].size());
+      a[d] = nodes[std::size_t(d)][std::size_t(flat % p)];
+      flat /= p;
+    }
+    return a;
+  }
+  /// row += value · Π_d L(a_d) over the tensor nodes (flat index, first axis fastest).
+  void add(const Index<dim>& a, double value, double* row) const {
+    const int p0 = int(nodes[0].size());
+    const double* w0 = &weights[0][std::size_t((a[0] - box.lo[0]) * p0)];
+    if constexpr (dim == 2) {
+      const int p1 = int(nodes[1].size());
+      const double* w1 = &weights[1][std::size_t((a[1] - box.lo[1]) * p1)];
+      for (int k1 = 0; k1 < p1; ++k1)
+        for (int k0 = 0; k0 < p0; ++k0) row[k1 * p0 + k0] += value * w1[k1] * w0[k0];
+    } else {
+      const int p1 = int(nodes[1].size()), p2 = int(nodes[2].size());
+      const double* w1 = &weights[1][std::size_t((a[1] - box.lo[1]) * p1)];
+      const double* w2 = &weights[2][std::size_t((a[2] - box.lo[2]) * p2)];
+      for (int k2 = 0; k2 < p2; ++k2)
+        for (int k1 = 0; k1 < p1; ++k1) {
+          const double v = value * w2[k2] * w1[k1];
+          double* r = row + (k2 * p1 + k1) * p0;
+          for (int k0 = 0; k0 < p0; ++k0) r[k0] += v * w0[k0];
+        }
+    }
+  }
+};
+
+/// The rows of one side: one or more row sets with the same number of rows (row r of every set is
+/// item r of the tree).
+struct RowSide {
+  std::vector<const SparseRows*> sets;
+  int n_rows() const { return sets.front()->n_rows(); }
+};
+
+template <int dim>
+NodeBox<dim> item_box(const RowSide& side, int r) {
+  NodeBox<dim> box;
+  for (const SparseRows* R : side.sets)
+    for (std::size_t a = R->row_begin[std::size_t(r)]; a < R->row_begin[std::size_t(r) + 1]; ++a)
+      box.add(node_of<dim>(R->entries[a]));
+  return box;
+}
+
+/// The distinct nodes of the rows of a cluster and, for each entry of each set in cluster order,
+/// its node's slot.
+template <int dim>
+struct DistinctNodes {
+  std::vector<Index<dim>> nodes;
+  std::vector<std::uint32_t> slot;
+  DistinctNodes(const RowSide& side, const std::vector<int>& items) {
+    std::unordered_map<std::size_t, std::uint32_t> slots;
+    for (const SparseRows* R : side.sets)
+      for (int r : items)
+        for (std::size_t a = R->row_begin[std::size_t(r)]; a < R->row_begin[std::size_t(r) + 1]; ++a) {
+          const auto [it, added] = slots.emplace(R->entries[a].index, std::uint32_t(nodes.size()));
+          if (added) nodes.push_back(node_of<dim>(R->entries[a]));
+          slot.push_back(it->second);
+        }
+  }
+};
+
+struct Block {
+  int x, y;  // row and column clusters
+  bool far;
+  double cost;
+};
+
+}  // namespace
+
+template <int dim>
+Eigen::MatrixXd green_block(const GreenTable<dim>& green, const SparseRows& R, const SparseRows& Q,
+                            const Execution& execution, const FarField& far_field) {
+  return green_blocks(green, {&R}, Q, execution, far_field).front();
+}
+
+template <int dim>
+std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
+                                          const SparseRows& Q, const Execution& execution, const FarField& far_field,
+                                          FarFieldReport* report) {
+  const RowSide rows{row_sets}, cols{{&Q}};
+  const int n_rows = rows.n_rows(), n_cols = Q.n_rows();
+  std::vector<Eigen::MatrixXd> out;
+  for (const SparseRows* R : row_sets) out.emplace_back(R->n_rows(), n_cols);
+  if (n_rows == 0 || n_cols == 0) return out;
+  const bool compress = far_field.order > 0;
+
+  // The trees: without compression one row cluster and columns in fours (the threads' work).
+  const auto n_r = std::size_t(n_rows), n_c = std::size_t(n_cols);
+  std::vector<NodeBox<dim>> row_boxes(n_r), col_boxes(n_c);
+  std::vector<double> row_work(n_r, 0.0), col_work(n_c, 0.0);
+  for (int r = 0; r < n_rows; ++r) {
+    row_boxes[std::size_t(r)] = item_box<dim>(rows, r);
+    for (const SparseRows* R : row_sets)
+      row_work[std::size_t(r)] += double(R->row_begin[std::size_t(r) + 1] - R->row_begin[std::size_t(r)]);
+  }
+  for (int c = 0; c < n_cols; ++c) {
+    col_boxes[std::size_t(c)] = item_box<dim>(cols, c);
+    col_work[std::size_t(c)] = double(Q.row_begin[std::size_t(c) + 1] - Q.row_begin[std::size_t(c)]);
+  }
+  const ClusterTree<dim> X(row_boxes, row_work, compress ? far_field.leaf : n_rows);
+  const ClusterTree<dim> Y(col_boxes, col_work, compress ? far_field.leaf : 4);
+  std::vector<Interpolation<dim>> no_interpolation;
+  const auto interpolation_size = [&](const NodeBox<dim>& b) {
+    int s = 1;
+    for (int d = 0; d < dim; ++d) s *= std::min(far_field.order, b.hi[d] - b.lo[d] + 1);
+    return double(s);
+  };
+
+  // The block partition: a pair far apart (max radius ≤ eta·distance) is interpolated when that is
+  // cheaper than exact; otherwise split, down to pairs of leaves computed exactly.
+  std::vector<Block> blocks;
+  const auto partition = [&](auto&& self, int x, int y) -> void {
+    const auto &cx = X.clusters[std::size_t(x)], &cy = Y.clusters[std::size_t(y)];
+    const double exact = cx.work * cy.work;
+    if (compress) {
+      const double interpolated = interpolation_size(cx.box) * interpolation_size(cy.box);
+      if (std::max(cx.box.radius(), cy.box.radius()) <= far_field.eta * image_distance(cx.box, cy.box, green.grid()) &&
+          interpolated < exact) {
+        blocks.push_back({x, y, true, interpolated});
+        return;
+      }
+    }
+    if (X.leaf(x) && Y.leaf(y)) {
+      blocks.push_back({x, y, false, exact});
+    } else if (X.leaf(x) || (!Y.leaf(y) && cy.end - cy.begin > cx.end - cx.begin)) {
+      self(self, x, cy.left);
+      self(self, x, cy.right);
+    } else {
+      self(self, cx.left, y);
+      self(self, cx.right, y);
+    }
+  };
+  partition(partition, 0, 0);
+  std::sort(blocks.begin(), blocks.end(), [](const Block& a, const Block& b) { return a.cost > b.cost; });
+
+  // Per cluster: the interpolation and U = R L (rows) or V = Q L (columns) for the far blocks; the
+  // distinct nodes for the near ones.
+  const auto cluster_items = [](const ClusterTree<dim>& T, int c) {
+    const auto& cl = T.clusters[std::size_t(c)];
+    return std::vector<int>(T.item.begin() + cl.begin, T.item.begin() + cl.end);
+  };
+  std::vector<char> x_far(X.clusters.size(), 0), y_far(Y.clusters.size(), 0), x_near(X.clusters.size(), 0);
+  for (const Block& b : blocks) {
+    if (b.far)
+      x_far[std::size_t(b.x)] = y_far[std::size_t(b.y)] = 1;
+    else
+      x_near[std::size_t(b.x)] = 1;
+  }
+  std::vector<std::unique_ptr<Interpolation<dim>>> x_interp(X.clusters.size()), y_interp(Y.clusters.size());
+  std::vector<std::vector<Eigen::MatrixXd>> U(X.clusters.size());
+  std::vector<Eigen::MatrixXd> V(Y.clusters.size());
+  std::vector<std::unique_ptr<DistinctNodes<dim>>> distinct(X.clusters.size());
+  const auto interpolate = [&](const RowSide& side, const std::vector<int>& items, const Interpolation<dim>& L,
+                               std::vector<Eigen::MatrixXd>& mats) {
+    mats.clear();
+    for (const SparseRows* R : side.sets) {
+      Eigen::MatrixXd M = Eigen::MatrixXd::Zero(Eigen::Index(items.size()), L.size());
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rowmajor = M;
+      for (std::size_t i = 0; i < items.size(); ++i)
+        for (std::size_t a = R->row_begin[std::size_t(items[i])]; a < R->row_begin[std::size_t(items[i]) + 1]; ++a)
+          L.add(node_of<dim>(R->entries[a]), R->entries[a].value, rowmajor.row(Eigen::Index(i)).data());
+      mats.push_back(rowmajor);
+    }
+  };
+#pragma omp parallel for schedule(dynamic, 1) num_threads(execution.threads())
+  for (int c = 0; c < int(X.clusters.size()) + int(Y.clusters.size()); ++c) {
+    if (c < int(X.clusters.size())) {
+      if (x_far[std::size_t(c)]) {
+        x_interp[std::size_t(c)] =
+            std::make_unique<Interpolation<dim>>(X.clusters[std::size_t(c)].box, far_field.order);
+        interpolate(rows, cluster_items(X, c), *x_interp[std::size_t(c)], U[std::size_t(c)]);
+      }
+      if (x_near[std::size_t(c)])
+        distinct[std::size_t(c)] = std::make_unique<DistinctNodes<dim>>(rows, cluster_items(X, c));
+    } else {
+      const int y = c - int(X.clusters.size());
+      if (!y_far[std::size_t(y)]) continue;
+      y_interp[std::size_t(y)] = std::make_unique<Interpolation<dim>>(Y.clusters[std::size_t(y)].box, far_field.order);
+      std::vector<Eigen::MatrixXd> mats;
+      interpolate(cols, cluster_items(Y, y), *y_interp[std::size_t(y)], mats);
+      V[std::size_t(y)] = std::move(mats.front());
+    }
+  }
+
+  std::atomic<bool> stop = false;  // an interruption seen by thread 0 (the caller's) ends every thread's work
+#pragma omp parallel num_threads(execution.threads())
+  {
+    std::vector<double> column;
+    Eigen::MatrixXd core, half, block;
+#pragma omp for schedule(dynamic, 1)
+    for (std::size_t k = 0; k < blocks.size(); ++k) {
+      if (omp_get_thread_num() == 0 && execution.interrupt_requested()) stop = true;
+      if (stop) continue;
+      const Block& b = blocks[k];
+      const auto &cx = X.clusters[std::size_t(b.x)], &cy = Y.clusters[std::size_t(b.y)];
+      if (b.far) {
+        const Interpolation<dim>&Lx = *x_interp[std::size_t(b.x)], &Ly = *y_interp[std::size_t(b.y)];
+        core.resize(Lx.size(), Ly.size());
+        for (int l = 0; l < Ly.size(); ++l) {
+          const Index<dim> q = Ly.node(l);
+          for (int p = 0; p < Lx.size(); ++p) core(p, l) = green_between(green, Lx.node(p), q);
+        }
+        half.noalias() = core * V[std::size_t(b.y)].transpose();
+        for (std::size_t s = 0; s < row_sets.size(); ++s) {
+          block.noalias() = U[std::size_t(b.x)][s] * half;
+          for (int j = cy.begin; j < cy.end; ++j)
+            for (int i = cx.begin; i < cx.end; ++i)
+              out[s](X.item[std::size_t(i)], Y.item[std::size_t(j)]) = block(i - cx.begin, j - cy.begin);
+        }
+        continue;
+      }
+      const DistinctNodes<dim>& nodes = *distinct[std::size_t(b.x)];
+      column.resize(nodes.nodes.size());
+      for (int j = cy.begin; j < cy.end; ++j) {
+        const int col = Y.item[std::size_t(j)];
+        for (std::size_t u = 0; u < nodes.nodes.size(); ++u) {
+          double sum = 0.0;
+          for (std::size_t q = Q.row_begin[std::size_t(col)]; q < Q.row_begin[std::size_t(col) + 1]; ++q)
+            sum += green_between(green, nodes.nodes[u], node_of<dim>(Q.entries[q])) * Q.entries[q].value;
+          column[u] = sum;
+        }
+        std::size_t entry = 0;
+        for (std::size_t s = 0; s < row_sets.size(); ++s) {
+          const SparseRows& R = *row_sets[s];
+          for (int i = cx.begin; i < cx.end; ++i) {
+            const int row = X.item[std::size_t(i)];
+            double sum = 0.0;
+            for (std::size_t a = R.row_begin[std::size_t(row)]; a < R.row_begin[std::size_t(row) + 1]; ++a, ++entry)
+              sum += R.entries[a].value * column[nodes.slot[entry]];
+            out[s](row, col) = sum;
+          }
+        }
+      }
+    }
+  }
+  if (stop) throw Interrupted();
+  if (report) {
+    *report = {};
+    for (const Block& b : blocks) {
+      const double pairs = double(X.clusters[std::size_t(b.x)].end - X.clusters[std::size_t(b.x)].begin) *
+                           double(Y.clusters[std::size_t(b.y)].end - Y.clusters[std::size_t(b.y)].begin);
+      (b.far ? report->far_pairs : report->near_pairs) += pairs;
+      (b.far ? report->far_blocks : report->near_blocks) += 1;
+    }
+  }
+  return out;
+}
+
+template Eigen::MatrixXd green_block(const GreenTable<2>&, const SparseRows&, const SparseRows&, const Execution&,
+                                     const FarField&);
+template Eigen::MatrixXd green_block(const GreenTable<3>&, const SparseRows&, const SparseRows&, const Execution&,
+                                     const FarField&);
+template std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>&, const std::vector<const SparseRows*>&,
+                                                   const SparseRows&, const Execution&, const FarField&,
+                                                   FarFieldReport*);
+template std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<3>&, const std::vector<const SparseRows*>&,
+                                                   const SparseRows&, const Execution&, const FarField&,
+                                                   FarFieldReport*);
+
+}  // namespace fictus
