@@ -247,6 +247,7 @@ json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& s) 
                   {"normal_derivative", to_string(o.normal_derivative)},
                   {"normal_shift", o.normal_shift},
                   {"schur", to_string(o.inner)},
+                  {"far_field", o.far_field},
                   {"rho", o.rho},
                   {"newton_tolerance", o.newton_tolerance},
                   {"threads", o.threads},
@@ -263,6 +264,13 @@ json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& s) 
   j["inner"] = {{"solver", to_string(s.options.inner)},
                 {"fast_solves", s.fast_solves},
                 {"krylov_iterations", s.inner_iterations}};
+  if (s.far_field) {
+    const FarFieldReport& a = s.far_field->assembly;
+    j["inner"]["far_field"] = {{"far_fraction", a.far_pairs / (a.far_pairs + a.near_pairs)},
+                               {"far_blocks", a.far_blocks},
+                               {"near_blocks", a.near_blocks},
+                               {"exact_steps", s.far_field->exact_steps}};
+  }
   j["signorini"] = signorini_json(s.signorini);
   long points = 0;
   double contact_area = 0, force = 0, min_gap = std::numeric_limits<double>::infinity(), max_gap = -min_gap;

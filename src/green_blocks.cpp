@@ -9,6 +9,7 @@
 #include <cmath>
 #include <memory>
 #include <numeric>
+#include <stdexcept>
 #include <unordered_map>
 
 #include "fictus/schur_complement.hpp"
@@ -255,6 +256,9 @@ template <int dim>
 std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
                                           const SparseRows& Q, const Execution& execution, const FarField& far_field,
                                           FarFieldReport* report) {
+  for (const SparseRows* R : row_sets)
+    if (R->n_rows() != row_sets.front()->n_rows())
+      throw std::invalid_argument("green_blocks: the row sets differ in their number of rows");
   const RowSide rows{row_sets}, cols{{&Q}};
   const int n_rows = rows.n_rows(), n_cols = Q.n_rows();
   std::vector<Eigen::MatrixXd> out;

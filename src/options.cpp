@@ -251,6 +251,15 @@ std::vector<OptionSpec> make_specs() {
   specs.push_back(integer("solver", "error_quadrature", &SolverOptions::error_quadrature, 1, 12,
                           "Gauss points per direction for the error integrals"));
   {
+    OptionSpec f =
+        member(std::string("solver"), std::string("far_field"), OptionType::boolean, &SolverOptions::far_field,
+               "3-D green: interpolate the far pairs of the Schur complement and finish Newton on the "
+               "exact one (false: assemble every pair exactly)");
+    f.rule = "true or false";
+    f.violation = [](const OptionValue&) { return std::string(); };
+    specs.push_back(f);
+  }
+  {
     OptionSpec c = member(std::string("solver"), std::string("condition_number"), OptionType::boolean,
                           &SolverOptions::condition_number, "compute cond(S) of the final Newton matrix (green only)");
     c.rule = "true or false";

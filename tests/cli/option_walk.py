@@ -43,6 +43,7 @@ WALK = {
     "max_memory": 16.0,
     "load_quadrature": 3,
     "error_quadrature": 4,
+    "far_field": False,
     "condition_number": False,
 }
 

@@ -105,6 +105,36 @@ TEST(Manufactured3d, GreenAndKrylovAgree) {
   EXPECT_GT(krylov.fast_solves, 20u);
 }
 
+TEST(Manufactured3d, InterpolatedFarFieldGivesTheExactAnswer) {
+  // solver.far_field: S̃ with its far pairs interpolated, Newton on S̃ and then on the exact S (S̃ as
+  // GMRES's preconditioner). The answer is the exact assembly's, in at most one Newton step more.
+  for (const auto variant : {fictus::Variant::smooth, fictus::Variant::nonsmooth}) {
+    fictus::SolverOptions o;
+    o.threads = 2;
+    o.variant = variant;
+    o.multipliers = variant == fictus::Variant::smooth ? 129 : 0;
+    o.far_field = false;
+    const fictus::SurfaceSolution exact = fictus::solve(problem("sphere", 64), o);
+    o.far_field = true;
+    const fictus::SurfaceSolution far = fictus::solve(problem("sphere", 64), o);
+    ASSERT_TRUE(exact.newton.converged && far.newton.converged);
+    ASSERT_TRUE(far.far_field.has_value());
+    EXPECT_FALSE(exact.far_field.has_value());
+    EXPECT_GT(far.far_field->assembly.far_pairs, far.far_field->assembly.near_pairs);
+    EXPECT_GE(far.far_field->exact_steps, 1);
+    EXPECT_EQ(far.newton.active, exact.newton.active);
+    EXPECT_LE(far.newton.iterations, exact.newton.iterations + 1);
+    double largest = 0, difference = 0;
+    for (std::size_t i = 0; i < far.lambda.size(); ++i) {
+      largest = std::max(largest, std::abs(exact.lambda[i]));
+      difference = std::max(difference, std::abs(far.lambda[i] - exact.lambda[i]));
+    }
+    EXPECT_LT(difference, 1e-10 * largest);
+    expect_signorini_at_round_off(far);
+    EXPECT_NEAR(far.errors->rel_l2_omega, exact.errors->rel_l2_omega, 1e-6 * exact.errors->rel_l2_omega);
+  }
+}
+
 TEST(Manufactured3d, NonSmoothVariantConvergesWithTheKinkCorrection) {
   // Multipliers on γ itself, traces of the kink-corrected field (surface_kink.hpp), patches of 4h. The
   // contact set is under-resolved at small N (fewer points in contact than the smooth variant finds),

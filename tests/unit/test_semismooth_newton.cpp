@@ -109,6 +109,28 @@ TEST(SemismoothNewton, SolvesASmallVariationalInequalityWithAKnownAnswer) {
     EXPECT_LE((r.normal_derivative - c).cwiseAbs().maxCoeff(), 1e-13);
     EXPECT_LE(r.iterations, 6);  // finite termination: a few active-set changes
   }
+  // Handed on after the first step, then on from there (another Schur complement's run may take over):
+  // the same answer, the same steps in all.
+  fictus::NewtonOptions options;
+  options.tolerance = 1e-13;
+  const fictus::NewtonResult whole = fictus::solve_semismooth_newton(schur, b0, c0, g, options);
+  options.hand_on_at_changes = m;
+  const fictus::NewtonResult first = fictus::solve_semismooth_newton(schur, b0, c0, g, options);
+  EXPECT_TRUE(first.handed_on);
+  EXPECT_FALSE(first.converged);
+  EXPECT_EQ(first.iterations, 1);
+  options.hand_on_at_changes = -1;
+  options.start = &first;
+  const fictus::NewtonResult rest = fictus::solve_semismooth_newton(schur, b0, c0, g, options);
+  ASSERT_TRUE(rest.converged) << rest.failure;
+  EXPECT_EQ(rest.active, contact);
+  EXPECT_LE((rest.lambda - lambda).cwiseAbs().maxCoeff(), 1e-13);
+  EXPECT_EQ(first.iterations + rest.iterations, whole.iterations);
+  // A start of another size is refused.
+  fictus::NewtonResult wrong = first;
+  wrong.lambda.resize(m - 1);
+  options.start = &wrong;
+  EXPECT_THROW(fictus::solve_semismooth_newton(schur, b0, c0, g, options), std::invalid_argument);
 }
 
 }  // namespace

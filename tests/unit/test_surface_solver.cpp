@@ -198,6 +198,33 @@ TEST(SurfaceSolver, PeriodicBoxWithoutReactionSolves) {
   EXPECT_LT(s.signorini.max_complementarity, 1e-12);
 }
 
+TEST(SurfaceSolver, PeriodicBoxWithoutReactionWithTheFarFieldInterpolated) {
+  // The bordered system (λ, α) through the interpolated S̃ and the exact S: the same answer as the
+  // exact assembly.
+  auto p = small_problem(0.3, 48);
+  p.boundary = fictus::Boundary::periodic;
+  p.c = 0;
+  p.f = [](double, double, double) { return -1.0; };
+  fictus::SolverOptions o;
+  o.variant = fictus::Variant::nonsmooth;
+  o.threads = 2;
+  o.far_field = false;
+  const fictus::SurfaceSolution exact = fictus::solve(p, o);
+  o.far_field = true;
+  const fictus::SurfaceSolution far = fictus::solve(p, o);
+  ASSERT_TRUE(exact.newton.converged && far.newton.converged);
+  ASSERT_TRUE(far.far_field.has_value());
+  EXPECT_EQ(far.newton.active, exact.newton.active);
+  double largest = 0, difference = 0;
+  for (std::size_t i = 0; i < far.lambda.size(); ++i) {
+    largest = std::max(largest, std::abs(exact.lambda[i]));
+    difference = std::max(difference, std::abs(far.lambda[i] - exact.lambda[i]));
+  }
+  EXPECT_LT(difference, 1e-10 * largest);
+  EXPECT_NEAR(far.alpha, exact.alpha, 1e-10 * std::abs(exact.alpha) + 1e-12);
+  EXPECT_LT(far.signorini.max_complementarity, 1e-12);
+}
+
 }  // namespace
 
 namespace {

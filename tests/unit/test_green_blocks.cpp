@@ -1,0 +1,123 @@
+// The dense blocks R A⁻¹ Qᵀ from the Green's table: exact against fast solves, and with the far
+// field interpolated (FarField) against the exact assembly.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <ostream>
+
+#include "fictus/fast_solver.hpp"
+#include "fictus/schur_complement.hpp"
+#include "fictus/surface_integrals.hpp"
+#include "fictus/surface_solver.hpp"
+#include "fictus/trace_operators.hpp"
+
+namespace {
+
+struct Case {
+  fictus::Boundary boundary;
+  double c;
+  double radius;  // of the sphere about the box's center: 0.45 comes within 2.4h of the walls at N = 48
+};
+
+std::string name(const ::testing::TestParamInfo<struct Case>& info);
+void PrintTo(const Case& k, std::ostream* out) {
+  *out << (k.boundary == fictus::Boundary::periodic ? "periodic" : "dirichlet") << ", c = " << k.c
+       << ", r = " << k.radius;
+}
+
+/// The smooth variant's rows on a sphere: B_γ, C_γ at the points, patch integrals on Γ at δ.
+struct SphereRows {
+  fictus::Grid3 grid;
+  fictus::SparseRows B, C, Q;
+  SphereRows(const Case& k, int N, double patch_cells, double delta_cells)
+      : grid(fictus::Box3{{0, 0, 0}, {1, 1, 1}}, N, k.boundary) {
+    const double h = grid.h();
+    const fictus::Ellipsoid sphere({0.5, 0.5, 0.5}, {k.radius, k.radius, k.radius});
+    const int m = int(sphere.area() / (patch_cells * h * patch_cells * h));
+    const fictus::PatchedSurface s = sphere.patches(m, h);
+    std::vector<fictus::Triangle3> Gamma = s.triangles;
+    for (fictus::Triangle3& t : Gamma)
+      for (fictus::Point3* p : {&t.a, &t.b, &t.c}) {
+        const fictus::Point3 d = *p - fictus::Point3{0.5, 0.5, 0.5};
+        *p = *p + (delta_cells * h / fictus::norm(d)) * d;
+      }
+    B = fictus::point_value_rows(grid, s.point);
+    C = fictus::normal_derivative_rows_centered(grid, s.point, s.normal);
+    Q = fictus::patch_integral_rows(grid, fictus::patch_integrals(grid, Gamma, s.patch_of, m), m);
+  }
+};
+
+double relative_max_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff();
+}
+
+class GreenBlocksTest : public ::testing::TestWithParam<Case> {};
+
+TEST_P(GreenBlocksTest, ExactAssemblyMatchesFastSolves) {
+  const SphereRows rows(GetParam(), 32, 3.0, 0.0);
+  const fictus::GreenTable<3> green(rows.grid, GetParam().c);
+  const std::vector<Eigen::MatrixXd> S = fictus::green_blocks(green, {&rows.B, &rows.C}, rows.Q);
+  const auto solver = fictus::make_fast_solver(rows.grid, GetParam().c);
+  for (int col : {0, rows.Q.n_rows() / 3, rows.Q.n_rows() - 1}) {
+    std::vector<double> unit(std::size_t(rows.Q.n_rows()), 0.0);
+    unit[std::size_t(col)] = 1.0;
+    fictus::GridVector w(rows.grid.n_unknowns(), 0.0);
+    rows.Q.add_transposed(unit, w);
+    solver->solve_in_place(w);  // A⁺ for the singular periodic c = 0, as the table
+    std::vector<double> b, c;
+    rows.B.multiply(w, b);
+    rows.C.multiply(w, c);
+    for (int r = 0; r < rows.B.n_rows(); ++r) {
+      EXPECT_NEAR(S[0](r, col), b[std::size_t(r)], 1e-11 * S[0].cwiseAbs().maxCoeff());
+      EXPECT_NEAR(S[1](r, col), c[std::size_t(r)], 1e-11 * S[1].cwiseAbs().maxCoeff());
+    }
+  }
+}
+
+TEST_P(GreenBlocksTest, InterpolatedFarFieldConvergesWithTheOrder) {
+  // Patches of 4h at N = 48, Γ at 2h: a few hundred rows, most pairs far. The error of an interpolated pair
+  // falls like (radius/distance)^order; the exact pairs and the rows' structure are untouched.
+  const SphereRows rows(GetParam(), 48, 4.0, 2.0);
+  const fictus::GreenTable<3> green(rows.grid, GetParam().c);
+  const std::vector<Eigen::MatrixXd> exact = fictus::green_blocks(green, {&rows.B, &rows.C}, rows.Q);
+  double previous = 1;
+  for (const int order : {3, 5, 7}) {
+    fictus::FarFieldReport report;
+    const std::vector<Eigen::MatrixXd> S =
+        fictus::green_blocks(green, {&rows.B, &rows.C}, rows.Q, fictus::Execution{2}, {order, 1.0, 2}, &report);
+    const double error = std::max(relative_max_difference(S[0], exact[0]), relative_max_difference(S[1], exact[1]));
+    EXPECT_GT(report.far_pairs, 0.3 * (report.far_pairs + report.near_pairs)) << "order " << order;
+    EXPECT_LT(error, previous / 8) << "order " << order;
+    previous = error;
+  }
+  EXPECT_LT(previous, 1e-4);
+  // The solver's setting: a preconditioner's accuracy.
+  const std::vector<Eigen::MatrixXd> S =
+      fictus::green_blocks(green, {&rows.B, &rows.C}, rows.Q, fictus::Execution{2}, fictus::default_far_field_3d);
+  EXPECT_LT(std::max(relative_max_difference(S[0], exact[0]), relative_max_difference(S[1], exact[1])), 2e-2);
+}
+
+INSTANTIATE_TEST_SUITE_P(Boxes, GreenBlocksTest,
+                         ::testing::Values(Case{fictus::Boundary::dirichlet, 1.0, 0.3},
+                                           Case{fictus::Boundary::dirichlet, 100.0, 0.3},
+                                           Case{fictus::Boundary::dirichlet, 1.0, 0.45},
+                                           Case{fictus::Boundary::periodic, 0.0, 0.45},
+                                           Case{fictus::Boundary::periodic, 1.0, 0.3}),
+                         name);
+
+std::string name(const ::testing::TestParamInfo<Case>& info) {
+  const Case& k = info.param;
+  return std::string(k.boundary == fictus::Boundary::periodic ? "periodic" : "dirichlet") + "_c" +
+         std::to_string(int(k.c)) + "_r" + std::to_string(int(100 * k.radius));
+}
+
+TEST(GreenBlocks, EmptyRowsGiveEmptyBlocks) {
+  const fictus::Grid3 grid(fictus::Box3{{0, 0, 0}, {1, 1, 1}}, 8);
+  const fictus::GreenTable<3> green(grid, 1.0);
+  const fictus::SparseRows none;
+  const fictus::SparseRows one = fictus::point_value_rows(grid, {fictus::Point3{0.5, 0.5, 0.5}});
+  EXPECT_EQ(fictus::green_block(green, none, one, {}, {6, 2.0, 2}).size(), 0);
+  EXPECT_EQ(fictus::green_block(green, one, none, {}, {6, 2.0, 2}).size(), 0);
+}
+
+}  // namespace
