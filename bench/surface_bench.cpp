@@ -1,6 +1,7 @@
-// fictus 3-D benchmark: the manufactured sphere (tests/convergence/manufactured3d.py) with the smooth
-// variant, end to end per phase with peak memory at N = 64 … --max-N, and the green and krylov inner
-// solvers compared in the same run. Writes a Markdown report (machine, compiler, threads, commit beside
+// fictus 3-D benchmark: the manufactured sphere (tests/convergence/manufactured3d.py), both variants,
+// end to end per phase with peak memory at N = 64 … --max-N (non-smooth up to 256), the exact and the
+// far-field assembly of S compared in the same run at N = 128, and the green and krylov inner solvers
+// at N = 64. Writes a Markdown report (machine, compiler, threads, commit beside
 // the figures). Not part of the test suite: `make bench`.
 #include <algorithm>
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "fictus/io/process.hpp"
 #include "manufactured_solutions_3d.hpp"
@@ -26,6 +28,22 @@ fictus::SurfaceSolution run(int N, fictus::SolverOptions o) {
   s.peak_memory_bytes = fictus::peak_memory_bytes();
   if (!s.newton.converged) std::fprintf(stderr, "N = %d: Newton did not converge: %s\n", N, s.newton.failure.c_str());
   return s;
+}
+
+double far_fraction(const fictus::SurfaceSolution& s) {
+  if (!s.far_field) return 0;
+  const fictus::FarFieldReport& a = s.far_field->assembly;
+  return a.far_pairs / (a.far_pairs + a.near_pairs);
+}
+
+/// max |a − b| / max |b|
+double max_relative_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  double largest = 0, difference = 0;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    largest = std::max(largest, std::abs(b[i]));
+    difference = std::max(difference, std::abs(a[i] - b[i]));
+  }
+  return difference / largest;
 }
 
 const char* phases[] = {"load",  "u0",     "geometry",    "kink_correction", "green_table",
@@ -61,30 +79,55 @@ int main(int argc, char** argv) {
         "∂²u/∂n² ≠ 0 on the free part), default m (patches of 8h smooth, 4h non-smooth) and δ = 1.5 s; one run per "
         "row; peak memory is the process's so far (rows in increasing N)\n\n";
 
-  // The non-smooth variant stops at N = 128: with patches of 4h its m grows to 4630 at N = 256 and the
-  // dense Schur blocks (m² pairs of wider rows) would take most of an hour.
+  // The non-smooth variant stops at N = 256: with patches of 4h its m is 18500 at N = 512, where the
+  // dense Newton matrices (2.7 GB each) and their LU (minutes per Newton step) would dominate.
   for (const fictus::Variant variant : {fictus::Variant::smooth, fictus::Variant::nonsmooth}) {
     const bool smooth = variant == fictus::Variant::smooth;
     md << (smooth ? "## End to end, smooth variant, green inner solver\n\n"
                   : "\n## End to end, non-smooth variant (kink correction, patches of 4h), green inner solver\n\n")
-       << "| N | unknowns | m | Newton | total [s]";
+       << "| N | unknowns | m | Newton | exact steps | fast solves | far pairs | total [s]";
     for (const char* p : phases) md << " | " << p;
-    md << " | rel L2(ω) | rel L2(γ) | peak MiB |\n|---|---|---|---|---";
+    md << " | rel L2(ω) | rel L2(γ) | peak MiB |\n|---|---|---|---|---|---|---|---";
     for (std::size_t k = 0; k < std::size(phases) + 3; ++k) md << "|---";
     md << "|\n";
-    for (int N = 64; N <= (smooth ? max_N : std::min(max_N, 128)); N *= 2) {
+    for (int N = 64; N <= (smooth ? max_N : std::min(max_N, 256)); N *= 2) {
       fictus::SolverOptions o;
       o.threads = threads;
       o.variant = variant;
       if (smooth && N == 64) o.multipliers = 129;  // patches of 6h: the default δ = 12h leaves no room at N = 64
       const fictus::SurfaceSolution s = run(N, o);
-      md << format("| %d | %zu | %d | %d | %.2f", N, s.grid.n_unknowns(), s.options.multipliers, s.newton.iterations,
-                   s.timings.total);
+      md << format("| %d | %zu | %d | %d | %d | %zu | %.1f %% | %.2f", N, s.grid.n_unknowns(), s.options.multipliers,
+                   s.newton.iterations, s.far_field ? s.far_field->exact_steps : 0, s.fast_solves,
+                   100 * far_fraction(s), s.timings.total);
       for (const char* p : phases) md << format(" | %.2f", s.timings[p]);
       md << format(" | %.3e | %.3e | %.0f |\n", s.errors->rel_l2_omega, s.errors->rel_l2_gamma,
                    s.peak_memory_bytes / 1048576.0);
       std::fflush(stdout);
     }
+  }
+
+  // The two assemblies of S in one run: every pair exact, or the far pairs interpolated (then Newton
+  // finishes on the exact S).
+  md << "\n## Explicit Schur complement: exact assembly vs interpolated far field (same run, N = 128)\n\n"
+     << "| variant | far_field | m | Newton | exact steps | fast solves | schur [s] | newton [s] | total [s] | rel "
+        "L2(ω) |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const fictus::Variant variant : {fictus::Variant::smooth, fictus::Variant::nonsmooth}) {
+    fictus::SolverOptions o;
+    o.threads = threads;
+    o.variant = variant;
+    o.far_field = false;
+    const fictus::SurfaceSolution exact = run(128, o);
+    o.far_field = true;
+    const fictus::SurfaceSolution far = run(128, o);
+    for (const fictus::SurfaceSolution* s : {&exact, &far})
+      md << format("| %s | %s | %d | %d | %d | %zu | %.2f | %.2f | %.2f | %.3e |\n", fictus::to_string(variant),
+                   s->options.far_field ? "true" : "false", s->options.multipliers, s->newton.iterations,
+                   s->far_field ? s->far_field->exact_steps : 0, s->fast_solves, s->timings["schur"],
+                   s->timings["newton"], s->timings.total, s->errors->rel_l2_omega);
+    md << format("\n%s: max |λ_far − λ_exact| / max |λ| = %.2e; active sets %s; schur %.1f× faster, total %.1f×\n\n",
+                 fictus::to_string(variant), max_relative_difference(far.lambda, exact.lambda),
+                 far.newton.active == exact.newton.active ? "identical" : "DIFFERENT",
+                 exact.timings["schur"] / far.timings["schur"], exact.timings.total / far.timings.total);
   }
   md << "\n## green vs krylov (same run, N = 64, m = 129, Krylov tolerance 1e-12)\n\n"
      << "| inner | Newton | fast solves | Krylov iterations | schur [s] | newton [s] | total [s] |\n"
@@ -96,17 +139,12 @@ int main(int argc, char** argv) {
   o.inner = fictus::InnerSolver::krylov;
   o.krylov_tolerance = 1e-12;
   const fictus::SurfaceSolution krylov = run(64, o);
-  double largest = 0, difference = 0;
-  for (std::size_t i = 0; i < green.lambda.size(); ++i) {
-    largest = std::max(largest, std::abs(green.lambda[i]));
-    difference = std::max(difference, std::abs(green.lambda[i] - krylov.lambda[i]));
-  }
   for (const fictus::SurfaceSolution* s : {&green, &krylov})
     md << format("| %s | %d | %zu | %d | %.2f | %.2f | %.2f |\n", fictus::to_string(s->options.inner),
                  s->newton.iterations, s->fast_solves, s->inner_iterations, s->timings["schur"], s->timings["newton"],
                  s->timings.total);
   md << format("\nmax |λ_green − λ_krylov| / max |λ| = %.2e; active sets %s; speed-up of green %.1f×\n",
-               difference / largest, green.newton.active == krylov.newton.active ? "identical" : "DIFFERENT",
+               max_relative_difference(green.lambda, krylov.lambda), green.newton.active == krylov.newton.active ? "identical" : "DIFFERENT",
                krylov.timings.total / green.timings.total);
 
   std::filesystem::create_directories(out_dir);
