@@ -189,6 +189,11 @@ int run_solve_surface(const std::string& text, const SolveCommand& command) {
                 fictus::to_string(s.options.inner));
     std::printf("Newton: %d steps, converged, %ld active of %d; fast solves %zu\n", s.newton.iterations, active,
                 s.gamma.m, s.fast_solves);
+    if (s.far_field) {
+      const fictus::FarFieldReport& a = s.far_field->assembly;
+      std::printf("Schur complement: %.1f%% of the pairs interpolated; the last %d Newton steps on the exact one\n",
+                  100 * a.far_pairs / (a.far_pairs + a.near_pairs), s.far_field->exact_steps);
+    }
     std::printf("Signorini checks: min gap %.2e, min du/dn %.2e, max |complementarity| %.2e\n", s.signorini.min_gap,
                 s.signorini.min_normal_derivative, s.signorini.max_complementarity);
     if (s.errors)

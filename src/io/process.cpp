@@ -24,6 +24,11 @@ std::size_t proc_kib(const char* file, const std::string& key) {
 
 std::size_t peak_memory_bytes() { return proc_kib("/proc/self/status", "VmHWM:"); }
 
+bool reset_peak_memory() {
+  std::ofstream out("/proc/self/clear_refs");
+  return bool(out << "5" << std::flush);
+}
+
 std::size_t available_memory_bytes() { return proc_kib("/proc/meminfo", "MemAvailable:"); }
 
 void check_memory(const Problem& problem, const SolverOptions& options) {

@@ -9,6 +9,10 @@ namespace fictus {
 /// Peak resident memory of this process in bytes (VmHWM; 0 where unknown).
 std::size_t peak_memory_bytes();
 
+/// Starts the peak over from the present resident memory (writes 5 to /proc/self/clear_refs), so that
+/// one process can measure several runs; false where the system does not allow it.
+bool reset_peak_memory();
+
 /// Memory the system can give without swapping (MemAvailable; 0 where unknown).
 std::size_t available_memory_bytes();
 
