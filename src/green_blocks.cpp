@@ -1,5 +1,5 @@
 // Dense blocks R G Qᵀ from sparse rows and the Green's table: exact, or with the far field
-// interpolated (schur_complement.hpp, docs/math.md "Assembling the Schur complement").
+// interpolated (schur_complement.hpp, docs/math.md "The far field of the 3-D Schur complement").
 #include <omp.h>
 
 #include <algorithm>
@@ -7,6 +7,7 @@
 #include <atomic>
 #include <climits>
 #include <cmath>
+#include <exception>
 #include <memory>
 #include <numeric>
 #include <stdexcept>
@@ -48,14 +49,16 @@ struct NodeBox {
     for (int d = 0; d < dim; ++d) lo[d] = std::min(lo[d], a[d]), hi[d] = std::max(hi[d], a[d]);
   }
   void add(const NodeBox& b) {
+    if (b.empty()) return;
     add(b.lo);
     add(b.hi);
   }
-  double center(int d) const { return 0.5 * (double(lo[d]) + double(hi[d])); }
+  bool empty() const { return lo[0] > hi[0]; }  // a row without entries
+  double center(int d) const { return empty() ? 0.0 : 0.5 * (double(lo[d]) + double(hi[d])); }
   /// Half the diagonal.
   double radius() const {
     double s = 0;
-    for (int d = 0; d < dim; ++d) s += double(hi[d] - lo[d]) * double(hi[d] - lo[d]);
+    for (int d = 0; d < dim && !empty(); ++d) s += (double(hi[d]) - lo[d]) * (double(hi[d]) - lo[d]);
     return 0.5 * std::sqrt(s);
   }
 };
@@ -147,14 +150,7 @@ struct Interpolation {
     for (int d = 0; d < dim; ++d) {
       const int lo = b.lo[d], hi = b.hi[d], width = hi - lo + 1;
       std::vector<int>& x = nodes[std::size_t(d)];
-      if (width <= order) {
-        for (int t = lo; t <= hi; ++t) x.push_back(t);
-      } else {
-        for (int k = order - 1; k >= 0; --k)
-          x.push_back(int(std::lround(0.5 * (lo + hi) + 0.5 * (hi - lo) * std::cos((2 * k + 1) * M_PI / (2 * order)))));
-        for (int k = 1; k < order; ++k) x[std::size_t(k)] = std::max(x[std::size_t(k)], x[std::size_t(k - 1)] + 1);
-        for (int k = order - 2; k >= 0; --k) x[std::size_t(k)] = std::min(x[std::size_t(k)], x[std::size_t(k + 1)] - 1);
-      }
+      x = interpolation_nodes(lo, hi, order);
       const int p = int(x.size());
       std::vector<double>& w = weights[std::size_t(d)];
       w.assign(std::size_t(width * p), 0.0);
@@ -246,6 +242,22 @@ struct Block {
 
 }  // namespace
 
+std::vector<int> interpolation_nodes(int lo, int hi, int order) {
+  std::vector<int> x;
+  if (hi - lo + 1 <= order) {
+    for (int t = lo; t <= hi; ++t) x.push_back(t);
+    return x;
+  }
+  for (int k = order - 1; k >= 0; --k)
+    x.push_back(int(std::lround(0.5 * (lo + hi) + 0.5 * (hi - lo) * std::cos((2 * k + 1) * M_PI / (2 * order)))));
+  // Nodes that round to the same grid node are pushed apart, inside [lo, hi] (there are more nodes than
+  // `order` there).
+  for (int k = 1; k < order; ++k) x[std::size_t(k)] = std::max(x[std::size_t(k)], x[std::size_t(k - 1)] + 1);
+  x.back() = std::min(x.back(), hi);
+  for (int k = order - 2; k >= 0; --k) x[std::size_t(k)] = std::min(x[std::size_t(k)], x[std::size_t(k + 1)] - 1);
+  return x;
+}
+
 template <int dim>
 Eigen::MatrixXd green_block(const GreenTable<dim>& green, const SparseRows& R, const SparseRows& Q,
                             const Execution& execution, const FarField& far_field) {
@@ -263,6 +275,8 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
   const int n_rows = rows.n_rows(), n_cols = Q.n_rows();
   std::vector<Eigen::MatrixXd> out;
   for (const SparseRows* R : row_sets) out.emplace_back(R->n_rows(), n_cols);
+  if (far_field.order < 0 || (far_field.order > 0 && !(far_field.eta > 0 && far_field.leaf >= 1)))
+    throw std::invalid_argument("green_blocks: a far field needs order >= 0, eta > 0 and leaves of >= 1 row");
   if (n_rows == 0 || n_cols == 0) return out;
   const bool compress = far_field.order > 0;
 
@@ -283,9 +297,9 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
   const ClusterTree<dim> Y(col_boxes, col_work, compress ? far_field.leaf : 4);
   std::vector<Interpolation<dim>> no_interpolation;
   const auto interpolation_size = [&](const NodeBox<dim>& b) {
-    int s = 1;
-    for (int d = 0; d < dim; ++d) s *= std::min(far_field.order, b.hi[d] - b.lo[d] + 1);
-    return double(s);
+    double s = 1;
+    for (int d = 0; d < dim && !b.empty(); ++d) s *= std::min(double(far_field.order), double(b.hi[d]) - b.lo[d] + 1);
+    return s;
   };
 
   // The block partition: a pair far apart (max radius ≤ eta·distance) is interpolated when that is
@@ -336,33 +350,45 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
                                std::vector<Eigen::MatrixXd>& mats) {
     mats.clear();
     for (const SparseRows* R : side.sets) {
-      Eigen::MatrixXd M = Eigen::MatrixXd::Zero(Eigen::Index(items.size()), L.size());
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rowmajor = M;
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rowmajor =
+          Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>::Zero(Eigen::Index(items.size()),
+                                                                                       L.size());
       for (std::size_t i = 0; i < items.size(); ++i)
         for (std::size_t a = R->row_begin[std::size_t(items[i])]; a < R->row_begin[std::size_t(items[i]) + 1]; ++a)
           L.add(node_of<dim>(R->entries[a]), R->entries[a].value, rowmajor.row(Eigen::Index(i)).data());
       mats.push_back(rowmajor);
     }
   };
+  // An exception (out of memory) inside a parallel loop is kept and thrown after it.
+  std::exception_ptr failure;
+  const auto keep = [&failure] {
+#pragma omp critical(fictus_green_blocks_failure)
+    if (!failure) failure = std::current_exception();
+  };
 #pragma omp parallel for schedule(dynamic, 1) num_threads(execution.threads())
-  for (int c = 0; c < int(X.clusters.size()) + int(Y.clusters.size()); ++c) {
-    if (c < int(X.clusters.size())) {
-      if (x_far[std::size_t(c)]) {
-        x_interp[std::size_t(c)] =
-            std::make_unique<Interpolation<dim>>(X.clusters[std::size_t(c)].box, far_field.order);
-        interpolate(rows, cluster_items(X, c), *x_interp[std::size_t(c)], U[std::size_t(c)]);
+  for (int c = 0; c < int(X.clusters.size()) + int(Y.clusters.size()); ++c) try {
+      if (c < int(X.clusters.size())) {
+        if (x_far[std::size_t(c)]) {
+          x_interp[std::size_t(c)] =
+              std::make_unique<Interpolation<dim>>(X.clusters[std::size_t(c)].box, far_field.order);
+          interpolate(rows, cluster_items(X, c), *x_interp[std::size_t(c)], U[std::size_t(c)]);
+        }
+        if (x_near[std::size_t(c)])
+          distinct[std::size_t(c)] = std::make_unique<DistinctNodes<dim>>(rows, cluster_items(X, c));
+      } else {
+        const int y = c - int(X.clusters.size());
+        if (!y_far[std::size_t(y)]) continue;
+        y_interp[std::size_t(y)] =
+            std::make_unique<Interpolation<dim>>(Y.clusters[std::size_t(y)].box, far_field.order);
+        std::vector<Eigen::MatrixXd> mats;
+        interpolate(cols, cluster_items(Y, y), *y_interp[std::size_t(y)], mats);
+        V[std::size_t(y)] = std::move(mats.front());
       }
-      if (x_near[std::size_t(c)])
-        distinct[std::size_t(c)] = std::make_unique<DistinctNodes<dim>>(rows, cluster_items(X, c));
-    } else {
-      const int y = c - int(X.clusters.size());
-      if (!y_far[std::size_t(y)]) continue;
-      y_interp[std::size_t(y)] = std::make_unique<Interpolation<dim>>(Y.clusters[std::size_t(y)].box, far_field.order);
-      std::vector<Eigen::MatrixXd> mats;
-      interpolate(cols, cluster_items(Y, y), *y_interp[std::size_t(y)], mats);
-      V[std::size_t(y)] = std::move(mats.front());
+    } catch (...) {
+      keep();
     }
-  }
+  if (failure) std::rethrow_exception(failure);
+  execution.throw_if_interrupted();
 
   std::atomic<bool> stop = false;  // an interruption seen by thread 0 (the caller's) ends every thread's work
 #pragma omp parallel num_threads(execution.threads())
@@ -370,51 +396,55 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
     std::vector<double> column;
     Eigen::MatrixXd core, half, block;
 #pragma omp for schedule(dynamic, 1)
-    for (std::size_t k = 0; k < blocks.size(); ++k) {
-      if (omp_get_thread_num() == 0 && execution.interrupt_requested()) stop = true;
-      if (stop) continue;
-      const Block& b = blocks[k];
-      const auto &cx = X.clusters[std::size_t(b.x)], &cy = Y.clusters[std::size_t(b.y)];
-      if (b.far) {
-        const Interpolation<dim>&Lx = *x_interp[std::size_t(b.x)], &Ly = *y_interp[std::size_t(b.y)];
-        core.resize(Lx.size(), Ly.size());
-        for (int l = 0; l < Ly.size(); ++l) {
-          const Index<dim> q = Ly.node(l);
-          for (int p = 0; p < Lx.size(); ++p) core(p, l) = green_between(green, Lx.node(p), q);
+    for (std::size_t k = 0; k < blocks.size(); ++k) try {
+        if (omp_get_thread_num() == 0 && execution.interrupt_requested()) stop = true;
+        if (stop) continue;
+        const Block& b = blocks[k];
+        const auto &cx = X.clusters[std::size_t(b.x)], &cy = Y.clusters[std::size_t(b.y)];
+        if (b.far) {
+          const Interpolation<dim>&Lx = *x_interp[std::size_t(b.x)], &Ly = *y_interp[std::size_t(b.y)];
+          core.resize(Lx.size(), Ly.size());
+          for (int l = 0; l < Ly.size(); ++l) {
+            const Index<dim> q = Ly.node(l);
+            for (int p = 0; p < Lx.size(); ++p) core(p, l) = green_between(green, Lx.node(p), q);
+          }
+          half.noalias() = core * V[std::size_t(b.y)].transpose();
+          for (std::size_t s = 0; s < row_sets.size(); ++s) {
+            block.noalias() = U[std::size_t(b.x)][s] * half;
+            for (int j = cy.begin; j < cy.end; ++j)
+              for (int i = cx.begin; i < cx.end; ++i)
+                out[s](X.item[std::size_t(i)], Y.item[std::size_t(j)]) = block(i - cx.begin, j - cy.begin);
+          }
+          continue;
         }
-        half.noalias() = core * V[std::size_t(b.y)].transpose();
-        for (std::size_t s = 0; s < row_sets.size(); ++s) {
-          block.noalias() = U[std::size_t(b.x)][s] * half;
-          for (int j = cy.begin; j < cy.end; ++j)
-            for (int i = cx.begin; i < cx.end; ++i)
-              out[s](X.item[std::size_t(i)], Y.item[std::size_t(j)]) = block(i - cx.begin, j - cy.begin);
-        }
-        continue;
-      }
-      const DistinctNodes<dim>& nodes = *distinct[std::size_t(b.x)];
-      column.resize(nodes.nodes.size());
-      for (int j = cy.begin; j < cy.end; ++j) {
-        const int col = Y.item[std::size_t(j)];
-        for (std::size_t u = 0; u < nodes.nodes.size(); ++u) {
-          double sum = 0.0;
-          for (std::size_t q = Q.row_begin[std::size_t(col)]; q < Q.row_begin[std::size_t(col) + 1]; ++q)
-            sum += green_between(green, nodes.nodes[u], node_of<dim>(Q.entries[q])) * Q.entries[q].value;
-          column[u] = sum;
-        }
-        std::size_t entry = 0;
-        for (std::size_t s = 0; s < row_sets.size(); ++s) {
-          const SparseRows& R = *row_sets[s];
-          for (int i = cx.begin; i < cx.end; ++i) {
-            const int row = X.item[std::size_t(i)];
+        const DistinctNodes<dim>& nodes = *distinct[std::size_t(b.x)];
+        column.resize(nodes.nodes.size());
+        for (int j = cy.begin; j < cy.end; ++j) {
+          const int col = Y.item[std::size_t(j)];
+          for (std::size_t u = 0; u < nodes.nodes.size(); ++u) {
             double sum = 0.0;
-            for (std::size_t a = R.row_begin[std::size_t(row)]; a < R.row_begin[std::size_t(row) + 1]; ++a, ++entry)
-              sum += R.entries[a].value * column[nodes.slot[entry]];
-            out[s](row, col) = sum;
+            for (std::size_t q = Q.row_begin[std::size_t(col)]; q < Q.row_begin[std::size_t(col) + 1]; ++q)
+              sum += green_between(green, nodes.nodes[u], node_of<dim>(Q.entries[q])) * Q.entries[q].value;
+            column[u] = sum;
+          }
+          std::size_t entry = 0;
+          for (std::size_t s = 0; s < row_sets.size(); ++s) {
+            const SparseRows& R = *row_sets[s];
+            for (int i = cx.begin; i < cx.end; ++i) {
+              const int row = X.item[std::size_t(i)];
+              double sum = 0.0;
+              for (std::size_t a = R.row_begin[std::size_t(row)]; a < R.row_begin[std::size_t(row) + 1]; ++a, ++entry)
+                sum += R.entries[a].value * column[nodes.slot[entry]];
+              out[s](row, col) = sum;
+            }
           }
         }
+      } catch (...) {
+        keep();
+        stop = true;
       }
-    }
   }
+  if (failure) std::rethrow_exception(failure);
   if (stop) throw Interrupted();
   if (report) {
     *report = {};

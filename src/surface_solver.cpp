@@ -547,8 +547,9 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
     GmresOptions polish = detail::gmres_options(options, m, execution);
     polish.relative_tolerance = far_field_gmres_tolerance;
     const PreconditionedSchur preconditioned(static_cast<const ExplicitSchur&>(*schur), *exact, polish);
-    NewtonOptions from_there = newton_options;
+    NewtonOptions from_there = newton_options;  // solver.max_newton caps both runs together
     from_there.start = &sol.newton;
+    from_there.max_iterations = std::max(1, newton_options.max_iterations - sol.newton.iterations);
     NewtonResult second = solve_semismooth_newton(preconditioned, to_eigen(b0), to_eigen(c0), to_eigen(sol.g),
                                                   from_there, mode ? &*mode : nullptr);
     sol.far_field->exact_steps = second.iterations;

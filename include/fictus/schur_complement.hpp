@@ -41,17 +41,24 @@ struct DirectTerms {
   bool empty() const { return trace.nonZeros() == 0 && normal_derivative.nonZeros() == 0; }
 };
 
-/// How the explicit assembly treats the far field (docs/math.md, "Assembling the Schur complement").
+/// How the explicit assembly treats the far field (docs/math.md, "The far field of the 3-D Schur
+/// complement").
 /// The rows and the columns are split into binary cluster trees; a pair of clusters whose node boxes
 /// lie apart, max(radius) ≤ eta·distance (the nearest image of the box counted), is interpolated:
 ///   G(a, b) ≈ Σ_k Σ_l L_k(a) G(p_k, p_l) L_l(b),
-/// L tensor Lagrange polynomials on `order` grid nodes per axis near the Chebyshev points of each box,
-/// so the block is (R L) G(P, P') (Q L')ᵀ; every other pair is exact. order = 0: all of it exact.
+/// L tensor Lagrange polynomials on `order` grid nodes per axis at the grid nodes nearest the Chebyshev
+/// points of each box (pushed apart where two round to one node), so the block is (R L) G(P, P') (Q L')ᵀ;
+/// every other pair is exact. order = 0: all of it exact. The solver's setting: default_far_field_3d.
 struct FarField {
   int order = 0;
-  double eta = 0.5;
-  int leaf = 32;  // rows per leaf cluster
+  double eta = 2.0;
+  int leaf = 2;  // rows per leaf cluster
 };
+
+/// The interpolation nodes of one axis of a box, lo ≤ hi: all of its nodes when there are at most
+/// `order`, else `order` distinct nodes in [lo, hi], the nearest to the Chebyshev points of [lo, hi]
+/// (pushed apart where two round to one), increasing.
+std::vector<int> interpolation_nodes(int lo, int hi, int order);
 
 /// What the assembly did: entries of the blocks computed exactly (near) and interpolated (far).
 struct FarFieldReport {
@@ -115,7 +122,8 @@ class ImplicitSchur final : public SchurComplement {
 
 class ExplicitSchur final : public SchurComplement {
  public:
-  /// Assembles S_B and S_C from the Green's table (threaded over columns); `loads` as above.
+  /// Assembles S_B and S_C from the Green's table (threaded over blocks of rows and columns; the far
+  /// field interpolated when far_field.order > 0); `loads` as above.
   template <int dim>
   ExplicitSchur(const GreenTable<dim>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
                 const SparseRows& loads, const Execution& execution = Execution{}, const DirectTerms& direct = {},

@@ -3,13 +3,15 @@
 //   u(λ) = u₀ + A⁻¹B_Γᵀλ,  b(λ) = B_γ u = b₀ + S_B λ,  c(λ) = C_γ u = c₀ + S_C λ,
 //   F(λ) = c(λ) − max{0, c(λ) − ρ(b(λ) − g)} = 0.
 // Algorithm (numbered as in the code):
-//   0. λ = 0; 𝒜 = all points ("all" start) or 𝒜 = {i : (c₀ − ρ(b₀ − g))_i > 0} ("zero" start).
+//   0. λ = 0; 𝒜 = all points ("all" start) or 𝒜 = {i : (c₀ − ρ(b₀ − g))_i > 0} ("zero" start);
+//      or λ, α and 𝒜 of an earlier run (NewtonOptions::start: another S takes over from there).
 //   1. Linear solve: S_𝒜 λ = d, rows i ∈ 𝒜: (S_B λ)_i = g_i − b₀_i (contact, u = g),
 //                               rows i ∉ 𝒜: (S_C λ)_i = −c₀_i     (free, ∂u/∂n = 0).
 //   2. Residual: b, c at the new λ and F(λ).
 //   3. Active set: 𝒜' = {i : (c − ρ(b − g))_i > 0}.
 //   4. Stop when 𝒜' = 𝒜 and ‖F‖∞ ≤ tol·scale (finite termination); fail when 𝒜' repeats an
-//      older set (cycling) or after max_iterations.
+//      older set (cycling) or after max_iterations; hand on (NewtonOptions::hand_on_at_changes)
+//      when 𝒜' differs from 𝒜 in at most that many points, returning 𝒜' as the next set.
 // λ is not sign-constrained: the B/C rows carry the Signorini conditions.
 #include <functional>
 #include <string>
@@ -22,9 +24,9 @@
 
 namespace fictus {
 
-/// The Newton part of SolverOptions (its defaults).
 struct NewtonResult;
 
+/// The Newton part of SolverOptions (its defaults).
 struct NewtonOptions {
   double rho = SolverOptions{}.rho;                 // ρ > 0 of the projection
   int max_iterations = SolverOptions{}.max_newton;  // linear solves

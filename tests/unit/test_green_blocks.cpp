@@ -111,13 +111,49 @@ std::string name(const ::testing::TestParamInfo<Case>& info) {
          std::to_string(int(k.c)) + "_r" + std::to_string(int(100 * k.radius));
 }
 
+TEST(GreenBlocks, InterpolationNodesAreDistinctAndInsideTheirBox) {
+  // Every width and order: high orders on narrow boxes round two Chebyshev points to one node, and a
+  // node pushed past the box would interpolate outside it (past a periodic box's last node, read
+  // outside the Green's table).
+  for (int order = 1; order <= 16; ++order)
+    for (int width = 1; width <= 64; ++width) {
+      const int lo = 7, hi = lo + width - 1;
+      const std::vector<int> x = fictus::interpolation_nodes(lo, hi, order);
+      ASSERT_EQ(int(x.size()), std::min(order, width)) << "order " << order << ", width " << width;
+      EXPECT_GE(x.front(), lo) << "order " << order << ", width " << width;
+      EXPECT_LE(x.back(), hi) << "order " << order << ", width " << width;
+      for (std::size_t k = 1; k < x.size(); ++k) EXPECT_LT(x[k - 1], x[k]) << "order " << order << ", width " << width;
+    }
+  EXPECT_EQ(fictus::interpolation_nodes(0, 10, 3), (std::vector<int>{1, 5, 9}));  // Chebyshev: 5 ∓ 5·cos(π/6)
+  const fictus::Grid3 grid(fictus::Box3{{0, 0, 0}, {1, 1, 1}}, 16);
+  const fictus::GreenTable<3> green(grid, 1.0);
+  const fictus::SparseRows one = fictus::point_value_rows(grid, {fictus::Point3{0.5, 0.5, 0.5}});
+  EXPECT_THROW(fictus::green_block(green, one, one, fictus::Execution{}, {6, 0.0, 2}), std::invalid_argument);
+  EXPECT_THROW(fictus::green_block(green, one, one, fictus::Execution{}, {6, 2.0, 0}), std::invalid_argument);
+}
+
+TEST(GreenBlocks, RowsWithoutEntriesGiveZeros) {
+  const fictus::Grid3 grid(fictus::Box3{{0, 0, 0}, {1, 1, 1}}, 16);
+  const fictus::GreenTable<3> green(grid, 1.0);
+  fictus::SparseRows rows = fictus::point_value_rows(
+      grid, {fictus::Point3{0.2, 0.2, 0.2}, fictus::Point3{0.8, 0.8, 0.8}, fictus::Point3{0.2, 0.8, 0.5}});
+  rows.row_begin.push_back(rows.row_begin.back());  // a fourth row, empty
+  rows.row_begin.push_back(rows.row_begin.back());  // and a fifth
+  const Eigen::MatrixXd exact = fictus::green_block(green, rows, rows);
+  const Eigen::MatrixXd far = fictus::green_block(green, rows, rows, fictus::Execution{}, {2, 4.0, 1});
+  EXPECT_EQ(exact.bottomRows(2).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(far.bottomRows(2).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(far.rightCols(2).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_LT(relative_max_difference(far, exact), 1e-2);
+}
+
 TEST(GreenBlocks, EmptyRowsGiveEmptyBlocks) {
   const fictus::Grid3 grid(fictus::Box3{{0, 0, 0}, {1, 1, 1}}, 8);
   const fictus::GreenTable<3> green(grid, 1.0);
   const fictus::SparseRows none;
   const fictus::SparseRows one = fictus::point_value_rows(grid, {fictus::Point3{0.5, 0.5, 0.5}});
-  EXPECT_EQ(fictus::green_block(green, none, one, {}, {6, 2.0, 2}).size(), 0);
-  EXPECT_EQ(fictus::green_block(green, one, none, {}, {6, 2.0, 2}).size(), 0);
+  EXPECT_EQ(fictus::green_block(green, none, one, fictus::Execution{}, {6, 2.0, 2}).size(), 0);
+  EXPECT_EQ(fictus::green_block(green, one, none, fictus::Execution{}, {6, 2.0, 2}).size(), 0);
 }
 
 }  // namespace

@@ -114,7 +114,13 @@ TEST(SemismoothNewton, SolvesASmallVariationalInequalityWithAKnownAnswer) {
   fictus::NewtonOptions options;
   options.tolerance = 1e-13;
   const fictus::NewtonResult whole = fictus::solve_semismooth_newton(schur, b0, c0, g, options);
-  options.hand_on_at_changes = m;
+  ASSERT_GE(whole.history.size(), 2u);
+  const int changed = whole.history.front().n_changed;  // by the first step
+  ASSERT_GT(changed, 0);
+  options.hand_on_at_changes = changed - 1;  // not yet after the first step
+  const fictus::NewtonResult later = fictus::solve_semismooth_newton(schur, b0, c0, g, options);
+  EXPECT_GT(later.iterations, 1);
+  options.hand_on_at_changes = changed;  // at the first step
   const fictus::NewtonResult first = fictus::solve_semismooth_newton(schur, b0, c0, g, options);
   EXPECT_TRUE(first.handed_on);
   EXPECT_FALSE(first.converged);

@@ -181,13 +181,18 @@ TEST(SurfaceSolver, NamesWhatIsWrongWithItsInput) {
   EXPECT_THROW(fictus::Ellipsoid({0, 0, 0}, {1, -1, 1}), std::invalid_argument);
 }
 
-TEST(SurfaceSolver, PeriodicBoxWithoutReactionSolves) {
-  // c = 0 on a periodic box: A is singular, the Newton system is bordered by the constants. With
-  // −Δu = f in ω, ∫_γ ∂u/∂n = −∫_ω f must be ≥ 0: f = −1.
-  auto p = small_problem(0.2, 32);
+/// c = 0 on a periodic box: A is singular, the Newton system is bordered by the constants. With
+/// −Δu = f in ω, ∫_γ ∂u/∂n = −∫_ω f must be ≥ 0: f = −1.
+fictus::SurfaceProblem periodic_without_reaction(double radius, int N) {
+  fictus::SurfaceProblem p = small_problem(radius, N);
   p.boundary = fictus::Boundary::periodic;
   p.c = 0;
   p.f = [](double, double, double) { return -1.0; };
+  return p;
+}
+
+TEST(SurfaceSolver, PeriodicBoxWithoutReactionSolves) {
+  const fictus::SurfaceProblem p = periodic_without_reaction(0.2, 32);
   fictus::SolverOptions o;
   o.variant = fictus::Variant::nonsmooth;
   o.normal_derivative = fictus::NormalDerivative::shifted;
@@ -201,10 +206,7 @@ TEST(SurfaceSolver, PeriodicBoxWithoutReactionSolves) {
 TEST(SurfaceSolver, PeriodicBoxWithoutReactionWithTheFarFieldInterpolated) {
   // The bordered system (λ, α) through the interpolated S̃ and the exact S: the same answer as the
   // exact assembly.
-  auto p = small_problem(0.3, 48);
-  p.boundary = fictus::Boundary::periodic;
-  p.c = 0;
-  p.f = [](double, double, double) { return -1.0; };
+  const fictus::SurfaceProblem p = periodic_without_reaction(0.3, 48);
   fictus::SolverOptions o;
   o.variant = fictus::Variant::nonsmooth;
   o.threads = 2;
