@@ -131,6 +131,7 @@ void print_progress_lines(fictus::FictitiousDomainSolver& solver) {
 int run_solve_surface(const std::string& text, const SolveCommand& command) {
   if (!command.parameters.empty()) throw std::invalid_argument("--parameter: 3-D problem files have no [parameters]");
   fictus::SurfaceProblemSpec spec = fictus::parse_surface_problem_text(text, command.problem_path);
+  for (const std::string& w : spec.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
   std::string name = command.problem_path.substr(command.problem_path.find_last_of('/') + 1);
   spec.name = name.substr(0, name.rfind(".toml"));
   if (command.flags.given("box"))

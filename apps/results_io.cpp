@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <variant>
 
+#include "fictus/mesh_surface.hpp"
 #include "fictus/options.hpp"
 
 namespace fictus::cli {
@@ -255,6 +256,12 @@ json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& s) 
                   {"c", spec.problem.c}};
   j["grid"] = {{"N", s.grid.nx()}, {"Ny", s.grid.ny()},           {"Nz", s.grid.nz()},
                {"h", s.grid.h()},  {"n_nodes", s.grid.n_nodes()}, {"n_unknowns", s.grid.n_unknowns()}};
+  if (const auto* mesh = dynamic_cast<const MeshSurface*>(spec.problem.gamma.get()))
+    j["mesh"] = {{"vertices", mesh->mesh_vertices()},
+                 {"faces", mesh->mesh_faces()},
+                 {"resolution", mesh->resolution()},
+                 {"spacing", mesh->spacing()},
+                 {"warnings", spec.warnings}};
   j["multipliers"] = s.gamma.m;
   double area = 0;
   for (double a : s.gamma.area) area += a;

@@ -1,4 +1,4 @@
-// fictus.SurfaceProblem and fictus.SurfaceSolution: 3-D problems (a sphere or an ellipsoid in a box)
+// fictus.SurfaceProblem and fictus.SurfaceSolution: 3-D problems (a closed surface in a box)
 // from a dict or TOML text, through the CLI's reader; û as an (N+1)³ numpy array and the per-patch
 // quantities on γ.
 #include <pybind11/numpy.h>
@@ -6,12 +6,14 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <stdexcept>
 
 #include "bindings.hpp"
 #include "fictus/io/problem_file.hpp"
 #include "fictus/io/process.hpp"
+#include "fictus/mesh_surface.hpp"
 #include "fictus/surface_solver.hpp"
 #include "python_problem.hpp"
 
@@ -20,6 +22,32 @@ namespace py = pybind11;
 namespace fictus::python {
 
 namespace {
+
+/// A MeshSurface from a float array (n, 3) of vertices and an integer array (k, 3) of triangles.
+std::shared_ptr<const Surface> mesh_from_arrays(py::handle vertices, py::handle faces, double resolution) {
+  const auto v = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(vertices);
+  if (!v || v.ndim() != 2 || v.shape(1) != 3)
+    throw std::invalid_argument("geometry.vertices: expected an (n, 3) array");
+  const auto f = py::array_t<long long, py::array::c_style>::ensure(faces);
+  if (!f || f.ndim() != 2 || f.shape(1) != 3)
+    throw std::invalid_argument("geometry.faces: expected a (k, 3) array of vertex indices");
+  if (resolution != std::floor(resolution) || !(resolution >= 0 && resolution <= max_mesh_resolution))
+    throw std::invalid_argument("geometry.resolution: expected 0 (automatic) or a whole number in [16, 512]");
+  PolygonSoup soup;
+  for (py::ssize_t i = 0; i < v.shape(0); ++i) soup.vertices.push_back({v.at(i, 0), v.at(i, 1), v.at(i, 2)});
+  for (py::ssize_t i = 0; i < f.shape(0); ++i) {
+    std::vector<std::size_t> face;
+    for (int k = 0; k < 3; ++k) {
+      const long long index = f.at(i, k);
+      if (index < 0 || index >= (long long)soup.vertices.size())
+        throw std::invalid_argument("geometry.faces: vertex index " + std::to_string(index) + " out of range");
+      face.push_back(std::size_t(index));
+    }
+    soup.faces.push_back(std::move(face));
+  }
+  py::gil_scoped_release release;
+  return std::make_shared<MeshSurface>(soup, int(resolution), "geometry.vertices");
+}
 
 struct PySurfaceProblem {
   SurfaceProblemSpec spec;
@@ -42,8 +70,28 @@ struct PySurfaceProblem {
         if (!py::isinstance<py::str>(v) && py::isinstance<py::function>(v))
           throw std::invalid_argument("data." + std::string(py::str(k)) +
                                       ": 3-D data are expressions in x, y, z (str); callables are 2-D only");
+    // A mesh from numpy arrays: geometry.vertices (n, 3) and geometry.faces (k, 3), built here and
+    // handed to the reader as the surface of shape = "mesh".
+    std::shared_ptr<const Surface> mesh;
+    if (sections.contains("geometry")) {
+      py::dict geometry = sections["geometry"];
+      if (geometry.contains("vertices") || geometry.contains("faces")) {
+        if (!geometry.contains("vertices") || !geometry.contains("faces"))
+          throw std::invalid_argument("geometry.faces: vertices and faces come together");
+        if (geometry.contains("file"))
+          throw std::invalid_argument("geometry.file: a file or vertices and faces, not both");
+        mesh = mesh_from_arrays(geometry["vertices"], geometry["faces"],
+                                geometry.contains("resolution") ? geometry["resolution"].cast<double>() : 0.0);
+        py::dict rest;
+        for (auto [k, v] : geometry)
+          if (std::string(py::str(k)) != "vertices" && std::string(py::str(k)) != "faces") rest[k] = v;
+        sections["geometry"] = rest;
+      }
+    }
     PySurfaceProblem p;
-    p.spec = parse_surface_problem_text(toml_text(sections), "problem");
+    p.spec = parse_surface_problem_text(toml_text(sections), "problem", mesh);
+    if (const auto* surface = dynamic_cast<const MeshSurface*>(mesh.get()))
+      for (const std::string& w : surface->warnings()) p.spec.warnings.push_back("geometry.vertices: " + w);
     return p;
   }
 };
@@ -86,11 +134,13 @@ const SurfaceSolution& of(py::handle self) { return *self.cast<const PySurfaceSo
 }  // namespace
 
 void bind_surface(py::module_& m) {
-  py::class_<PySurfaceProblem>(m, "SurfaceProblem", R"doc(A 3-D Signorini problem: a sphere or an ellipsoid in a box.
+  py::class_<PySurfaceProblem>(m, "SurfaceProblem", R"doc(A 3-D Signorini problem: a closed surface in a box.
 
     SurfaceProblem(domain=..., geometry=..., formulation=..., data=..., solver=...)
         Sections as dicts with the keys of a 3-D problem file (docs/problem_files.md, "3-D problems");
-        domain.dim = 3 is implied. f, g, exact: expressions in x, y, z (str).
+        domain.dim = 3 is implied. f, g, exact: expressions in x, y, z (str). A mesh: geometry =
+        {"shape": "mesh", "file": path} or {"shape": "mesh", "vertices": (n, 3) array, "faces": (k, 3)
+        integer array}, optional "resolution".
     SurfaceProblem.from_dict(d), SurfaceProblem.from_toml(text)
 )doc")
       .def(py::init([](py::kwargs kwargs) { return PySurfaceProblem::from_config(kwargs); }))
@@ -101,6 +151,9 @@ void bind_surface(py::module_& m) {
           [](const std::string& text) { return PySurfaceProblem{parse_surface_problem_text(text, "problem")}; },
           py::arg("text"))
       .def_property_readonly("N", [](const PySurfaceProblem& p) { return p.spec.problem.N; })
+      .def_property_readonly(
+          "warnings", [](const PySurfaceProblem& p) { return p.spec.warnings; },
+          "What the reader changed (e.g. a mesh oriented inward, reoriented).")
       .def("solve", &solve,
            "Solves (the GIL is released meanwhile) and returns a SurfaceSolution; raises ValueError on bad input "
            "and RuntimeError when Newton does not converge, with the CLI's messages.");

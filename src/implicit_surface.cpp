@@ -29,7 +29,8 @@ constexpr int tetrahedra[6][4] = {{0, 1, 3, 7}, {0, 3, 2, 7}, {0, 2, 6, 7}, {0, 
 
 }  // namespace
 
-ImplicitSurface::ImplicitSurface(ScalarField3 level, Box3 bounds) : level_(std::move(level)), bounds_(bounds) {
+ImplicitSurface::ImplicitSurface(ScalarField3 level, Box3 bounds, GradientField3 gradient, HessianField3 hessian)
+    : level_(std::move(level)), gradient_(std::move(gradient)), hessian_(std::move(hessian)), bounds_(bounds) {
   if (!level_) throw std::invalid_argument("geometry.level: not given");
   for (int d = 0; d < 3; ++d)
     if (!std::isfinite(bounds.lower[d]) || !std::isfinite(bounds.upper[d]) || !(bounds.upper[d] > bounds.lower[d]) ||
@@ -99,6 +100,7 @@ ImplicitSurface::ImplicitSurface(ScalarField3 level, Box3 bounds) : level_(std::
 double ImplicitSurface::level(const Point3& p) const { return level_(p.x, p.y, p.z); }
 
 Point3 ImplicitSurface::level_gradient(const Point3& p) const {
+  if (gradient_) return gradient_(p.x, p.y, p.z);
   const double step = 1e-5 * scale_;
   Point3 g;
   for (int d = 0; d < 3; ++d) {
@@ -111,6 +113,7 @@ Point3 ImplicitSurface::level_gradient(const Point3& p) const {
 }
 
 Matrix3 ImplicitSurface::level_hessian(const Point3& p) const {
+  if (hessian_) return hessian_(p);
   const double step = 1e-4 * scale_;
   const auto shifted = [&](int d, double a, int e, double b) {
     Point3 q = p;

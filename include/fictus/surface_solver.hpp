@@ -84,15 +84,18 @@ class Torus final : public Surface {
   double R_, r_;
 };
 
+using HessianField3 = std::function<Matrix3(const Point3& p)>;
+
 /// level(x) < 0 in ω, any smooth function with a nonzero gradient on its zero set, inside a box that
 /// holds γ: triangulated by marching tetrahedra on a lattice of cubes of side `edge` (the crossings on the
-/// tetrahedra's edges by root finding), split into patches as the built-in shapes are. Derivatives by
-/// central differences (steps 1e-5 and 1e-4 of the largest side of γ's box).
+/// tetrahedra's edges by root finding), split into patches as the built-in shapes are. Derivatives from
+/// `gradient` and `hessian` when given, else by central differences (steps 1e-5 and 1e-4 of the
+/// largest side of γ's box).
 class ImplicitSurface final : public Surface {
  public:
   /// Throws std::invalid_argument naming geometry.bounds (not a box, or γ reaches its faces) or
   /// geometry.level (not finite, no surface inside the box, or a vanishing gradient on γ).
-  ImplicitSurface(ScalarField3 level, Box3 bounds);
+  ImplicitSurface(ScalarField3 level, Box3 bounds, GradientField3 gradient = {}, HessianField3 hessian = {});
   double level(const Point3& p) const override;
   Point3 level_gradient(const Point3& p) const override;
   Matrix3 level_hessian(const Point3& p) const override;
@@ -108,6 +111,8 @@ class ImplicitSurface final : public Surface {
  private:
   std::vector<Triangle3> triangulate(const Box3& box, double edge) const;
   ScalarField3 level_;
+  GradientField3 gradient_;
+  HessianField3 hessian_;
   Box3 bounds_, tight_;
   double scale_ = 1, area_ = 0, reach_ = 0;
 };

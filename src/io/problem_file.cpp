@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "fictus/io/expression.hpp"
+#include "fictus/mesh_surface.hpp"
 #include "fictus/options.hpp"
 #include "fictus/shapes.hpp"
 #include "fictus/surface_solver.hpp"
@@ -275,7 +276,8 @@ int problem_dimension(const std::string& text, const std::string& source) {
   return int(*value);
 }
 
-SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std::string& source) {
+SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std::string& source,
+                                              std::shared_ptr<const Surface> mesh) {
   const toml::table root = parse_toml(text, source);
   for (const auto& [k, v] : root) {
     const std::string name(k.str());
@@ -317,9 +319,33 @@ SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std
         },
         Box3{{b[0], b[1], b[2]}, {b[3], b[4], b[5]}});
   }
-  const auto center = shape == "implicit" ? std::vector<double>(3, 0.0) : geometry.required_numbers("center", 3);
+  if (shape == "mesh") {
+    const double resolution = geometry.number("resolution", automatic_mesh_resolution);
+    if (resolution != std::floor(resolution) ||
+        (resolution != automatic_mesh_resolution &&
+         (resolution < min_mesh_resolution || resolution > max_mesh_resolution)))
+      fail("geometry.resolution", "expected 0 (automatic) or a whole number of lattice cells, " +
+                                      std::to_string(min_mesh_resolution) +
+                                      " <= resolution <= " + std::to_string(max_mesh_resolution));
+    if (geometry.has("file")) {
+      std::filesystem::path file = geometry.string("file", "");
+      std::error_code error;
+      if (file.is_relative() && std::filesystem::is_regular_file(source, error))
+        file = std::filesystem::path(source).parent_path() / file;
+      const auto surface = std::make_shared<MeshSurface>(read_polygon_soup(file.string(), "geometry.file"),
+                                                         int(resolution), "geometry.file");
+      for (const std::string& w : surface->warnings()) spec.warnings.push_back("geometry.file: " + w);
+      p.gamma = surface;
+    } else if (mesh) {
+      p.gamma = std::move(mesh);
+    } else {
+      fail("geometry.file", "missing (a .off, .stl, .obj or .ply file)");
+    }
+  }
+  const bool centered = shape != "implicit" && shape != "mesh";
+  const auto center = centered ? geometry.required_numbers("center", 3) : std::vector<double>(3, 0.0);
   Point3 axes;
-  if (shape == "implicit") {
+  if (!centered) {
   } else if (shape == "torus") {
     if (!geometry.has("major_radius")) fail("geometry.major_radius", "missing");
     if (!geometry.has("minor_radius")) fail("geometry.minor_radius", "missing");
@@ -335,7 +361,8 @@ SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std
     const auto a = geometry.required_numbers("semi_axes", 3);
     axes = {a[0], a[1], a[2]};
   } else {
-    fail("geometry.shape", "unknown 3-D shape \"" + shape.substr(0, 40) + "\" (sphere, ellipsoid, torus, implicit)");
+    fail("geometry.shape",
+         "unknown 3-D shape \"" + shape.substr(0, 40) + "\" (sphere, ellipsoid, torus, implicit, mesh)");
   }
   if (shape == "sphere" || shape == "ellipsoid")
     p.gamma = std::make_shared<Ellipsoid>(Point3{center[0], center[1], center[2]}, axes);

@@ -55,11 +55,15 @@ struct SurfaceProblemSpec {
   SurfaceProblem problem;
   SolverOptions options;
   OutputOptions output;
-  std::string name;        // the file's name without .toml
-  std::string input_json;  // [geometry] and [data] as JSON (results.json echoes it)
+  std::string name;                   // the file's name without .toml
+  std::string input_json;             // [geometry] and [data] as JSON (results.json echoes it)
+  std::vector<std::string> warnings;  // e.g. a mesh that was reoriented
 };
-/// Reads and checks one; errors as read_problem_file's, naming the key.
-SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std::string& source = "problem");
+/// Reads and checks one; errors as read_problem_file's, naming the key. A mesh's `geometry.file` is
+/// relative to the folder of `source` when that names a file, else to the working folder. `mesh`:
+/// the surface for shape = "mesh" without a file (vertices and faces given by a caller).
+SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std::string& source = "problem",
+                                              std::shared_ptr<const Surface> mesh = nullptr);
 /// The names a 3-D problem's `[output] files` accepts.
 const std::vector<std::string>& surface_output_file_names();
 

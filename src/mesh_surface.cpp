@@ -1,0 +1,287 @@
+// Surfaces from triangle meshes: reading, checks and the signed distance by CGAL, then the lattice
+// spline (lattice_spline.cpp). The only translation unit that includes CGAL: it is compiled with
+// CGAL's flags (-frounding-math) apart from the numerics.
+#include <CGAL/AABB_face_graph_triangle_primitive.h>
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/IO/polygon_soup_io.h>
+#include <CGAL/Polygon_mesh_processing/measure.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_faces.h>
+#include <CGAL/Side_of_triangle_mesh.h>
+#include <CGAL/Surface_mesh.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <iterator>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "fictus/mesh_surface.hpp"
+
+namespace fictus {
+
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using CgalPoint = Kernel::Point_3;
+using TriangleMeshCgal = CGAL::Surface_mesh<CgalPoint>;
+using Primitive = CGAL::AABB_face_graph_triangle_primitive<TriangleMeshCgal>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+using Side = CGAL::Side_of_triangle_mesh<TriangleMeshCgal, Kernel>;
+namespace PMP = CGAL::Polygon_mesh_processing;
+
+/// Coordinates beyond this are refused: squared distances must stay finite.
+constexpr double largest_coordinate = 1e100;
+
+std::string at(const CgalPoint& p) {
+  char buffer[96];
+  std::snprintf(buffer, sizeof buffer, "(%.4g, %.4g, %.4g)", p.x(), p.y(), p.z());
+  return buffer;
+}
+
+[[noreturn]] void fail(const std::string& field, const std::string& what) {
+  throw std::invalid_argument(field + ": " + what);
+}
+
+std::string extension_of(const std::string& path) {
+  std::string e = std::filesystem::path(path).extension().string();
+  for (char& c : e) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return e;
+}
+
+}  // namespace
+
+struct MeshSurface::Mesh {
+  TriangleMeshCgal mesh;
+  Tree tree;
+};
+
+PolygonSoup read_polygon_soup(const std::string& path, const std::string& field) {
+  const std::string e = extension_of(path);
+  if (e != ".off" && e != ".stl" && e != ".obj" && e != ".ply")
+    fail(field, "'" + path + "': expected a .off, .stl, .obj or .ply file");
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) fail(field, "'" + path + "': no such file");
+  std::vector<CgalPoint> points;
+  std::vector<std::vector<std::size_t>> faces;
+  bool read = false;
+  try {
+    read = CGAL::IO::read_polygon_soup(path, points, faces, CGAL::parameters::verbose(false));
+  } catch (const std::exception&) {
+    read = false;
+  }
+  if (!read) fail(field, "'" + path + "': not a readable " + e.substr(1) + " surface mesh");
+  if (faces.empty()) fail(field, "'" + path + "': no faces");
+  PolygonSoup soup;
+  soup.vertices.reserve(points.size());
+  for (const CgalPoint& p : points) soup.vertices.push_back({p.x(), p.y(), p.z()});
+  soup.faces = std::move(faces);
+  return soup;
+}
+
+void write_off(const std::string& path, const PolygonSoup& soup) {
+  std::vector<CgalPoint> points;
+  for (const Point3& v : soup.vertices) points.emplace_back(v.x, v.y, v.z);
+  if (!CGAL::IO::write_OFF(path, points, soup.faces, CGAL::parameters::stream_precision(17)))
+    throw std::runtime_error("cannot write " + path);
+}
+
+MeshSurface::~MeshSurface() = default;
+
+MeshSurface::MeshSurface(const PolygonSoup& soup, int resolution, const std::string& field) {
+  if (resolution != automatic_mesh_resolution && (resolution < min_mesh_resolution || resolution > max_mesh_resolution))
+    fail("geometry.resolution", "expected 0 (automatic) or " + std::to_string(min_mesh_resolution) +
+                                    " <= resolution <= " + std::to_string(max_mesh_resolution) +
+                                    " lattice cells across the mesh");
+  if (soup.faces.empty()) fail(field, "the mesh has no faces");
+  std::vector<CgalPoint> points;
+  points.reserve(soup.vertices.size());
+  for (const Point3& v : soup.vertices) {
+    for (int d = 0; d < 3; ++d)
+      if (!(std::abs(v[d]) <= largest_coordinate))
+        fail(field, "a vertex coordinate is not finite or beyond 1e100 in size");
+    points.emplace_back(v.x, v.y, v.z);
+  }
+  std::vector<std::vector<std::size_t>> polygons = soup.faces;
+  for (const auto& face : polygons) {
+    if (face.size() < 3) fail(field, "a face has fewer than three vertices");
+    for (std::size_t index : face)
+      if (index >= points.size())
+        fail(field, "a face refers to vertex " + std::to_string(index) + " of " + std::to_string(points.size()));
+  }
+
+  // Merge the duplicate points of STL-like files, drop degenerate and repeated faces, then orient
+  // the faces consistently: false when some edge has more than two faces, or a vertex joins sheets
+  // that meet only there.
+  PMP::repair_polygon_soup(points, polygons, CGAL::parameters::erase_all_duplicates(true));
+  if (polygons.empty()) fail(field, "every face of the mesh is degenerate");
+  if (!PMP::orient_polygon_soup(points, polygons))
+    fail(field,
+         "the mesh is not a manifold surface: an edge with more than two faces, a vertex where separate "
+         "sheets meet, or faces that cannot be oriented consistently");
+  auto mesh = std::make_unique<Mesh>();
+  TriangleMeshCgal& m = mesh->mesh;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, m);
+  if (!CGAL::is_triangle_mesh(m) && !PMP::triangulate_faces(m)) fail(field, "a face could not be triangulated");
+  for (auto h : halfedges(m))
+    if (is_border(h, m))
+      fail(field, "the mesh is not closed: it has a hole (an edge with one face) at " + at(m.point(source(h, m))));
+  std::vector<std::pair<TriangleMeshCgal::Face_index, TriangleMeshCgal::Face_index>> crossing;
+  PMP::self_intersections(m, std::back_inserter(crossing));  // all pairs: checks stay O(n log n)
+  if (!crossing.empty()) {
+    const auto h = halfedge(crossing.front().first, m);
+    fail(field, "the mesh intersects itself (" + std::to_string(crossing.size()) + " pairs of faces), near " +
+                    at(m.point(target(h, m))));
+  }
+  const double before = PMP::volume(m);  // signed: positive for outward faces
+  PMP::orient_to_bound_a_volume(m);
+  const double volume = PMP::volume(m);
+  if (!(volume > 0)) fail(field, "the mesh encloses no volume");
+  if (before < volume * (1 - 1e-12))
+    warnings_.push_back(before <= -volume * (1 - 1e-12)
+                            ? "the mesh's faces pointed inward: reoriented outward"
+                            : "some components of the mesh were oriented inward: reoriented to bound a volume");
+  vertices_ = num_vertices(m);
+  faces_ = num_faces(m);
+
+  mesh->tree.insert(faces(m).first, faces(m).second, m);
+  mesh->tree.build();
+  mesh->tree.accelerate_distance_queries();
+  Side side(m);  // ray casting with exact predicates (its own tree)
+
+  // The lattice: `resolution` cells across the mesh's largest side, a margin of 8 cells around it.
+  const CGAL::Bbox_3 box = PMP::bbox(m);
+  const double largest = std::max({box.xmax() - box.xmin(), box.ymax() - box.ymin(), box.zmax() - box.zmin()});
+  if (!(largest > 0)) fail(field, "the mesh is flat");
+  if (resolution == automatic_mesh_resolution) {
+    std::vector<double> lengths;
+    lengths.reserve(num_edges(m));
+    for (auto e : edges(m)) lengths.push_back(PMP::edge_length(e, m));
+    std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2), lengths.end());
+    const double median = lengths[lengths.size() / 2];
+    resolution = int(
+        std::clamp(std::round(largest / (2 * median)), double(min_mesh_resolution), double(default_mesh_resolution)));
+  }
+  resolution_ = resolution;
+  const double spacing = largest / resolution;
+  constexpr int margin = 8;
+  const int n = resolution + 2 * margin;
+  const Point3 center{(box.xmin() + box.xmax()) / 2, (box.ymin() + box.ymax()) / 2, (box.zmin() + box.zmax()) / 2};
+  const Point3 lower = center - (0.5 * n * spacing) * Point3{1, 1, 1};
+  const std::size_t side_nodes = std::size_t(n) + 1, nodes = side_nodes * side_nodes * side_nodes;
+  const auto node = [&](std::size_t i, std::size_t j, std::size_t k) {
+    return CgalPoint(lower.x + double(i) * spacing, lower.y + double(j) * spacing, lower.z + double(k) * spacing);
+  };
+  const auto index = [&](std::size_t i, std::size_t j, std::size_t k) { return (k * side_nodes + j) * side_nodes + i; };
+
+  // Exact distances by the AABB tree in a band of 3ℓ around the faces (the nodes in each face's box
+  // grown by the band), the nearest points of the others by closest-point sweeps from the band.
+  constexpr double band = 3;
+  std::vector<std::uint8_t> in_band(nodes, 0);
+  for (auto f : faces(m)) {
+    std::array<double, 3> lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                             std::numeric_limits<double>::infinity()};
+    std::array<double, 3> hi{-lo[0], -lo[1], -lo[2]};
+    for (auto v : vertices_around_face(halfedge(f, m), m))
+      for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], m.point(v)[d]), hi[d] = std::max(hi[d], m.point(v)[d]);
+    std::array<std::size_t, 3> first, last;
+    for (int d = 0; d < 3; ++d) {
+      first[d] = std::size_t(std::max(0.0, std::ceil((lo[d] - band * spacing - lower[d]) / spacing)));
+      last[d] = std::size_t(std::min(double(n), std::floor((hi[d] + band * spacing - lower[d]) / spacing)));
+    }
+    for (std::size_t k = first[2]; k <= last[2]; ++k)
+      for (std::size_t j = first[1]; j <= last[1]; ++j)
+        for (std::size_t i = first[0]; i <= last[0]; ++i) in_band[index(i, j, k)] = 1;
+  }
+  std::vector<std::size_t> band_nodes;
+  for (std::size_t q = 0; q < nodes; ++q)
+    if (in_band[q]) band_nodes.push_back(q);
+  std::vector<double> distance(nodes, std::numeric_limits<double>::infinity());
+  std::vector<std::array<float, 3>> nearest(nodes, {NAN, NAN, NAN});
+  const auto coordinates = [&](std::size_t q) {
+    return std::array<std::size_t, 3>{q % side_nodes, (q / side_nodes) % side_nodes, q / (side_nodes * side_nodes)};
+  };
+  (void)mesh->tree.closest_point(node(0, 0, 0));  // any lazy set-up happens here, before the threads
+  (void)side(node(0, 0, 0));
+#pragma omp parallel for schedule(dynamic, 256)
+  for (std::size_t b = 0; b < band_nodes.size(); ++b) {
+    const std::size_t q = band_nodes[b];
+    const auto [i, j, k] = coordinates(q);
+    const CgalPoint p = node(i, j, k);
+    const CgalPoint c = mesh->tree.closest_point(p);
+    distance[q] = std::sqrt(CGAL::squared_distance(p, c));
+    nearest[q] = {float(c.x()), float(c.y()), float(c.z())};
+  }
+  // Sweeps in the eight diagonal orders, twice: each node away from the band tries the nearest
+  // points of its three upwind neighbours.
+  for (int round = 0; round < 2; ++round)
+    for (int order = 0; order < 8; ++order) {
+      const int step[3] = {order & 1 ? -1 : 1, order & 2 ? -1 : 1, order & 4 ? -1 : 1};
+      for (std::size_t kk = 0; kk < side_nodes; ++kk)
+        for (std::size_t jj = 0; jj < side_nodes; ++jj)
+          for (std::size_t ii = 0; ii < side_nodes; ++ii) {
+            const std::size_t i = step[0] > 0 ? ii : n - ii, j = step[1] > 0 ? jj : n - jj,
+                              k = step[2] > 0 ? kk : n - kk;
+            const std::size_t q = index(i, j, k);
+            if (in_band[q]) continue;
+            const std::array<std::size_t, 3> here{i, j, k};
+            const Point3 x{lower.x + double(i) * spacing, lower.y + double(j) * spacing, lower.z + double(k) * spacing};
+            for (int d = 0; d < 3; ++d) {
+              if ((step[d] > 0 && here[d] == 0) || (step[d] < 0 && here[d] == std::size_t(n))) continue;
+              std::array<std::size_t, 3> from = here;
+              from[d] = step[d] > 0 ? from[d] - 1 : from[d] + 1;
+              const auto& c = nearest[index(from[0], from[1], from[2])];
+              if (std::isnan(c[0])) continue;
+              const double candidate = norm(x - Point3{double(c[0]), double(c[1]), double(c[2])});
+              if (candidate < distance[q]) distance[q] = candidate, nearest[q] = c;
+            }
+          }
+    }
+  std::vector<std::array<float, 3>>().swap(nearest);
+  std::atomic<bool> unreached = false;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::size_t k = 0; k < side_nodes; ++k)
+    for (std::size_t j = 0; j < side_nodes; ++j)
+      for (std::size_t i = 0; i < side_nodes; ++i) {
+        const std::size_t q = index(i, j, k);
+        if (!std::isfinite(distance[q])) unreached = true;
+        if (side(node(i, j, k)) == CGAL::ON_BOUNDED_SIDE) distance[q] = -distance[q];
+      }
+  if (unreached) throw std::logic_error("MeshSurface: a lattice node without a nearest point");
+  spline_ = std::make_shared<const LatticeSpline>(lower, spacing, n, std::move(distance));
+  mesh_ = std::move(mesh);
+
+  const std::shared_ptr<const LatticeSpline> spline = spline_;
+  implicit_ = std::make_unique<ImplicitSurface>(
+      [spline](double x, double y, double z) {
+        return spline->value({x, y, z});
+      },
+      spline->box(),
+      [spline](double x, double y, double z) {
+        return spline->gradient({x, y, z});
+      },
+      [spline](const Point3& p) { return spline->hessian(p); });
+}
+
+double MeshSurface::distance_to_mesh(const Point3& p) const {
+  const CgalPoint q(p.x, p.y, p.z);
+  return std::sqrt(CGAL::squared_distance(q, mesh_->tree.closest_point(q)));
+}
+
+}  // namespace fictus
