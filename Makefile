@@ -45,11 +45,13 @@ sanitize: deps
 	cmake --build $(SANITIZE_DIR) -j $(JOBS)
 	cd $(SANITIZE_DIR) && ctest --output-on-failure -LE 'slow|convergence|regression' -E 'style|docs|plot' -j $(JOBS)
 
-# Ten minutes of the mutation fuzzer on the Release build (FUZZ_ARGS: e.g. --minutes 2 --seed 7);
+# Ten minutes of the mutation fuzzer on the Release build (FUZZ_ARGS: e.g. --minutes 2 --seed 7), then
+# 2000 mutants of surface-mesh files (tests/fuzz/fuzz_mesh.py);
 # new outcomes grow tests/fuzz/corpus, defects go to build/fuzz-findings.
 fuzz: build
 	/usr/bin/python3 tests/fuzz/fuzz.py run $(BUILD_DIR)/apps/fictus --grow tests/fuzz/corpus \
 	  --findings $(BUILD_DIR)/fuzz-findings $(FUZZ_ARGS)
+	/usr/bin/python3 tests/fuzz/fuzz_mesh.py $(BUILD_DIR)/apps/fictus --cases 2000 --findings $(BUILD_DIR)/fuzz-findings
 
 bench: build
 	$(BUILD_DIR)/bench/fictus_bench --out bench/results $(BENCH_ARGS)

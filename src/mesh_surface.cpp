@@ -25,8 +25,10 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iterator>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -65,6 +67,46 @@ std::string extension_of(const std::string& path) {
   return e;
 }
 
+/// CGAL's PLY reader trusts the header: a `property` before any `element` is written out of bounds.
+/// So the header is checked first: `ply`, a format line, every property after an element, vertex and
+/// face elements, and `end_header`, within 64 KiB. Returns what is wrong, or "" when it is sound.
+std::string ply_header_problem(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) return "it does not start with 'ply'";
+  bool format = false, element = false, vertex = false, face = false;
+  std::size_t read = line.size();
+  while (std::getline(in, line)) {
+    read += line.size() + 1;
+    if (read > (64u << 10)) return "its header is longer than 64 KiB";
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream words(line);
+    std::string word, name;
+    words >> word;
+    if (word == "format") {
+      std::string kind;
+      words >> kind;
+      if (kind != "ascii" && kind != "binary_little_endian" && kind != "binary_big_endian")
+        return "an unknown format in its header";
+      format = true;
+    } else if (word == "element") {
+      words >> name;
+      element = true;
+      vertex = vertex || name == "vertex";
+      face = face || name == "face";
+    } else if (word == "property") {
+      if (!element) return "a property before any element in its header";
+    } else if (word == "end_header") {
+      if (!format) return "no format line in its header";
+      if (!vertex || !face) return "no vertex or no face element in its header";
+      return "";
+    } else if (word != "comment" && word != "obj_info" && !word.empty()) {
+      return "an unknown line in its header";
+    }
+  }
+  return "no end_header";
+}
+
 }  // namespace
 
 struct MeshSurface::Mesh {
@@ -78,6 +120,10 @@ PolygonSoup read_polygon_soup(const std::string& path, const std::string& field)
     fail(field, "'" + path + "': expected a .off, .stl, .obj or .ply file");
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) fail(field, "'" + path + "': no such file");
+  if (e == ".ply") {
+    const std::string problem = ply_header_problem(path);
+    if (!problem.empty()) fail(field, "'" + path + "': not a readable ply surface mesh (" + problem + ")");
+  }
   std::vector<CgalPoint> points;
   std::vector<std::vector<std::size_t>> faces;
   bool read = false;

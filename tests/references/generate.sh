@@ -33,11 +33,11 @@ done
 # elements fitted exactly to the ellipsoid (see the comments at the top of
 # signorini3d.edp).  Not run by default; regenerate with
 #   GEN3D=1 ./generate.sh
-# The levels are m = 4,6,8,12 cells per half axis of the reference cube
-# (about 20 minutes of CPU on one core, under 2 GiB); add 16 with
-# -levels 4,6,8,12,16 for one more level (several times longer).
+# The levels are m = 4,6,8 cells per half axis of the reference cube
+# (about 4 minutes of CPU on one core, under 1 GiB).  m = 12 (117649 dofs)
+# fails: UMFPACK returns a zero solution (the script stops there).
 if [ "${GEN3D:-0}" = 1 ]; then
   echo "== ellipsoid3d (log: $LOGDIR/ellipsoid3d.log)"
-  FreeFem++ -nw -v 0 signorini3d.edp -levels 4,6,8,12 -out ellipsoid3d.json -pkg "$pkg" > "$LOGDIR/ellipsoid3d.log" 2>&1
+  FreeFem++ -nw -v 0 signorini3d.edp -levels 4,6,8 -out ellipsoid3d.json -pkg "$pkg" > "$LOGDIR/ellipsoid3d.log" 2>&1
   grep -E '^LEVEL' "$LOGDIR/ellipsoid3d.log"
 fi
