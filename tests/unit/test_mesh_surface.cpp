@@ -174,6 +174,13 @@ TEST_F(MeshFiles, BadFilesGiveOneLineErrors) {
       std::string::npos);
   EXPECT_NE(error_of([&] { fictus::read_polygon_soup(write("e.obj", "v 0 0 0\nv 1 0 0\n")); }).find("geometry.file"),
             std::string::npos);
+  // CGAL's PLY reader would write out of bounds for a property before any element: checked first.
+  EXPECT_NE(error_of([&] {
+              fictus::read_polygon_soup(write("p.ply",
+                                              "ply\nformat ascii 1.0\nproperty double x\nelement face 1\n"
+                                              "property list uchar int vertex_indices\nend_header\n3 0 1 2\n"));
+            }).find("a property before any element"),
+            std::string::npos);
   std::filesystem::create_directories(path("folder.off"));
   EXPECT_NE(error_of([&] { fictus::read_polygon_soup(path("folder.off")); }).find("no such file"), std::string::npos);
 }
