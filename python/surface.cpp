@@ -28,11 +28,14 @@ std::shared_ptr<const Surface> mesh_from_arrays(py::handle vertices, py::handle 
   const auto v = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(vertices);
   if (!v || v.ndim() != 2 || v.shape(1) != 3)
     throw std::invalid_argument("geometry.vertices: expected an (n, 3) array");
-  const auto f = py::array_t<long long, py::array::c_style>::ensure(faces);
+  const py::array given = py::array::ensure(faces);
+  if (given && given.dtype().kind() != 'i' && given.dtype().kind() != 'u')
+    throw std::invalid_argument("geometry.faces: expected integer vertex indices, got " +
+                                std::string(py::str(given.dtype())));
+  const auto f = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(faces);
   if (!f || f.ndim() != 2 || f.shape(1) != 3)
     throw std::invalid_argument("geometry.faces: expected a (k, 3) array of vertex indices");
-  if (resolution != std::floor(resolution) || !(resolution >= 0 && resolution <= max_mesh_resolution))
-    throw std::invalid_argument("geometry.resolution: expected 0 (automatic) or a whole number in [16, 512]");
+  check_mesh_resolution(resolution);
   PolygonSoup soup;
   for (py::ssize_t i = 0; i < v.shape(0); ++i) soup.vertices.push_back({v.at(i, 0), v.at(i, 1), v.at(i, 2)});
   for (py::ssize_t i = 0; i < f.shape(0); ++i) {
@@ -80,8 +83,15 @@ struct PySurfaceProblem {
           throw std::invalid_argument("geometry.faces: vertices and faces come together");
         if (geometry.contains("file"))
           throw std::invalid_argument("geometry.file: a file or vertices and faces, not both");
-        mesh = mesh_from_arrays(geometry["vertices"], geometry["faces"],
-                                geometry.contains("resolution") ? geometry["resolution"].cast<double>() : 0.0);
+        if (!geometry.contains("shape") || std::string(py::str(geometry["shape"])) != "mesh")
+          throw std::invalid_argument("geometry.vertices: vertices and faces need shape = \"mesh\"");
+        double resolution = 0;
+        if (geometry.contains("resolution")) {
+          if (!py::isinstance<py::int_>(geometry["resolution"]) && !py::isinstance<py::float_>(geometry["resolution"]))
+            throw std::invalid_argument("geometry.resolution: expected a number");
+          resolution = geometry["resolution"].cast<double>();
+        }
+        mesh = mesh_from_arrays(geometry["vertices"], geometry["faces"], resolution);
         py::dict rest;
         for (auto [k, v] : geometry)
           if (std::string(py::str(k)) != "vertices" && std::string(py::str(k)) != "faces") rest[k] = v;
@@ -103,10 +113,20 @@ struct PySurfaceSolution {
 
 PySurfaceSolution solve(const PySurfaceProblem& p) {
   std::shared_ptr<const SurfaceSolution> solution;
-  {
+  try {
+    // Ctrl-C: Python's handler runs in PyErr_CheckSignals (this thread, under the GIL) and leaves
+    // KeyboardInterrupt set; the solve stops at its next check.
+    const auto interrupt = [] {
+      py::gil_scoped_acquire gil;
+      return PyErr_CheckSignals() != 0;
+    };
     py::gil_scoped_release release;
-    solution = std::make_shared<const SurfaceSolution>(fictus::solve(p.spec.problem, p.spec.options));
+    solution = std::make_shared<const SurfaceSolution>(fictus::solve(p.spec.problem, p.spec.options, {}, interrupt));
+  } catch (const Interrupted&) {
+    if (!PyErr_Occurred()) PyErr_SetNone(PyExc_KeyboardInterrupt);
+    throw py::error_already_set();
   }
+  if (PyErr_Occurred()) throw py::error_already_set();  // a signal seen after the last check
   std::const_pointer_cast<SurfaceSolution>(solution)->peak_memory_bytes = peak_memory_bytes();
   if (!solution->newton.converged)
     throw std::runtime_error("solver.max_newton: Newton did not converge: " + solution->newton.failure);

@@ -2,6 +2,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <utility>
@@ -77,6 +78,12 @@ Box3 LatticeSpline::box() const {
 double LatticeSpline::evaluate(const Point3& p, Point3* gradient, Matrix3* hessian) const {
   // Outside the box: the value at the nearest point of the box plus the distance to it; the
   // derivatives are those of the spline there, with the outward unit vector added to the gradient.
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (gradient) *gradient = {nan, nan, nan};
+    if (hessian) *hessian = {Point3{nan, nan, nan}, Point3{nan, nan, nan}, Point3{nan, nan, nan}};
+    return nan;
+  }
   Point3 outside{0, 0, 0};
   int cell[3];
   double w[3][4], d1[3][4], d2[3][4];

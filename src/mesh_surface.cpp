@@ -16,6 +16,7 @@
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/Surface_mesh.h>
 #include <omp.h>
+#include <boost/function_output_iterator.hpp>
 
 #include <algorithm>
 #include <array>
@@ -24,6 +25,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -70,11 +72,14 @@ std::string extension_of(const std::string& path) {
 /// CGAL's PLY reader trusts the header: a `property` before any `element` is written out of bounds.
 /// So the header is checked first: `ply`, a format line, every property after an element, vertex and
 /// face elements, and `end_header`, within 64 KiB. Returns what is wrong, or "" when it is sound.
-std::string ply_header_problem(const std::string& path) {
+/// Also, since the reader sizes its arrays by the header's counts before reading them: the counts
+/// must fit in the file (at least 2 bytes a value), and list counts must be 8 or 16 bits wide.
+std::string ply_header_problem(const std::string& path, std::uintmax_t file_size) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
   if (!std::getline(in, line) || line.rfind("ply", 0) != 0) return "it does not start with 'ply'";
   bool format = false, element = false, vertex = false, face = false;
+  double values = 0, count = 0;  // the least number of values the elements need, the current element's count
   std::size_t read = line.size();
   while (std::getline(in, line)) {
     read += line.size() + 1;
@@ -90,12 +95,23 @@ std::string ply_header_problem(const std::string& path) {
         return "an unknown format in its header";
       format = true;
     } else if (word == "element") {
-      words >> name;
+      words >> name >> count;
+      if (!words || !(count >= 0)) return "an element without a count in its header";
       element = true;
       vertex = vertex || name == "vertex";
       face = face || name == "face";
     } else if (word == "property") {
       if (!element) return "a property before any element in its header";
+      std::string type, count_type;
+      words >> type;
+      if (type == "list") {
+        words >> count_type;
+        if (count_type != "uchar" && count_type != "uint8" && count_type != "char" && count_type != "int8" &&
+            count_type != "ushort" && count_type != "uint16" && count_type != "short" && count_type != "int16")
+          return "a list whose count is wider than 16 bits in its header";
+      }
+      values += count;
+      if (2 * values > double(file_size)) return "its header counts more values than the file holds";
     } else if (word == "end_header") {
       if (!format) return "no format line in its header";
       if (!vertex || !face) return "no vertex or no face element in its header";
@@ -105,6 +121,30 @@ std::string ply_header_problem(const std::string& path) {
     }
   }
   return "no end_header";
+}
+
+/// The same for OFF (vertex and face counts on the first line after the keyword) and binary STL (a
+/// triangle count at byte 80, 50 bytes a triangle).
+std::string count_problem(const std::string& path, const std::string& extension, std::uintmax_t file_size) {
+  std::ifstream in(path, std::ios::binary);
+  if (extension == ".stl") {
+    char head[84] = {};
+    in.read(head, 84);
+    if (in.gcount() < 84 || std::string(head, 5) == "solid") return "";  // ASCII: no counts
+    std::uint32_t triangles = 0;
+    std::memcpy(&triangles, head + 80, 4);
+    return 84 + 50 * std::uintmax_t(triangles) > file_size ? "its triangle count is more than the file holds" : "";
+  }
+  if (extension != ".off") return "";
+  std::string word;
+  in >> word;  // OFF, COFF, NOFF, …
+  if (word.find("OFF") == std::string::npos) return "";
+  double vertices = 0, faces = 0;
+  while (in >> std::ws && in.peek() == '#') std::getline(in, word);
+  if (!(in >> vertices >> faces)) return "";
+  if (!(vertices >= 0 && faces >= 0) || 6 * vertices + 8 * faces > double(file_size))
+    return "its vertex and face counts are more than the file holds";
+  return "";
 }
 
 }  // namespace
@@ -120,10 +160,11 @@ PolygonSoup read_polygon_soup(const std::string& path, const std::string& field)
     fail(field, "'" + path + "': expected a .off, .stl, .obj or .ply file");
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) fail(field, "'" + path + "': no such file");
-  if (e == ".ply") {
-    const std::string problem = ply_header_problem(path);
-    if (!problem.empty()) fail(field, "'" + path + "': not a readable ply surface mesh (" + problem + ")");
-  }
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (error) fail(field, "'" + path + "': cannot read its size");
+  const std::string problem = e == ".ply" ? ply_header_problem(path, size) : count_problem(path, e, size);
+  if (!problem.empty())
+    fail(field, "'" + path + "': not a readable " + e.substr(1) + " surface mesh (" + problem + ")");
   std::vector<CgalPoint> points;
   std::vector<std::vector<std::size_t>> faces;
   bool read = false;
@@ -148,13 +189,19 @@ void write_off(const std::string& path, const PolygonSoup& soup) {
     throw std::runtime_error("cannot write " + path);
 }
 
+void check_mesh_resolution(double resolution) {
+  if (resolution != std::floor(resolution) ||
+      (resolution != automatic_mesh_resolution &&
+       !(resolution >= min_mesh_resolution && resolution <= max_mesh_resolution)))
+    fail("geometry.resolution", "expected 0 (automatic) or a whole number of lattice cells across the mesh, " +
+                                    std::to_string(min_mesh_resolution) +
+                                    " <= resolution <= " + std::to_string(max_mesh_resolution));
+}
+
 MeshSurface::~MeshSurface() = default;
 
 MeshSurface::MeshSurface(const PolygonSoup& soup, int resolution, const std::string& field) {
-  if (resolution != automatic_mesh_resolution && (resolution < min_mesh_resolution || resolution > max_mesh_resolution))
-    fail("geometry.resolution", "expected 0 (automatic) or " + std::to_string(min_mesh_resolution) +
-                                    " <= resolution <= " + std::to_string(max_mesh_resolution) +
-                                    " lattice cells across the mesh");
+  check_mesh_resolution(resolution);
   if (soup.faces.empty()) fail(field, "the mesh has no faces");
   std::vector<CgalPoint> points;
   points.reserve(soup.vertices.size());
@@ -175,7 +222,7 @@ MeshSurface::MeshSurface(const PolygonSoup& soup, int resolution, const std::str
   // Merge the duplicate points of STL-like files, drop degenerate and repeated faces, then orient
   // the faces consistently: false when some edge has more than two faces, or a vertex joins sheets
   // that meet only there.
-  PMP::repair_polygon_soup(points, polygons, CGAL::parameters::erase_all_duplicates(true));
+  PMP::repair_polygon_soup(points, polygons, CGAL::parameters::erase_all_duplicates(false));
   if (polygons.empty()) fail(field, "every face of the mesh is degenerate");
   if (!PMP::orient_polygon_soup(points, polygons))
     fail(field,
@@ -188,21 +235,27 @@ MeshSurface::MeshSurface(const PolygonSoup& soup, int resolution, const std::str
   for (auto h : halfedges(m))
     if (is_border(h, m))
       fail(field, "the mesh is not closed: it has a hole (an edge with one face) at " + at(m.point(source(h, m))));
-  std::vector<std::pair<TriangleMeshCgal::Face_index, TriangleMeshCgal::Face_index>> crossing;
-  PMP::self_intersections(m, std::back_inserter(crossing));  // all pairs: checks stay O(n log n)
-  if (!crossing.empty()) {
-    const auto h = halfedge(crossing.front().first, m);
-    fail(field, "the mesh intersects itself (" + std::to_string(crossing.size()) + " pairs of faces), near " +
-                    at(m.point(target(h, m))));
+  // The first crossing pair ends the search (a hostile mesh can have n² of them).
+  struct Found {
+    TriangleMeshCgal::Face_index face;
+  };
+  const auto first_crossing = boost::make_function_output_iterator(
+      [](const std::pair<TriangleMeshCgal::Face_index, TriangleMeshCgal::Face_index>& pair) {
+        throw Found{pair.first};
+      });
+  try {
+    PMP::self_intersections(m, first_crossing);
+  } catch (const Found& found) {
+    fail(field, "the mesh intersects itself, near " + at(m.point(target(halfedge(found.face, m), m))));
   }
   const double before = PMP::volume(m);  // signed: positive for outward faces
   PMP::orient_to_bound_a_volume(m);
   const double volume = PMP::volume(m);
   if (!(volume > 0)) fail(field, "the mesh encloses no volume");
-  if (before < volume * (1 - 1e-12))
+  if (std::abs(before - volume) > 1e-12 * volume)  // also a shell inside another that pointed outward
     warnings_.push_back(before <= -volume * (1 - 1e-12)
                             ? "the mesh's faces pointed inward: reoriented outward"
-                            : "some components of the mesh were oriented inward: reoriented to bound a volume");
+                            : "some components of the mesh were oriented the wrong way: reoriented to bound a volume");
   vertices_ = num_vertices(m);
   faces_ = num_faces(m);
 
@@ -236,9 +289,9 @@ MeshSurface::MeshSurface(const PolygonSoup& soup, int resolution, const std::str
   };
   const auto index = [&](std::size_t i, std::size_t j, std::size_t k) { return (k * side_nodes + j) * side_nodes + i; };
 
-  // Exact distances by the AABB tree in a band of 3ℓ around the faces (the nodes in each face's box
+  // Exact distances by the AABB tree in a band of 6ℓ around the faces (the nodes in each face's box
   // grown by the band), the nearest points of the others by closest-point sweeps from the band.
-  constexpr double band = 3;
+  constexpr double band = 6;
   std::vector<std::uint8_t> in_band(nodes, 0);
   for (auto f : faces(m)) {
     std::array<double, 3> lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
@@ -263,8 +316,9 @@ MeshSurface::MeshSurface(const PolygonSoup& soup, int resolution, const std::str
   const auto coordinates = [&](std::size_t q) {
     return std::array<std::size_t, 3>{q % side_nodes, (q / side_nodes) % side_nodes, q / (side_nodes * side_nodes)};
   };
-  (void)mesh->tree.closest_point(node(0, 0, 0));  // any lazy set-up happens here, before the threads
-  (void)side(node(0, 0, 0));
+  const CgalPoint middle(center.x, center.y, center.z);  // inside the mesh's box: lazy set-ups happen here
+  (void)mesh->tree.closest_point(middle);
+  (void)side(middle);
 #pragma omp parallel for schedule(dynamic, 256)
   for (std::size_t b = 0; b < band_nodes.size(); ++b) {
     const std::size_t q = band_nodes[b];
@@ -272,7 +326,7 @@ MeshSurface::MeshSurface(const PolygonSoup& soup, int resolution, const std::str
     const CgalPoint p = node(i, j, k);
     const CgalPoint c = mesh->tree.closest_point(p);
     distance[q] = std::sqrt(CGAL::squared_distance(p, c));
-    nearest[q] = {float(c.x()), float(c.y()), float(c.z())};
+    nearest[q] = {float(c.x() - center.x), float(c.y() - center.y), float(c.z() - center.z)};  // from the centre
   }
   // Sweeps in the eight diagonal orders, twice: each node away from the band tries the nearest
   // points of its three upwind neighbours.
@@ -287,7 +341,7 @@ MeshSurface::MeshSurface(const PolygonSoup& soup, int resolution, const std::str
             const std::size_t q = index(i, j, k);
             if (in_band[q]) continue;
             const std::array<std::size_t, 3> here{i, j, k};
-            const Point3 x{lower.x + double(i) * spacing, lower.y + double(j) * spacing, lower.z + double(k) * spacing};
+            const Point3 x = lower - center + spacing * Point3{double(i), double(j), double(k)};
             for (int d = 0; d < 3; ++d) {
               if ((step[d] > 0 && here[d] == 0) || (step[d] < 0 && here[d] == std::size_t(n))) continue;
               std::array<std::size_t, 3> from = here;
@@ -314,15 +368,26 @@ MeshSurface::MeshSurface(const PolygonSoup& soup, int resolution, const std::str
   mesh_ = std::move(mesh);
 
   const std::shared_ptr<const LatticeSpline> spline = spline_;
-  implicit_ = std::make_unique<ImplicitSurface>(
-      [spline](double x, double y, double z) {
-        return spline->value({x, y, z});
-      },
-      spline->box(),
-      [spline](double x, double y, double z) {
-        return spline->gradient({x, y, z});
-      },
-      [spline](const Point3& p) { return spline->hessian(p); });
+  try {
+    implicit_ = std::make_unique<ImplicitSurface>(
+        [spline](double x, double y, double z) {
+          return spline->value({x, y, z});
+        },
+        spline->box(),
+        [spline](double x, double y, double z) {
+          return spline->gradient({x, y, z});
+        },
+        [spline](const Point3& p) { return spline->hessian(p); });
+  } catch (const std::invalid_argument& e) {
+    fail(field, std::string("the mesh's level set on the lattice of spacing ") + std::to_string(spacing) + " fails (" +
+                    e.what() + "): parts thinner than the spacing are lost; a larger geometry.resolution");
+  }
+  // Parts thinner than ℓ vanish from the level set: its area then falls short of the mesh's.
+  const double mesh_area = PMP::area(m), kept = implicit_->area() / mesh_area;
+  if (std::abs(kept - 1) > 0.05)
+    fail(field, "the mesh's level set on the lattice of spacing " + std::to_string(spacing) + " has " +
+                    std::to_string(int(std::lround(100 * kept))) +
+                    "% of the mesh's area: parts thinner than the spacing are lost; a larger geometry.resolution");
 }
 
 double MeshSurface::distance_to_mesh(const Point3& p) const {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -13,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include <omp.h>
 #include <Eigen/Dense>
 
 #include "fictus/q1_element.hpp"
@@ -239,8 +241,11 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
 
   // 1. The band: the nodes outside ω within 6h of γ, with ψ and the patch of their nearest point.
   std::vector<std::vector<BandNode>> band_by_z(std::size_t(last[2] - first[2] + 1));
+  std::atomic<bool> stop = false;  // an interruption seen by thread 0 (the caller's) ends every thread's work
 #pragma omp parallel for num_threads(execution.threads()) schedule(dynamic, 1)
   for (int k = first[2]; k <= last[2]; ++k) {
+    if (omp_get_thread_num() == 0 && execution.interrupt_requested()) stop = true;
+    if (stop) continue;
     try {
       for (int j = first[1]; j <= last[1]; ++j)
         for (int i = first[0]; i <= last[0]; ++i) {
@@ -257,6 +262,7 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
     }
   }
   if (failure) std::rethrow_exception(failure);
+  execution.throw_if_interrupted();
   for (auto& layer : band_by_z) st.band.insert(st.band.end(), layer.begin(), layer.end());
   std::sort(st.band.begin(), st.band.end(), [](const BandNode& a, const BandNode& b) { return a.key < b.key; });
 
@@ -293,10 +299,13 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
   std::vector<char> is_cut(near_voxels.size(), 0);
 #pragma omp parallel for num_threads(execution.threads()) schedule(dynamic, 64)
   for (std::size_t n = 0; n < near_voxels.size(); ++n) {
+    if (omp_get_thread_num() == 0 && n % 256 == 0 && execution.interrupt_requested()) stop = true;
+    if (stop) continue;
     double volume = 0;
     for_each_omega_point_in_voxel(grid, gamma, near_voxels[n], cut_q, [&](const Point3&, double w) { volume += w; });
     is_cut[n] = volume > 1e-12 * h * h * h && volume < (1 - 1e-12) * h * h * h;
   }
+  execution.throw_if_interrupted();
   std::vector<Grid3::Index> voxels;  // the cut ones, then the ring of outside voxels around their nodes
   for (std::size_t n = 0; n < near_voxels.size(); ++n)
     if (is_cut[n]) voxels.push_back(near_voxels[n]);
@@ -346,6 +355,8 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
     std::vector<std::pair<Point3, double>> inside;
 #pragma omp for schedule(dynamic, 16)
     for (std::size_t n = 0; n < voxels.size(); ++n) try {
+        if (omp_get_thread_num() == 0 && n % 64 == 0 && execution.interrupt_requested()) stop = true;
+        if (stop) continue;
         const Grid3::Index cell = voxels[n];
         const Point3 lower{grid.x(cell[0]), grid.y(cell[1]), grid.z(cell[2])};
         inside.clear();
@@ -402,6 +413,7 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
       }
   }
   if (failure) std::rethrow_exception(failure);
+  execution.throw_if_interrupted();
 
   // The rows: entries merged per (patch, node) in voxel order, nodes without an unknown dropped.
   std::vector<RowEntry> entries;

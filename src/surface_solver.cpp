@@ -395,10 +395,11 @@ std::vector<Triangle3> offset_triangles(const std::vector<Triangle3>& triangles,
 }  // namespace
 
 SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
-                      std::function<void(const std::string&, double)> progress) {
+                      std::function<void(const std::string&, double)> progress, std::function<bool()> interrupt) {
   options.validate();
   Execution execution(options.threads);
   execution.set_progress(std::move(progress));
+  execution.set_interrupt_check(std::move(interrupt));
   if (!problem.gamma) throw std::invalid_argument("geometry: no surface given");
   if (!problem.f) throw std::invalid_argument("data.f: not given");
   if (!problem.g) throw std::invalid_argument("data.g: not given");
@@ -421,6 +422,7 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
     load_total += v;
   }
   clock.mark("load");
+  execution.throw_if_interrupted();
   fast->solve_in_place(u0);
   ++sol.fast_solves;
   for (double v : u0)
@@ -430,6 +432,7 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
                  "by one factor)",
                  v, detail::largest_scale));
   clock.mark("u0");
+  execution.throw_if_interrupted();
 
   // 1. Geometry: the patches of γ, δ and Γ.
   const double area = gamma.area();
@@ -443,6 +446,7 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
                                 format(" gives patches of side %.3g < 2h = %.3g (use m <= %.0f)", spacing, 2 * h,
                                        std::floor(area / (4 * h * h))));
   sol.gamma = gamma.patches(m, h);
+  execution.throw_if_interrupted();
   sol.Gamma = sol.gamma;
   if (options.variant == Variant::smooth) {
     sol.delta = options.offset * spacing;
@@ -475,6 +479,7 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
                     : normal_derivative_rows(grid, sol.gamma.point, sol.gamma.normal, options.normal_shift * h);
   // Non-smooth: λ lives on γ itself, where the kink of û must sit to O(h³) for C_γ (which reaches across
   // γ): the triangles' points are mapped onto γ (their O(h²) sag would be a double layer, an O(h) error).
+  execution.throw_if_interrupted();
   const SparseRows B_Gamma = patch_integral_rows(
       grid,
       patch_integrals(grid, sol.Gamma.triangles, sol.Gamma.patch_of, m,
@@ -518,6 +523,7 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
                                               detail::gmres_options(options, m, execution), direct);
     }
     clock.mark("schur");
+    execution.throw_if_interrupted();
   }
 
   // 4. g at the points.
@@ -571,6 +577,7 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
                  "and g by one factor)",
                  v, detail::largest_scale));
   clock.mark("newton");
+  execution.throw_if_interrupted();
 
   // 6. The field.
   GridVector u(grid.n_unknowns(), 0.0);
@@ -584,6 +591,7 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   B_gamma.multiply(sol.u, sol.trace);
   C_gamma.multiply(sol.u, sol.normal_derivative);
   clock.mark("final_solve");
+  execution.throw_if_interrupted();
 
   sol.signorini = detail::signorini_check(sol.trace, sol.normal_derivative, sol.g);  // 7
 

@@ -22,9 +22,14 @@ class Execution {
 
   /// A check for a request to stop, polled between the steps of a solve, in Newton and GMRES
   /// iterations and in the long assembly loops, always on the thread that called solve (OpenMP's
-  /// thread 0). It returns true to stop; the work then ends with Interrupted.
+  /// thread 0). It returns true to stop; the work then ends with Interrupted. Once it has said stop,
+  /// every later question is answered yes without asking it again (a check may say so only once, as
+  /// Python's signal check does).
   void set_interrupt_check(std::function<bool()> check) { interrupt_check_ = std::move(check); }
-  bool interrupt_requested() const { return interrupt_check_ && interrupt_check_(); }
+  bool interrupt_requested() const {
+    if (!interrupted_ && interrupt_check_ && interrupt_check_()) interrupted_ = true;
+    return interrupted_;
+  }
   void throw_if_interrupted() const {
     if (interrupt_requested()) throw Interrupted();
   }
@@ -41,6 +46,7 @@ class Execution {
  private:
   int threads_;
   std::function<bool()> interrupt_check_;
+  mutable bool interrupted_ = false;  // asked and answered on the calling thread only
   std::function<void(const std::string&, double)> progress_;
 };
 

@@ -48,6 +48,9 @@ inline constexpr int default_mesh_resolution = 128;
 inline constexpr int min_mesh_resolution = 16;
 inline constexpr int max_mesh_resolution = 512;
 
+/// Throws std::invalid_argument naming geometry.resolution unless it is 0 or a whole number in [16, 512].
+void check_mesh_resolution(double resolution);
+
 /// A polygon soup as read from a file: vertices and faces (three or more vertex indices each).
 struct PolygonSoup {
   std::vector<Point3> vertices;

@@ -170,9 +170,11 @@ struct SurfaceSolution {
 };
 
 /// One 3-D problem, one call, on options.threads threads; `progress` is called with each step's name
-/// and seconds as it ends. Throws std::invalid_argument naming the field on bad input.
+/// and seconds as it ends. Throws std::invalid_argument naming the field on bad input, and
+/// Interrupted soon after `interrupt` (asked from the calling thread) returns true.
 SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
-                      std::function<void(const std::string& phase, double seconds)> progress = {});
+                      std::function<void(const std::string& phase, double seconds)> progress = {},
+                      std::function<bool()> interrupt = {});
 
 /// ∫_ω w over the part of each voxel inside γ: full voxels by q³ Gauss points, voxels near γ split
 /// in 8 and each cut half-voxel by a rule along the axis where γ is steepest (the segment of each

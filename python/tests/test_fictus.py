@@ -318,3 +318,28 @@ def test_surface_from_numpy_arrays_solves_like_the_sphere():
         fictus.SurfaceProblem(geometry=dict(shape="mesh", vertices=vertices, faces=faces[1:]), **common)
     with pytest.raises(ValueError, match="geometry.file: missing"):
         fictus.SurfaceProblem(geometry=dict(shape="mesh"), **common)
+    with pytest.raises(ValueError, match="geometry.faces: expected integer vertex indices"):
+        fictus.SurfaceProblem(geometry=dict(shape="mesh", vertices=vertices, faces=faces * 1.0), **common)
+    with pytest.raises(ValueError, match='geometry.vertices: vertices and faces need shape = "mesh"'):
+        fictus.SurfaceProblem(geometry=dict(shape="sphere", vertices=vertices, faces=faces), **common)
+    with pytest.raises(ValueError, match="geometry.resolution: expected a number"):
+        fictus.SurfaceProblem(geometry=dict(shape="mesh", vertices=vertices, faces=faces, resolution="x"), **common)
+
+
+def test_ctrl_c_stops_a_3d_solve():
+    """3-D: SIGINT during a solve (here the non-smooth variant at N = 128, about 12 s uninterrupted) raises
+    KeyboardInterrupt within a second, in the load (0.3 s) and in the kink correction (2.5 s)."""
+    import signal
+    geometry = dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.3)
+    for delay in (0.3, 2.5):
+        p = fictus.SurfaceProblem(domain=dict(N=128), geometry=geometry, formulation=dict(variant="nonsmooth"),
+                                  data=dict(f="1", g="1 + 0.5 * (x - 0.5)"), solver=dict(threads=2))
+        start = time.perf_counter()
+        threading.Timer(delay, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+        with pytest.raises(KeyboardInterrupt):
+            p.solve()
+        stopped = time.perf_counter() - start
+        assert stopped < delay + 1.0, f"stopped {stopped:.2f} s after the start, the signal came at {delay} s"
+    assert fictus.SurfaceProblem(domain=dict(N=32), geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.2),
+                                 formulation=dict(variant="nonsmooth"),
+                                 data=dict(f="-1", g="0.2 * (x - 0.5)")).solve().iterations > 0

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <numbers>
 #include <set>
@@ -319,23 +320,22 @@ SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std
         },
         Box3{{b[0], b[1], b[2]}, {b[3], b[4], b[5]}});
   }
+  // A mesh is built last, once every other key has been read (building it can take seconds).
+  std::function<void()> build_mesh;
   if (shape == "mesh") {
     const double resolution = geometry.number("resolution", automatic_mesh_resolution);
-    if (resolution != std::floor(resolution) ||
-        (resolution != automatic_mesh_resolution &&
-         (resolution < min_mesh_resolution || resolution > max_mesh_resolution)))
-      fail("geometry.resolution", "expected 0 (automatic) or a whole number of lattice cells, " +
-                                      std::to_string(min_mesh_resolution) +
-                                      " <= resolution <= " + std::to_string(max_mesh_resolution));
+    check_mesh_resolution(resolution);
     if (geometry.has("file")) {
       std::filesystem::path file = geometry.string("file", "");
       std::error_code error;
       if (file.is_relative() && std::filesystem::is_regular_file(source, error))
         file = std::filesystem::path(source).parent_path() / file;
-      const auto surface = std::make_shared<MeshSurface>(read_polygon_soup(file.string(), "geometry.file"),
-                                                         int(resolution), "geometry.file");
-      for (const std::string& w : surface->warnings()) spec.warnings.push_back("geometry.file: " + w);
-      p.gamma = surface;
+      build_mesh = [&spec, &p, file, resolution] {
+        const auto surface = std::make_shared<MeshSurface>(read_polygon_soup(file.string(), "geometry.file"),
+                                                           int(resolution), "geometry.file");
+        for (const std::string& w : surface->warnings()) spec.warnings.push_back("geometry.file: " + w);
+        p.gamma = surface;
+      };
     } else if (mesh) {
       p.gamma = std::move(mesh);
     } else {
@@ -411,6 +411,7 @@ SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std
   json << toml::json_formatter{echo};
   spec.input_json = json.str();
   spec.name = source;
+  if (build_mesh) build_mesh();
   return spec;
 }
 

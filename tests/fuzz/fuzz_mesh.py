@@ -6,11 +6,13 @@
 Starts from small meshes in the four formats (OFF, OBJ, ASCII STL, ASCII PLY; a sphere and an
 octahedron) and mutates them: numbers replaced by NaN, ±inf, 1e308, huge or negative indices, lines
 dropped, repeated or swapped, the file cut short, bytes inserted. Each mutant is solved through a
-3-D problem file with N = 16. Acceptable: exit 0 with finite results, or exit 1 with exactly one
-`fictus: error: <key>: …` line. Anything else (a signal, an ASan/UBSan report, another exit code, a
+3-D problem file with N = 16. Acceptable: exit 0 with finite results (every number in results.json
+finite and within 1e100), exit 1 or 2 with exactly one `fictus: error: <key>: …` line, or a timeout
+(slow, not wrong). Anything else (a signal, an ASan/UBSan report, another exit code, a
 message over several lines) is a defect, written to --findings. Exit 1 when there is a defect.
 """
 import argparse
+import json
 import math
 import os
 import random
@@ -123,14 +125,26 @@ def mutate(text, rng):
     return text
 
 
-def classify(rc, stderr):
+def finite(value):
+    if isinstance(value, dict):
+        return all(finite(v) for v in value.values())
+    if isinstance(value, list):
+        return all(finite(v) for v in value)
+    return not isinstance(value, float) or (math.isfinite(value) and abs(value) <= 1e100)
+
+
+def classify(rc, stderr, outdir):
     if any(mark in stderr for mark in SANITIZER_MARKS):
         return "sanitizer"
     if rc < 0:
         return "crash"
     lines = [line for line in stderr.splitlines() if not line.startswith("fictus: warning:")]
     if rc == 0:
-        return "ok"
+        try:
+            with open(os.path.join(outdir, "results.json")) as handle:
+                return "ok" if finite(json.load(handle)) else "nonfinite"
+        except (OSError, ValueError):
+            return "nonfinite"
     if rc in (1, 2) and len(lines) == 1 and ERROR_LINE.match(lines[0]):
         return "error"
     return "bad_message" if rc in (1, 2) else "bad_exit"
@@ -162,7 +176,7 @@ def main():
             try:
                 run = subprocess.run([args.exe, "solve", problem, "--threads", "1", "--quiet", "--out", outdir],
                                      capture_output=True, text=True, errors="replace", timeout=120)
-                kind = classify(run.returncode, run.stderr)
+                kind = classify(run.returncode, run.stderr, outdir)
             except subprocess.TimeoutExpired:
                 kind, run = "timeout", None
             counts[kind] = counts.get(kind, 0) + 1
