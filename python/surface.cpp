@@ -6,6 +6,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -177,6 +178,22 @@ void bind_surface(py::module_& m) {
       .def("solve", &solve,
            "Solves (the GIL is released meanwhile) and returns a SurfaceSolution; raises ValueError on bad input "
            "and RuntimeError when Newton does not converge, with the CLI's messages.");
+
+  m.def(
+      "icosphere",
+      [](int levels, std::array<double, 3> center, double radius) {
+        const PolygonSoup soup = icosphere({center[0], center[1], center[2]}, radius, levels);
+        py::array_t<double> vertices({py::ssize_t(soup.vertices.size()), py::ssize_t(3)});
+        py::array_t<long long> faces({py::ssize_t(soup.faces.size()), py::ssize_t(3)});
+        for (std::size_t i = 0; i < soup.vertices.size(); ++i)
+          for (int d = 0; d < 3; ++d) vertices.mutable_at(i, d) = soup.vertices[i][d];
+        for (std::size_t i = 0; i < soup.faces.size(); ++i)
+          for (int d = 0; d < 3; ++d) faces.mutable_at(i, d) = (long long)soup.faces[i][std::size_t(d)];
+        return py::make_tuple(vertices, faces);
+      },
+      py::arg("levels"), py::arg("center"), py::arg("radius"),
+      "A sphere as (vertices (n, 3), faces (k, 3)): the icosahedron's faces split in four `levels` times "
+      "(20·4^levels triangles), for geometry=dict(shape=\"mesh\", vertices=..., faces=...).");
 
   py::class_<PySurfaceSolution>(m, "SurfaceSolution", "The result of SurfaceProblem.solve(); arrays are numpy arrays.")
       .def_property_readonly(

@@ -16,7 +16,7 @@
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/Surface_mesh.h>
 #include <omp.h>
-#include <boost/function_output_iterator.hpp>
+#include <boost/iterator/function_output_iterator.hpp>
 
 #include <algorithm>
 #include <array>
@@ -147,6 +147,53 @@ std::string count_problem(const std::string& path, const std::string& extension,
   return "";
 }
 
+/// CGAL's ASCII OFF scanner reads a face's size and indices as doubles and converts them to unsigned
+/// integers unchecked (undefined for −1 or 1e20): the face lines are checked first. Vertices are one a
+/// line (the usual layout; extra columns such as colours are allowed), then each face line holds its
+/// size k ≥ 3 and k whole indices below the vertex count.
+std::string off_faces_problem(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  std::vector<std::string> header;  // the keyword and the three counts, wherever the lines break
+  const auto next_line = [&](std::vector<std::string>& words) {
+    while (std::getline(in, line)) {
+      if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
+      std::istringstream split(line);
+      words.clear();
+      for (std::string w; split >> w;) words.push_back(w);
+      if (!words.empty()) return true;
+    }
+    return false;
+  };
+  std::vector<std::string> words;
+  while (header.size() < 4 && next_line(words)) header.insert(header.end(), words.begin(), words.end());
+  if (header.empty() || header[0].find("OFF") == std::string::npos) return "";  // the reader decides
+  if (header[0].find("BINARY") != std::string::npos || (header.size() > 1 && header[1] == "BINARY")) return "";
+  if (header.size() < 4) return "no vertex, face and edge counts";
+  const auto whole = [](const std::string& w, double& value) {
+    std::istringstream number(w);
+    return number >> value && number.eof() && value == std::floor(value);
+  };
+  double vertices = 0, faces = 0;
+  if (!whole(header[1], vertices) || !whole(header[2], faces) || vertices < 0 || faces < 0)
+    return "its vertex and face counts are not whole numbers";
+  for (double v = 0; v < vertices; ++v)
+    if (!next_line(words)) return "fewer vertices than its count";
+  for (double f = 0; f < faces; ++f) {
+    if (!next_line(words)) return "fewer faces than its count";
+    double size = 0;
+    if (!whole(words[0], size) || size < 3 || size + 1 > double(words.size()))
+      return "face " + std::to_string(std::size_t(f)) +
+             " does not start with its size (3 or more) and that many indices";
+    for (std::size_t k = 1; k <= std::size_t(size); ++k) {
+      double index = 0;
+      if (!whole(words[k], index) || index < 0 || index >= vertices)
+        return "face " + std::to_string(std::size_t(f)) + " has an index that is not a vertex number";
+    }
+  }
+  return "";
+}
+
 }  // namespace
 
 struct MeshSurface::Mesh {
@@ -162,7 +209,8 @@ PolygonSoup read_polygon_soup(const std::string& path, const std::string& field)
   if (!std::filesystem::is_regular_file(path, error)) fail(field, "'" + path + "': no such file");
   const std::uintmax_t size = std::filesystem::file_size(path, error);
   if (error) fail(field, "'" + path + "': cannot read its size");
-  const std::string problem = e == ".ply" ? ply_header_problem(path, size) : count_problem(path, e, size);
+  std::string problem = e == ".ply" ? ply_header_problem(path, size) : count_problem(path, e, size);
+  if (problem.empty() && e == ".off") problem = off_faces_problem(path);
   if (!problem.empty())
     fail(field, "'" + path + "': not a readable " + e.substr(1) + " surface mesh (" + problem + ")");
   std::vector<CgalPoint> points;

@@ -46,9 +46,9 @@ class LatticeSpline {
 inline constexpr int automatic_mesh_resolution = 0;
 inline constexpr int default_mesh_resolution = 128;
 inline constexpr int min_mesh_resolution = 16;
-inline constexpr int max_mesh_resolution = 512;
+inline constexpr int max_mesh_resolution = 256;  // (272 + 1)³ lattice nodes: about 0.5 GB while it is built
 
-/// Throws std::invalid_argument naming geometry.resolution unless it is 0 or a whole number in [16, 512].
+/// Throws std::invalid_argument naming geometry.resolution unless it is 0 or a whole number in [16, 256].
 void check_mesh_resolution(double resolution);
 
 /// A polygon soup as read from a file: vertices and faces (three or more vertex indices each).
@@ -74,7 +74,7 @@ class MeshSurface final : public Surface {
   /// Checks the mesh and builds the level function. Throws std::invalid_argument naming `field` for a
   /// mesh that is empty, not finite, has a face index out of range, is not closed, not manifold,
   /// intersects itself, or encloses no volume; and naming geometry.resolution for a resolution out
-  /// of [16, 512] (0: automatic). An inward-oriented mesh is reoriented (see warnings()).
+  /// of [16, 256] (0: automatic). An inward-oriented mesh is reoriented (see warnings()).
   MeshSurface(const PolygonSoup& soup, int resolution = automatic_mesh_resolution,
               const std::string& field = "geometry.file");
   ~MeshSurface() override;

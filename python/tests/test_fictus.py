@@ -266,37 +266,11 @@ def test_surface_problem_from_a_dict_and_its_errors():
                               data=dict(f=lambda x, y, z: x, g="0"))
 
 
-def icosphere(levels, center, radius):
-    """A sphere as vertex and face arrays: the icosahedron's faces split in four `levels` times."""
-    t = (1 + 5 ** 0.5) / 2
-    v = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
-         (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
-    f = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2), (10, 7, 6),
-         (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10),
-         (8, 6, 7), (9, 8, 1)]
-    v = [np.array(p) / np.linalg.norm(p) for p in v]
-    for _ in range(levels):
-        middle, finer = {}, []
-
-        def split(a, b):
-            key = (min(a, b), max(a, b))
-            if key not in middle:
-                m = v[a] + v[b]
-                v.append(m / np.linalg.norm(m))
-                middle[key] = len(v) - 1
-            return middle[key]
-
-        for a, b, c in f:
-            ab, bc, ca = split(a, b), split(b, c), split(c, a)
-            finer += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
-        f = finer
-    return np.asarray(center) + radius * np.array(v), np.array(f)
-
-
 def test_surface_from_numpy_arrays_solves_like_the_sphere():
     """3-D: a sphere given as vertices and faces (5120 triangles) answers as the analytic sphere does, up to
     the facets; an inward mesh is reoriented with a warning; bad arrays get errors naming the key."""
-    vertices, faces = icosphere(4, [0.5, 0.5, 0.5], 0.2)
+    vertices, faces = fictus.icosphere(4, [0.5, 0.5, 0.5], 0.2)
+    assert vertices.shape == (2562, 3) and faces.shape == (5120, 3)
     common = dict(domain=dict(N=48), formulation=dict(variant="smooth", multipliers=60),
                   data=dict(f="-1", g="0.2 * (x - 0.5)"))
     sphere = fictus.SurfaceProblem(geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.2), **common).solve()
