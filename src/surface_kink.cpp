@@ -305,7 +305,7 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
             }
         }
   }
-  // The cut voxels: those near γ whose part in ω is neither empty nor whole.
+  // The cut voxels: those near γ with corners on both sides of γ or a part in ω neither empty nor whole.
   std::vector<Grid3::Index> near_voxels;
   for (int k = first[2]; k < last[2]; ++k)
     for (int j = first[1]; j < last[1]; ++j)
@@ -320,9 +320,8 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
     if (stop) continue;
     // Cut: corners on both sides of γ, or a part in ω that the cut-voxel rule sees as neither empty
     // nor whole (γ through a face between the corners). The rule alone misses a corner just outside
-    // γ: that voxel's ψ at the corner and its residual would be lost (measured on the manufactured
-    // sphere at N = 96, 128, 160 with the cubic term of q: L²(ω) 1.4e-4, 5.2e-4, 4.7e-4 with the rule
-    // alone, 5.5e-5, 4.7e-5, 2.3e-5 with the corners as well).
+    // γ: that voxel's ψ at the corner and its residual would be lost (docs/math.md, "Three dimensions":
+    // the error then follows the grid's position against γ).
     const Grid3::Index& cell = near_voxels[n];
     bool inside = false, outside = false;
     for (int corner = 0; corner < 8; ++corner) {

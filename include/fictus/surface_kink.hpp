@@ -32,11 +32,9 @@ struct SurfaceFoot {
   double H = 0.0;       // κ₁ + κ₂ there (> 0 on a convex γ)
   double K2 = 0.0;      // κ₁² + κ₂² there
   /// q(d) = d − H d²/2 + β d³ with β = (κ₁² + κ₂² + H²)/6: ψ outside ω, extended smoothly inside.
-  /// For −Δu + c·u the jump of û's third normal derivative across γ is −(c + κ₁² + κ₂² + H²)λ + Δ_γλ
-  /// (λ is constant on a patch), so q‴ = 6β makes w = û + λψ C³ across γ up to the c·λ part. That
-  /// part is left out: where the reaction length 1/√c spans a few cells only, the cubic outgrows q
-  /// within the band of 6h (measured on a layer with c = 400 at h = 1/64: the error of ∂û/∂n 2.1e-3
-  /// with it, below 1e-3 without), and where it spans many, it is small beside κ₁² + κ₂² + H².
+  /// For −Δu + c·u the jump (outside − inside) of û's third normal derivative across γ is
+  /// −(c + κ₁² + κ₂² + H²)λ + Δ_γλ (λ is constant on a patch), so q‴ = 6β makes w = û + λψ C³ across
+  /// γ up to the c·λ part, which is left out (docs/math.md, "Three dimensions").
   double q() const { return d * (1.0 - d * (0.5 * H - beta() * d)); }
   double psi() const { return d > 0 ? q() : 0.0; }                               // q(d)⁺
   Point3 grad_q() const { return (1.0 - H * d + 3 * beta() * d * d) * normal; }  // ∇q, H and β taken constant

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <numbers>
 
 #include "fictus/fast_solver.hpp"
@@ -38,7 +39,12 @@ TEST(SurfaceKink, NearestPointDistanceAndCurvature) {
     const fictus::SurfaceFoot f = fictus::nearest_point(sphere, x, x, 1e-15);
     EXPECT_NEAR(f.d, d, 1e-14);
     EXPECT_NEAR(f.H, 2 / 0.3, 1e-10);
+    EXPECT_NEAR(f.K2, 2 / 0.09, 1e-8);  // κ₁² + κ₂²
     EXPECT_NEAR(norm(f.foot - (c + 0.3 * direction)), 0.0, 1e-14);
+    // q = d − H d²/2 + β d³, β = (κ₁² + κ₂² + H²)/6 = 1/(3·0.09) + 4/(6·0.09), and ∇q = q′(d)·n.
+    const double beta = (2 / 0.09 + 4 / 0.09) / 6;
+    EXPECT_NEAR(f.q(), d - d * d / 0.3 + beta * d * d * d, 1e-15);
+    EXPECT_NEAR(dot(f.grad_q(), f.normal), 1 - 2 * d / 0.3 + 3 * beta * d * d, 1e-13);
   }
   // Ellipsoid: x − foot along the normal, foot on γ; the default Hessian gives the same H.
   const fictus::Ellipsoid ellipsoid(c, {0.34, 0.26, 0.2});
@@ -59,10 +65,12 @@ TEST(SurfaceKink, NearestPointDistanceAndCurvature) {
       fictus::nearest_point(torus, c + Point3{R + rt + 0.01, 0, 0}, c + Point3{R + rt + 0.01, 0, 0}, 1e-15);
   EXPECT_NEAR(outer.d, 0.01, 1e-13);
   EXPECT_NEAR(outer.H, 1 / rt + 1 / (R + rt), 1e-9);
+  EXPECT_NEAR(outer.K2, 1 / (rt * rt) + 1 / ((R + rt) * (R + rt)), 1e-7);
   const Point3 inner_x = c + Point3{0, R - rt - 0.01, 0};
   const fictus::SurfaceFoot inner = fictus::nearest_point(torus, inner_x, inner_x, 1e-15);
   EXPECT_NEAR(inner.d, 0.01, 1e-13);
   EXPECT_NEAR(inner.H, 1 / rt - 1 / (R - rt), 1e-9);
+  EXPECT_NEAR(inner.K2, 1 / (rt * rt) + 1 / ((R - rt) * (R - rt)), 1e-7);
 }
 
 /// A sphere whose level gradient vanishes on part of it (a singular level function).
@@ -128,16 +136,18 @@ std::pair<double, double> layer_normal_derivative_error(int N, bool corrected) {
 
 TEST(SurfaceKink, CorrectedNormalDerivativeOfALayerConverges) {
   // The exact inside ∂û/∂n is 0.4167. Measured: uncorrected mean error 0.58 at every N; corrected
-  // 1.6e-3 (N = 32), 5.6e-4 (N = 64), largest 1.2e-2 and 5.6e-3.
+  // 6.8e-4 (N = 32), 2.1e-4 (N = 64), largest 7.7e-3 and 3.1e-3.
   const auto [raw_mean, raw_largest] = layer_normal_derivative_error(32, false);
   EXPECT_GT(raw_mean, 0.3);
   const auto [mean32, largest32] = layer_normal_derivative_error(32, true);
   const auto [mean64, largest64] = layer_normal_derivative_error(64, true);
-  EXPECT_LT(mean32, 3e-3);
-  EXPECT_LT(mean64, 1e-3);
+  std::cout << "layer: mean error of the corrected dudn " << mean32 << " (N = 32), " << mean64 << " (N = 64); largest "
+            << largest32 << ", " << largest64 << "\n";
+  EXPECT_LT(mean32, 1.5e-3);
+  EXPECT_LT(mean64, 4e-4);
   EXPECT_LT(mean64, 0.5 * mean32);
   EXPECT_LT(largest64, 0.6 * largest32);
-  EXPECT_LT(largest64, 1e-2);
+  EXPECT_LT(largest64, 5e-3);
 }
 
 }  // namespace
