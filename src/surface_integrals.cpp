@@ -14,10 +14,6 @@ namespace {
 
 using Polygon = std::vector<Point3>;
 
-Point3 cross(const Point3& u, const Point3& v) {
-  return {u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
-}
-
 /// The part of a convex polygon where sign·(p[axis] − plane) ≥ 0 (Sutherland–Hodgman, one plane).
 Polygon clip(const Polygon& polygon, int axis, double plane, double sign) {
   Polygon out;

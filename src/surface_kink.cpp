@@ -115,10 +115,9 @@ class PatchLocator {
       Frame f;
       f.a = t.a, f.e1 = t.b - t.a, f.e2 = t.c - t.a;
       f.a11 = dot(f.e1, f.e1), f.a12 = dot(f.e1, f.e2), f.a22 = dot(f.e2, f.e2);
-      f.inverse_det = 1 / (f.a11 * f.a22 - f.a12 * f.a12);
+      const Point3 n = cross(f.e1, f.e2);
+      f.inverse_det = 1 / dot(n, n);  // a11·a22 − a12², without its cancellation on slivers
       f.longest = std::sqrt(std::max(f.a11, f.a22));
-      const Point3 n{f.e1.y * f.e2.z - f.e1.z * f.e2.y, f.e1.z * f.e2.x - f.e1.x * f.e2.z,
-                     f.e1.x * f.e2.y - f.e1.y * f.e2.x};
       f.normal = (1 / norm(n)) * n;
       frames_.push_back(f);
     }

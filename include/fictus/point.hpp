@@ -55,6 +55,9 @@ inline Point<2> operator*(double s, Point<2> a) { return {s * a.x, s * a.y}; }
 inline double dot(const Point<2>& a, const Point<2>& b) { return a.x * b.x + a.y * b.y; }
 inline double norm(const Point<2>& a) { return std::hypot(a.x, a.y); }
 inline double norm(const Point<3>& a) { return std::hypot(a.x, a.y, a.z); }
+inline Point<3> cross(const Point<3>& u, const Point<3>& v) {
+  return {u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
+}
 
 /// Ω = [lower[0], upper[0]] × … × [lower[dim−1], upper[dim−1]].
 template <int dim>
