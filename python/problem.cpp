@@ -85,44 +85,89 @@ std::string toml_text(py::dict sections) {
   return text.str();
 }
 
-VectorizedField PyProblem::wrap(py::function fn, const std::string& key, std::shared_ptr<CallbackErrors> errors) {
-  // The callable is released under the GIL whenever the last copy of the field goes.
-  std::shared_ptr<py::function> holder(new py::function(std::move(fn)), [](py::function* f) {
+void CallbackErrors::raise_if_any() {
+  std::lock_guard lock(mutex);
+  if (interrupted) {
+    PyErr_SetNone(PyExc_KeyboardInterrupt);
+    throw py::error_already_set();
+  }
+  if (!message.empty()) throw std::invalid_argument(message);
+}
+
+namespace {
+
+/// The callable, released under the GIL whenever the last copy of a field holding it goes.
+std::shared_ptr<py::function> hold(py::function fn) {
+  return std::shared_ptr<py::function>(new py::function(std::move(fn)), [](py::function* f) {
     py::gil_scoped_acquire gil;
     delete f;
   });
-  return [holder, key, errors](std::size_t n, const double* x, const double* y, double* out) {
-    // Called from solver threads: never throw through them; record the error, return NaN.
-    py::gil_scoped_acquire gil;
-    std::string failure;
-    try {
-      py::array_t<double> xs(n), ys(n);
-      std::copy(x, x + n, xs.mutable_data());
-      std::copy(y, y + n, ys.mutable_data());
-      const py::array result = py::array::ensure((*holder)(xs, ys));
-      const char kind = result ? result.dtype().kind() : 'O';
-      if (kind != 'f' && kind != 'i' && kind != 'u')
-        throw std::invalid_argument("the callable must return real numbers (got " +
-                                    (result ? std::string(py::str(result.dtype())) : std::string("no array")) + ")");
-      const auto values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(result);
-      if (!values || (values.size() != py::ssize_t(n) && values.size() != 1))
-        throw std::invalid_argument("the callable must return one number per point (an array of " + std::to_string(n) +
-                                    ")");
-      for (std::size_t k = 0; k < n; ++k) out[k] = values.data()[values.size() == 1 ? 0 : k];
-      return;
-    } catch (py::error_already_set& e) {
-      if (e.matches(PyExc_KeyboardInterrupt)) {
-        std::lock_guard lock(errors->mutex);
-        errors->interrupted = true;
-      }
-      failure = e.what();
-    } catch (const std::exception& e) {
-      failure = e.what();
+}
+
+/// out[k] = fn(*coordinates)[k] for k < n. Called from solver threads: never throws through them;
+/// records the error in `errors` and returns NaN.
+void call_batch(const py::function& fn, const std::string& key, CallbackErrors& errors, std::size_t n,
+                std::initializer_list<const double*> coordinates, double* out) {
+  py::gil_scoped_acquire gil;
+  std::string failure;
+  try {
+    py::tuple arguments(coordinates.size());
+    std::size_t a = 0;
+    for (const double* c : coordinates) {
+      py::array_t<double> values(n);
+      std::copy(c, c + n, values.mutable_data());
+      arguments[a++] = values;
     }
-    std::lock_guard lock(errors->mutex);
-    if (errors->message.empty()) errors->message = (key + ": the callable failed: " + failure).substr(0, 300);
-    std::fill(out, out + n, std::nan(""));
+    const py::array result = py::array::ensure(fn(*arguments));
+    const char kind = result ? result.dtype().kind() : 'O';
+    if (kind != 'f' && kind != 'i' && kind != 'u')
+      throw std::invalid_argument("the callable must return real numbers (got " +
+                                  (result ? std::string(py::str(result.dtype())) : std::string("no array")) + ")");
+    const auto values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(result);
+    if (!values || (values.size() != py::ssize_t(n) && values.size() != 1))
+      throw std::invalid_argument("the callable must return one number per point (an array of " + std::to_string(n) +
+                                  ")");
+    for (std::size_t k = 0; k < n; ++k) out[k] = values.data()[values.size() == 1 ? 0 : k];
+    return;
+  } catch (py::error_already_set& e) {
+    if (e.matches(PyExc_KeyboardInterrupt)) {
+      std::lock_guard lock(errors.mutex);
+      errors.interrupted = true;
+    }
+    failure = e.what();
+  } catch (const std::exception& e) {
+    failure = e.what();
+  }
+  failure = failure.substr(0, failure.find('\n'));  // the exception, without Python's traceback
+  std::lock_guard lock(errors.mutex);
+  if (errors.message.empty()) errors.message = (key + ": the callable failed: " + failure).substr(0, 300);
+  std::fill(out, out + n, std::nan(""));
+}
+
+}  // namespace
+
+VectorizedField PyProblem::wrap(py::function fn, const std::string& key, std::shared_ptr<CallbackErrors> errors) {
+  return [holder = hold(std::move(fn)), key, errors](std::size_t n, const double* x, const double* y, double* out) {
+    call_batch(*holder, key, *errors, n, {x, y}, out);
   };
+}
+
+VectorizedField3 wrap3(py::function fn, const std::string& key, std::shared_ptr<CallbackErrors> errors) {
+  return [holder = hold(std::move(fn)), key, errors](std::size_t n, const double* x, const double* y, const double* z,
+                                                     double* out) {
+    call_batch(*holder, key, *errors, n, {x, y, z}, out);
+  };
+}
+
+std::map<std::string, py::function> take_callables(py::dict data) {
+  std::map<std::string, py::function> callables;
+  for (const char* key : {"f", "g", "exact"}) {
+    if (data.contains(key) && !py::isinstance<py::str>(data[key]) && py::isinstance<py::function>(data[key])) {
+      callables[key] = data[key].cast<py::function>();
+      data[key] = py::str("0");
+    }
+  }
+  return callables;
 }
 
 Problem PyProblem::bound(const std::shared_ptr<CallbackErrors>& errors) const {
@@ -158,15 +203,7 @@ PyProblem PyProblem::from_config(py::dict config) {
     }
   }
   // Callables in [data] are attached after parsing; the TOML gets placeholders.
-  if (sections.contains("data")) {
-    py::dict data = sections["data"];
-    for (const char* key : {"f", "g", "exact"}) {
-      if (data.contains(key) && !py::isinstance<py::str>(data[key]) && py::isinstance<py::function>(data[key])) {
-        callables[key] = data[key].cast<py::function>();
-        data[key] = py::str("0");
-      }
-    }
-  }
+  if (sections.contains("data")) callables = take_callables(sections["data"]);
   p.spec = parse_problem_text(toml_text(sections), "problem");
   return p;
 }

@@ -18,7 +18,17 @@ struct CallbackErrors {
   std::mutex mutex;
   std::string message;
   bool interrupted = false;  // Ctrl-C (KeyboardInterrupt) inside a callable
+
+  /// Raises what a callable raised: KeyboardInterrupt, or ValueError with `message`; else nothing.
+  void raise_if_any();
 };
+
+/// A numpy callable fn(x, y, z) -> array as a batch field; errors go to `errors` (the field returns NaN).
+VectorizedField3 wrap3(pybind11::function fn, const std::string& key, std::shared_ptr<CallbackErrors> errors);
+
+/// The callables among data's f, g and exact, by key; each is replaced in `data` by the placeholder
+/// expression "0" for the reader.
+std::map<std::string, pybind11::function> take_callables(pybind11::dict data);
 
 /// A solved problem, as Python sees it.
 class PySolution {

@@ -23,14 +23,6 @@ PySolution PyProblem::solve(bool field) {
   const Problem problem = bound(errors);
   check_memory(problem, spec.options);
   std::shared_ptr<const Solution> solution;
-  auto raise_callback_error = [&] {
-    std::lock_guard lock(errors->mutex);
-    if (errors->interrupted) {
-      PyErr_SetNone(PyExc_KeyboardInterrupt);
-      throw py::error_already_set();
-    }
-    if (!errors->message.empty()) throw std::invalid_argument(errors->message);
-  };
   try {
     FictitiousDomainSolver solver(problem, spec.options);
     // Ctrl-C: Python's handler runs in PyErr_CheckSignals (this thread, under the GIL) and leaves
@@ -45,10 +37,10 @@ PySolution PyProblem::solve(bool field) {
     if (!PyErr_Occurred()) PyErr_SetNone(PyExc_KeyboardInterrupt);
     throw py::error_already_set();
   } catch (const std::invalid_argument&) {
-    raise_callback_error();  // a NaN from a failed callable: report the callable, not the NaN
+    errors->raise_if_any();  // a NaN from a failed callable: report the callable, not the NaN
     throw;
   }
-  raise_callback_error();
+  errors->raise_if_any();
   std::const_pointer_cast<Solution>(solution)->peak_memory_bytes = peak_memory_bytes();
   if (!solution->newton.converged) throw std::runtime_error(describe_newton_failure(*solution));
   return PySolution(solution, problem);

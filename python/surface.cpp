@@ -55,6 +55,19 @@ std::shared_ptr<const Surface> mesh_from_arrays(py::handle vertices, py::handle 
 
 struct PySurfaceProblem {
   SurfaceProblemSpec spec;
+  std::map<std::string, py::function> callables;  // data key ("f", "g", "exact") → numpy callable fn(x, y, z)
+
+  /// The problem with the callables bound to this solve's error slot.
+  SurfaceProblem bound(const std::shared_ptr<CallbackErrors>& errors) const {
+    SurfaceProblem problem = spec.problem;
+    for (const auto& [key, fn] : callables) {
+      VectorizedField3 field = wrap3(fn, "data." + key, errors);
+      if (key == "f") problem.f = nullptr, problem.f_vectorized = field;
+      if (key == "g") problem.g = nullptr, problem.g_vectorized = field;
+      if (key == "exact") problem.exact = nullptr, problem.exact_gradient = nullptr, problem.exact_vectorized = field;
+    }
+    return problem;
+  }
 
   static PySurfaceProblem from_config(py::dict config) {
     py::dict sections;
@@ -69,11 +82,9 @@ struct PySurfaceProblem {
     if (!sections.contains("domain")) sections["domain"] = py::dict();
     py::dict domain = sections["domain"];
     if (!domain.contains("dim")) domain["dim"] = 3;
-    if (sections.contains("data"))
-      for (auto [k, v] : sections["data"].cast<py::dict>())
-        if (!py::isinstance<py::str>(v) && py::isinstance<py::function>(v))
-          throw std::invalid_argument("data." + std::string(py::str(k)) +
-                                      ": 3-D data are expressions in x, y, z (str); callables are 2-D only");
+    // Callables in [data] are attached at each solve; the TOML gets placeholders.
+    std::map<std::string, py::function> callables;
+    if (sections.contains("data")) callables = take_callables(sections["data"]);
     // A mesh from numpy arrays: geometry.vertices (n, 3) and geometry.faces (k, 3), built here and
     // handed to the reader as the surface of shape = "mesh".
     std::shared_ptr<const Surface> mesh;
@@ -101,6 +112,7 @@ struct PySurfaceProblem {
     }
     PySurfaceProblem p;
     p.spec = parse_surface_problem_text(toml_text(sections), "problem", mesh);
+    p.callables = std::move(callables);
     if (const auto* surface = dynamic_cast<const MeshSurface*>(mesh.get()))
       for (const std::string& w : surface->warnings()) p.spec.warnings.push_back("geometry.vertices: " + w);
     return p;
@@ -113,6 +125,8 @@ struct PySurfaceSolution {
 };
 
 PySurfaceSolution solve(const PySurfaceProblem& p) {
+  const auto errors = std::make_shared<CallbackErrors>();  // this solve's own slot
+  const SurfaceProblem problem = p.bound(errors);
   std::shared_ptr<const SurfaceSolution> solution;
   try {
     // Ctrl-C: Python's handler runs in PyErr_CheckSignals (this thread, under the GIL) and leaves
@@ -122,12 +136,16 @@ PySurfaceSolution solve(const PySurfaceProblem& p) {
       return PyErr_CheckSignals() != 0;
     };
     py::gil_scoped_release release;
-    solution = std::make_shared<const SurfaceSolution>(fictus::solve(p.spec.problem, p.spec.options, {}, interrupt));
+    solution = std::make_shared<const SurfaceSolution>(fictus::solve(problem, p.spec.options, {}, interrupt));
   } catch (const Interrupted&) {
     if (!PyErr_Occurred()) PyErr_SetNone(PyExc_KeyboardInterrupt);
     throw py::error_already_set();
+  } catch (const std::invalid_argument&) {
+    errors->raise_if_any();  // a NaN from a failed callable: report the callable, not the NaN
+    throw;
   }
   if (PyErr_Occurred()) throw py::error_already_set();  // a signal seen after the last check
+  errors->raise_if_any();
   std::const_pointer_cast<SurfaceSolution>(solution)->peak_memory_bytes = peak_memory_bytes();
   if (!solution->newton.converged)
     throw std::runtime_error("solver.max_newton: Newton did not converge: " + solution->newton.failure);
@@ -159,7 +177,8 @@ void bind_surface(py::module_& m) {
 
     SurfaceProblem(domain=..., geometry=..., formulation=..., data=..., solver=...)
         Sections as dicts with the keys of a 3-D problem file (docs/problem_files.md, "3-D problems");
-        domain.dim = 3 is implied. f, g, exact: expressions in x, y, z (str). A mesh: geometry =
+        domain.dim = 3 is implied. f, g, exact: expressions in x, y, z (str) or numpy callables
+        f(x, y, z) -> array, called in batches. A mesh: geometry =
         {"shape": "mesh", "file": path} or {"shape": "mesh", "vertices": (n, 3) array, "faces": (k, 3)
         integer array}, optional "resolution".
     SurfaceProblem.from_dict(d), SurfaceProblem.from_toml(text)

@@ -245,8 +245,8 @@ void for_each_omega_point_in_voxel(const Grid3& grid, const Surface& gamma, cons
   omega_part(grid, gamma, cell, gauss_legendre(q), visit, depth);
 }
 
-void for_each_omega_point(const Grid3& grid, const Surface& gamma, int q, const Execution& execution,
-                          const OmegaVisitor& visit) {
+void for_each_omega_row(const Grid3& grid, const Surface& gamma, int q, const Execution& execution,
+                        const OmegaRowVisitor& visit) {
   const GaussRule& rule = gauss_legendre(q);
   const Box3 bounds = gamma.bounds();
   std::array<int, 3> first, last;
@@ -255,18 +255,32 @@ void for_each_omega_point(const Grid3& grid, const Surface& gamma, int q, const 
     last[d] = grid.cell(d, bounds.upper[d]);
   }
   std::atomic<bool> stop = false;
-#pragma omp parallel for num_threads(execution.threads()) schedule(dynamic, 1)
-  for (int iz = first[2]; iz <= last[2]; ++iz) {
-    const int thread = omp_get_thread_num();
-    if (thread == 0 && execution.interrupt_requested()) stop = true;
-    if (stop) continue;
-    for (int iy = first[1]; iy <= last[1]; ++iy)
-      for (int ix = first[0]; ix <= last[0]; ++ix) {
-        const Grid3::Index cell{ix, iy, iz};
-        omega_part(grid, gamma, cell, rule, [&](const Point3& x, double w) { visit(thread, cell, x, w); });
+#pragma omp parallel num_threads(execution.threads())
+  {
+    std::vector<OmegaPoint> row;
+#pragma omp for schedule(dynamic, 1)
+    for (int iz = first[2]; iz <= last[2]; ++iz) {
+      const int thread = omp_get_thread_num();
+      if (thread == 0 && execution.interrupt_requested()) stop = true;
+      if (stop) continue;
+      for (int iy = first[1]; iy <= last[1]; ++iy) {
+        row.clear();
+        for (int ix = first[0]; ix <= last[0]; ++ix) {
+          const Grid3::Index cell{ix, iy, iz};
+          omega_part(grid, gamma, cell, rule, [&](const Point3& x, double w) { row.push_back({cell, x, w}); });
+        }
+        if (!row.empty()) visit(thread, row);
       }
+    }
   }
   if (stop) throw Interrupted();
+}
+
+void for_each_omega_point(const Grid3& grid, const Surface& gamma, int q, const Execution& execution,
+                          const OmegaVisitor& visit) {
+  for_each_omega_row(grid, gamma, q, execution, [&](int thread, const std::vector<OmegaPoint>& row) {
+    for (const OmegaPoint& p : row) visit(thread, p.cell, p.x, p.weight);
+  });
 }
 
 double omega_volume(const Grid3& grid, const Surface& gamma, int q, const Execution& execution) {
@@ -298,12 +312,40 @@ void sample_q1(const Grid3& grid, const GridVector& u, const Grid3::Index& cell,
   }
 }
 
-GradientField3 central_differences(const ScalarField3& u, double step) {
-  return [u, step](double x, double y, double z) {
-    return Point3{(u(x + step, y, z) - u(x - step, y, z)) / (2 * step),
-                  (u(x, y + step, z) - u(x, y - step, z)) / (2 * step),
-                  (u(x, y, z + step) - u(x, y, z - step)) / (2 * step)};
-  };
+/// ∇u at the points: the given gradient, or central differences of u with step e (six batches).
+void gradient_at(const VectorizedField3& u, const GradientField3& gradient, double e,
+                 const std::array<std::vector<double>, 3>& x, std::array<std::vector<double>, 3>& du) {
+  const std::size_t n = x[0].size();
+  for (auto& d : du) d.resize(n);
+  if (gradient) {
+    for (std::size_t k = 0; k < n; ++k) {
+      const Point3 g = gradient(x[0][k], x[1][k], x[2][k]);
+      for (int d = 0; d < 3; ++d) du[d][k] = g[d];
+    }
+    return;
+  }
+  std::vector<double> shifted(n), plus(n), minus(n);
+  for (int axis = 0; axis < 3; ++axis) {
+    const auto at = [&](std::vector<double>& out) {
+      const double* c[3] = {x[0].data(), x[1].data(), x[2].data()};
+      c[axis] = shifted.data();
+      u(n, c[0], c[1], c[2], out.data());
+    };
+    for (std::size_t k = 0; k < n; ++k) shifted[k] = x[axis][k] + e;
+    at(plus);
+    for (std::size_t k = 0; k < n; ++k) shifted[k] = x[axis][k] - e;
+    at(minus);
+    for (std::size_t k = 0; k < n; ++k) du[axis][k] = (plus[k] - minus[k]) / (2 * e);
+  }
+}
+
+/// The coordinates of `points` as three arrays.
+std::array<std::vector<double>, 3> coordinates(const std::vector<Point3>& points) {
+  std::array<std::vector<double>, 3> x;
+  for (auto& c : x) c.reserve(points.size());
+  for (const Point3& p : points)
+    for (int d = 0; d < 3; ++d) x[d].push_back(p[d]);
+  return x;
 }
 
 }  // namespace
@@ -311,45 +353,68 @@ GradientField3 central_differences(const ScalarField3& u, double step) {
 ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,
                           const std::vector<double>& trace, const ScalarField3& exact,
                           const GradientField3& exact_gradient, int q, const Execution& execution) {
-  const GradientField3 gradient =
-      exact_gradient ? exact_gradient : central_differences(exact, 1e-6 * grid.box().width(0));
+  return compute_errors(u_h, grid, gamma, patches, trace, vectorize(exact), exact_gradient, q, execution);
+}
+
+ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,
+                          const std::vector<double>& trace, const VectorizedField3& exact,
+                          const GradientField3& exact_gradient, int q, const Execution& execution) {
+  const double e = 1e-6 * grid.box().width(0);
   struct Sums {
     double e2 = 0, de2 = 0, u2 = 0, du2 = 0;
   };
+  struct Buffers {
+    std::array<std::vector<double>, 3> x, du;
+    std::vector<double> u;
+  };
   std::vector<Sums> sums(execution.threads());
-  for_each_omega_point(grid, gamma, q, execution, [&](int thread, const Grid3::Index& cell, const Point3& x, double w) {
-    double value;
-    Point3 slope;
-    sample_q1(grid, u_h, cell, x, value, slope);
-    const double u = exact(x.x, x.y, x.z);
-    const Point3 du = gradient(x.x, x.y, x.z);
-    const Point3 de = slope - du;
+  std::vector<Buffers> buffers(execution.threads());
+  for_each_omega_row(grid, gamma, q, execution, [&](int thread, const std::vector<OmegaPoint>& row) {
+    Buffers& b = buffers[thread];
+    const std::size_t n = row.size();
+    for (int d = 0; d < 3; ++d) {
+      b.x[d].resize(n);
+      for (std::size_t k = 0; k < n; ++k) b.x[d][k] = row[k].x[d];
+    }
+    b.u.resize(n);
+    exact(n, b.x[0].data(), b.x[1].data(), b.x[2].data(), b.u.data());
+    gradient_at(exact, exact_gradient, e, b.x, b.du);
     Sums& s = sums[thread];
-    s.e2 += w * (value - u) * (value - u);
-    s.de2 += w * dot(de, de);
-    s.u2 += w * u * u;
-    s.du2 += w * dot(du, du);
+    for (std::size_t k = 0; k < n; ++k) {
+      double value;
+      Point3 slope;
+      sample_q1(grid, u_h, row[k].cell, row[k].x, value, slope);
+      const double u = b.u[k];
+      const Point3 du{b.du[0][k], b.du[1][k], b.du[2][k]};
+      const Point3 de = slope - du;
+      const double w = row[k].weight;
+      s.e2 += w * (value - u) * (value - u);
+      s.de2 += w * dot(de, de);
+      s.u2 += w * u * u;
+      s.du2 += w * dot(du, du);
+    }
   });
   Sums total;
   for (const Sums& s : sums) total.e2 += s.e2, total.de2 += s.de2, total.u2 += s.u2, total.du2 += s.du2;
+  const std::array<std::vector<double>, 3> x = coordinates(patches.point);
+  std::vector<double> u(x[0].size());
+  exact(u.size(), x[0].data(), x[1].data(), x[2].data(), u.data());
   double g2 = 0, gu2 = 0;
   for (int p = 0; p < patches.m; ++p) {
-    const Point3 x = patches.point[p];
-    const double u = exact(x.x, x.y, x.z);
-    g2 += patches.area[p] * (trace[p] - u) * (trace[p] - u);
-    gu2 += patches.area[p] * u * u;
+    g2 += patches.area[p] * (trace[p] - u[p]) * (trace[p] - u[p]);
+    gu2 += patches.area[p] * u[p] * u[p];
   }
-  ErrorNorms e;
-  e.l2_omega = std::sqrt(total.e2);
-  e.h1semi_omega = std::sqrt(total.de2);
-  e.h1_omega = std::sqrt(total.e2 + total.de2);
-  e.l2_gamma = std::sqrt(g2);
+  ErrorNorms out;
+  out.l2_omega = std::sqrt(total.e2);
+  out.h1semi_omega = std::sqrt(total.de2);
+  out.h1_omega = std::sqrt(total.e2 + total.de2);
+  out.l2_gamma = std::sqrt(g2);
   const auto relative = [](double error, double norm) { return norm > 0 ? error / norm : error; };
-  e.rel_l2_omega = relative(e.l2_omega, std::sqrt(total.u2));
-  e.rel_h1semi_omega = relative(e.h1semi_omega, std::sqrt(total.du2));
-  e.rel_h1_omega = relative(e.h1_omega, std::sqrt(total.u2 + total.du2));
-  e.rel_l2_gamma = relative(e.l2_gamma, std::sqrt(gu2));
-  return e;
+  out.rel_l2_omega = relative(out.l2_omega, std::sqrt(total.u2));
+  out.rel_h1semi_omega = relative(out.h1semi_omega, std::sqrt(total.du2));
+  out.rel_h1_omega = relative(out.h1_omega, std::sqrt(total.u2 + total.du2));
+  out.rel_l2_gamma = relative(out.l2_gamma, std::sqrt(gu2));
+  return out;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -401,8 +466,8 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   execution.set_progress(std::move(progress));
   execution.set_interrupt_check(std::move(interrupt));
   if (!problem.gamma) throw std::invalid_argument("geometry: no surface given");
-  if (!problem.f) throw std::invalid_argument("data.f: not given");
-  if (!problem.g) throw std::invalid_argument("data.g: not given");
+  if (!problem.f && !problem.f_vectorized) throw std::invalid_argument("data.f: not given");
+  if (!problem.g && !problem.g_vectorized) throw std::invalid_argument("data.g: not given");
   if (!(problem.c >= 0) || !std::isfinite(problem.c)) throw std::invalid_argument("data.c: must be finite and >= 0");
   const Grid3 grid(problem.box, problem.N, problem.boundary);
   const Surface& gamma = *problem.gamma;
@@ -415,7 +480,8 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
 
   // 0. The load and u₀.
   std::unique_ptr<FastSolver<3>> fast = make_fast_solver(grid, problem.c, execution);
-  GridVector u0 = assemble_load(grid, problem.f, options.load_quadrature, execution);
+  GridVector u0 = problem.f_vectorized ? assemble_load(grid, problem.f_vectorized, options.load_quadrature, execution)
+                                       : assemble_load(grid, problem.f, options.load_quadrature, execution);
   double load_total = 0;
   for (double v : u0) {
     if (!std::isfinite(v)) throw std::invalid_argument("data.f: not finite somewhere in the box");
@@ -528,9 +594,13 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
 
   // 4. g at the points.
   sol.g.resize(m);
+  {
+    const std::array<std::vector<double>, 3> x = coordinates(sol.gamma.point);
+    (problem.g_vectorized ? problem.g_vectorized : vectorize(problem.g))(std::size_t(m), x[0].data(), x[1].data(),
+                                                                         x[2].data(), sol.g.data());
+  }
   for (int p = 0; p < m; ++p) {
     const Point3 x = sol.gamma.point[p];
-    sol.g[p] = problem.g(x.x, x.y, x.z);
     if (!std::isfinite(sol.g[p]))
       throw std::invalid_argument(format("data.g: not finite at the point (%.6g, %.6g, %.6g)", x.x, x.y, x.z));
     if (std::abs(sol.g[p]) > detail::largest_scale)
@@ -596,20 +666,24 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   sol.signorini = detail::signorini_check(sol.trace, sol.normal_derivative, sol.g);  // 7
 
   // 8. Errors.
-  if (problem.exact) {
-    const GradientField3 gradient = problem.exact_gradient
-                                        ? problem.exact_gradient
-                                        : central_differences(problem.exact, 1e-6 * grid.box().width(0));
+  if (problem.exact || problem.exact_vectorized) {
+    const VectorizedField3 exact = problem.exact_vectorized ? problem.exact_vectorized : vectorize(problem.exact);
+    const GradientField3 exact_gradient = problem.exact_vectorized ? GradientField3{} : problem.exact_gradient;
+    const std::array<std::vector<double>, 3> x = coordinates(sol.gamma.point);
+    std::array<std::vector<double>, 3> du;
+    std::vector<double> u(sol.gamma.point.size());
+    exact(u.size(), x[0].data(), x[1].data(), x[2].data(), u.data());
+    gradient_at(exact, exact_gradient, 1e-6 * grid.box().width(0), x, du);
     PointErrors pe;
     for (int p = 0; p < m; ++p) {
-      const Point3 x = sol.gamma.point[p];
-      pe.max_trace = std::max(pe.max_trace, std::abs(sol.trace[p] - problem.exact(x.x, x.y, x.z)));
+      const Point3 n = sol.gamma.normal[p];
+      pe.max_trace = std::max(pe.max_trace, std::abs(sol.trace[p] - u[p]));
       pe.max_normal_derivative =
           std::max(pe.max_normal_derivative,
-                   std::abs(sol.normal_derivative[p] - dot(sol.gamma.normal[p], gradient(x.x, x.y, x.z))));
+                   std::abs(sol.normal_derivative[p] - (n.x * du[0][p] + n.y * du[1][p] + n.z * du[2][p])));
     }
     sol.point_errors = pe;
-    sol.errors = compute_errors(sol.u, grid, gamma, sol.gamma, sol.trace, problem.exact, gradient,
+    sol.errors = compute_errors(sol.u, grid, gamma, sol.gamma, sol.trace, exact, exact_gradient,
                                 options.error_quadrature, execution);
     clock.mark("errors");
   }

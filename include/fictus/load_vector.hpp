@@ -24,6 +24,13 @@ GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q = 2,
 /// 3-D: f_k = ∫_Ω f φ_k with the trilinear basis, q×q×q Gauss points per voxel (threaded over voxel
 /// layers; f must be thread-safe).
 using ScalarField3 = std::function<double(double x, double y, double z)>;
+/// A 3-D field on many points at once: out[k] = F(x[k], y[k], z[k]) for k < n (e.g. a numpy callable).
+/// Called with one batch per voxel row; must be thread-safe when threads > 1.
+using VectorizedField3 =
+    std::function<void(std::size_t n, const double* x, const double* y, const double* z, double* out)>;
+VectorizedField3 vectorize(ScalarField3 f);
 GridVector assemble_load(const Grid3& grid, const ScalarField3& f, int q = 2, const Execution& execution = Execution{});
+GridVector assemble_load(const Grid3& grid, const VectorizedField3& f, int q = 2,
+                         const Execution& execution = Execution{});
 
 }  // namespace fictus

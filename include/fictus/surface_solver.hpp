@@ -126,6 +126,8 @@ struct SurfaceProblem {
   ScalarField3 f, g;
   ScalarField3 exact;             // optional: errors
   GradientField3 exact_gradient;  // optional with exact (else central differences)
+  /// Optional batch forms (e.g. numpy callables), used instead of f, g and exact when set.
+  VectorizedField3 f_vectorized, g_vectorized, exact_vectorized;
 };
 
 /// Default patch size s (the side of a square of the patch's area) in cells: m = area/(s·h)².
@@ -184,6 +186,15 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
 using OmegaVisitor = std::function<void(int thread, const Grid3::Index& cell, const Point3& x, double weight)>;
 void for_each_omega_point(const Grid3& grid, const Surface& gamma, int q, const Execution& execution,
                           const OmegaVisitor& visit);
+/// The same points one voxel row (fixed y and z) at a time, for integrands evaluated in batches.
+struct OmegaPoint {
+  Grid3::Index cell;
+  Point3 x;
+  double weight;
+};
+using OmegaRowVisitor = std::function<void(int thread, const std::vector<OmegaPoint>& row)>;
+void for_each_omega_row(const Grid3& grid, const Surface& gamma, int q, const Execution& execution,
+                        const OmegaRowVisitor& visit);
 
 /// May γ come within `radius` of `center`? (|level| ≤ 2·radius·|∇level| there: the distance is about
 /// |level|/|∇level| near γ, with a factor 2 to spare.)
@@ -201,6 +212,10 @@ double omega_volume(const Grid3& grid, const Surface& gamma, int q = 3, const Ex
 /// (û − u)(x_p)²)^½, absolute and relative.
 ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,
                           const std::vector<double>& trace, const ScalarField3& exact,
+                          const GradientField3& exact_gradient, int q = 3, const Execution& execution = Execution{});
+/// The same with `exact` in batches (∇u by central differences in batches when no gradient is given).
+ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,
+                          const std::vector<double>& trace, const VectorizedField3& exact,
                           const GradientField3& exact_gradient, int q = 3, const Execution& execution = Execution{});
 
 }  // namespace fictus

@@ -261,9 +261,62 @@ def test_surface_problem_from_a_dict_and_its_errors():
     assert s.errors is None and 0 < np.count_nonzero(s.contact) < s.multipliers
     with pytest.raises(ValueError, match="geometry.radius"):
         fictus.SurfaceProblem(geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=-1), data=dict(f="1", g="0"))
-    with pytest.raises(ValueError, match="data.f: 3-D data are expressions"):
-        fictus.SurfaceProblem(geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.2),
-                              data=dict(f=lambda x, y, z: x, g="0"))
+    sphere = dict(domain=dict(N=32), geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.2),
+                  formulation=dict(variant="nonsmooth"))
+
+    def broken(x, y, z):
+        raise ZeroDivisionError("boom")
+    with pytest.raises(ValueError, match=r"^data.f: the callable failed: ZeroDivisionError: boom$"):
+        fictus.SurfaceProblem(**sphere, data=dict(f=broken, g="0")).solve()
+    with pytest.raises(ValueError, match="data.g: the callable failed: .*takes 2 positional arguments but 3"):
+        fictus.SurfaceProblem(**sphere, data=dict(f="1", g=lambda x, y: x)).solve()
+    with pytest.raises(ValueError, match="data.exact: the callable failed: the callable must return real numbers"):
+        fictus.SurfaceProblem(**sphere, data=dict(f="1", g="0", exact=lambda x, y, z: x + 0j)).solve()
+    with pytest.raises(ValueError, match="data.f: the callable failed: .*one number per point"):
+        fictus.SurfaceProblem(**sphere, data=dict(f=lambda x, y, z: x[:3], g="0")).solve()
+
+
+def numpy_function(text):
+    """A problem file's expression ("q0 = ..., q1 = ..., result": muParser syntax) as a numpy callable f(x, y, z)."""
+    parts, depth, start = [], 0, 0
+    for k, ch in enumerate(text):
+        depth += {"(": 1, ")": -1}.get(ch, 0)
+        if ch == "," and depth == 0:
+            parts.append(text[start:k])
+            start = k + 1
+    parts.append(text[start:])
+    code = [p.strip().replace("^", "**") for p in parts]
+    steps = [(line.split("=", 1)[0].strip(), compile(line.split("=", 1)[1].strip(), "data", "eval")) for line in code[:-1]]
+    result = compile(code[-1], "data", "eval")
+    names = dict(sin=np.sin, cos=np.cos, exp=np.exp, sqrt=np.sqrt, max=np.maximum)
+
+    def f(x, y, z):
+        scope = dict(names, x=x, y=y, z=z)
+        for name, value in steps:
+            scope[name] = eval(value, scope)
+        return eval(result, scope) + 0 * x
+    return f
+
+
+def test_surface_problem_with_numpy_callables_matches_expressions():
+    """3-D data as numpy callables f(x, y, z) give the numbers of the same data as expressions: the load,
+    g at the points and the errors (∇u by central differences in batches) all go through them."""
+    with open(os.path.join(EXAMPLES, "manufactured_sphere.toml")) as handle:
+        text = handle.read().replace("N = 80", "N = 48").replace('variant = "smooth"', 'variant = "nonsmooth"')
+    a = fictus.SurfaceProblem.from_toml(text).solve()
+    data = {}
+    for key in ("f", "g", "exact"):
+        line = next(line for line in text.splitlines() if line.startswith(key + " = "))
+        data[key] = numpy_function(line.split(" = ", 1)[1].strip().strip('"'))
+    b = fictus.SurfaceProblem(domain=dict(N=48), geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.3),
+                              formulation=dict(variant="nonsmooth"), data=data).solve()
+    assert b.multipliers == a.multipliers and b.iterations == a.iterations
+    np.testing.assert_allclose(b.lambda_, a.lambda_, rtol=1e-9, atol=1e-11)
+    np.testing.assert_array_equal(b.contact, a.contact)
+    np.testing.assert_allclose(b.u, a.u, rtol=0, atol=1e-11)
+    for key in ("rel_l2_omega", "rel_h1_omega", "rel_l2_gamma"):
+        assert b.errors[key] == pytest.approx(a.errors[key], rel=1e-6), key
+    assert a.errors["rel_l2_omega"] < 6e-4 and np.count_nonzero(a.contact) > 0.2 * a.multipliers
 
 
 def test_surface_from_numpy_arrays_solves_like_the_sphere():
