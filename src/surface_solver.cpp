@@ -581,7 +581,10 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
     clock.mark("green_table");
     FarFieldReport report;
     schur = std::make_unique<ExplicitSchur>(*green, B_gamma, C_gamma, loads, execution, direct,
-                                            options.far_field ? default_far_field_3d : FarField{}, &report);
+                                            !options.far_field                      ? FarField{}
+                                            : options.variant == Variant::nonsmooth ? default_far_field_3d_nonsmooth
+                                                                                    : default_far_field_3d,
+                                            &report);
     green.reset();
     if (report.far_pairs > 0) {
       sol.far_field = SurfaceSolution::FarFieldUse{report, 0};

@@ -133,8 +133,11 @@ struct SurfaceProblem {
 /// Default patch size s (the side of a square of the patch's area) in cells: m = area/(s·h)².
 inline constexpr double default_patch_cells_smooth_3d = 8.0;
 inline constexpr double default_patch_cells_nonsmooth_3d = 4.0;
-/// The far field of the 3-D explicit assembly (solver.far_field): chosen by measurement (docs/math.md).
+/// The far field of the 3-D explicit assembly (solver.far_field), chosen by measurement (docs/math.md):
+/// p = 6 where the columns are B_Γ's; p = 5 in the non-smooth variant, whose columns carry the kink
+/// rows (about 270 entries each) and make the exact blocks dearer.
 inline constexpr FarField default_far_field_3d{6, 2.0, 2};
+inline constexpr FarField default_far_field_3d_nonsmooth{5, 2.0, 2};
 /// Newton runs on S̃ until a step changes at most this fraction of the points (at least one), then
 /// on the exact S.
 inline constexpr double far_field_hand_on = 0.05;
