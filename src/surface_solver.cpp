@@ -294,22 +294,15 @@ double omega_volume(const Grid3& grid, const Surface& gamma, int q, const Execut
 
 namespace {
 
-/// û and ∇û of the trilinear function at x in `cell`.
-void sample_q1(const Grid3& grid, const GridVector& u, const Grid3::Index& cell, const Point3& x, double& value,
-               Point3& gradient) {
-  Point3 xi;
-  for (int d = 0; d < 3; ++d) xi[d] = (x[d] - grid.coordinate(d, cell[d])) / grid.h();
-  const Q1Element<3> element(xi, grid.h());
-  value = 0;
-  gradient = {};
+/// û at the eight nodes of `cell` (local node k as in Q1Element; 0 where a node has no unknown).
+std::array<double, 8> nodal_values(const Grid3& grid, const GridVector& u, const Grid3::Index& cell) {
+  std::array<double, 8> v;
   for (int k = 0; k < 8; ++k) {
     const Grid3::Index node{cell[0] + Q1Element<3>::offset(k, 0), cell[1] + Q1Element<3>::offset(k, 1),
                             cell[2] + Q1Element<3>::offset(k, 2)};
-    if (!grid.has_unknown(node)) continue;
-    const double uk = u[grid.index(node)];
-    value += uk * element.value[k];
-    gradient = gradient + uk * element.gradient(k);
+    v[std::size_t(k)] = grid.has_unknown(node) ? u[grid.index(node)] : 0.0;
   }
+  return v;
 }
 
 /// ∇u at the points: the given gradient, or central differences of u with step e (six batches).
@@ -380,10 +373,12 @@ ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surfac
     exact(n, b.x[0].data(), b.x[1].data(), b.x[2].data(), b.u.data());
     gradient_at(exact, exact_gradient, e, b.x, b.du);
     Sums& s = sums[thread];
+    std::array<double, 8> nodal{};
     for (std::size_t k = 0; k < n; ++k) {
-      double value;
-      Point3 slope;
-      sample_q1(grid, u_h, row[k].cell, row[k].x, value, slope);
+      if (k == 0 || row[k].cell != row[k - 1].cell) nodal = nodal_values(grid, u_h, row[k].cell);
+      Point3 xi;
+      for (int d = 0; d < 3; ++d) xi[d] = (row[k].x[d] - grid.coordinate(d, row[k].cell[d])) / grid.h();
+      const auto [value, slope] = Q1Element<3>::interpolate(nodal, xi, grid.h());
       const double u = b.u[k];
       const Point3 du{b.du[0][k], b.du[1][k], b.du[2][k]};
       const Point3 de = slope - du;

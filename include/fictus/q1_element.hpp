@@ -51,13 +51,33 @@ struct Q1Element {
   /// factorized 2-D form, for the loops that sample a grid function at many points.
   struct Sample {
     double value;
-    Point<2> gradient;
+    Point<dim> gradient;
   };
   static Sample interpolate(double u0, double u1, double u2, double u3, const Point<2>& xi,
                             double h) requires(dim == 2) {
     const double x = xi.x, y = xi.y;
     return {u0 * (1 - x) * (1 - y) + u1 * x * (1 - y) + u2 * (1 - x) * y + u3 * x * y,
             {((u1 - u0) * (1 - y) + (u3 - u2) * y) / h, ((u2 - u0) * (1 - x) + (u3 - u1) * x) / h}};
+  }
+  /// The same in 3-D from the nodal values u[k] (local node k as above), by nested linear
+  /// interpolation along x, then y, then z.
+  static Sample interpolate(const std::array<double, 8>& u, const Point<3>& xi, double h) requires(dim == 3) {
+    const double x = xi.x, y = xi.y, z = xi.z;
+    double a[2][2], dx[2][2];  // along x on the four edges (y, z) ∈ {0, 1}², and the edges' differences
+    for (int k = 0; k < 2; ++k)
+      for (int j = 0; j < 2; ++j) {
+        const double u0 = u[std::size_t(2 * j + 4 * k)], u1 = u[std::size_t(1 + 2 * j + 4 * k)];
+        a[k][j] = u0 + (u1 - u0) * x;
+        dx[k][j] = u1 - u0;
+      }
+    double b[2], ex[2], dy[2];  // along y on the two faces z ∈ {0, 1}
+    for (int k = 0; k < 2; ++k) {
+      b[k] = a[k][0] + (a[k][1] - a[k][0]) * y;
+      ex[k] = dx[k][0] + (dx[k][1] - dx[k][0]) * y;
+      dy[k] = a[k][1] - a[k][0];
+    }
+    return {b[0] + (b[1] - b[0]) * z,
+            {(ex[0] + (ex[1] - ex[0]) * z) / h, (dy[0] + (dy[1] - dy[0]) * z) / h, (b[1] - b[0]) / h}};
   }
   /// The offset of local node k along axis d (0 or 1).
   static int offset(int k, int d) { return (k >> d) & 1; }

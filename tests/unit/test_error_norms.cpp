@@ -2,6 +2,7 @@
 // norms of the polynomial itself, ∫_ω p², ∫_ω |∇p|², ∫_γ p², known in closed form.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -9,6 +10,7 @@
 #include "fictus/curve.hpp"
 #include "fictus/curve_grid_intersection.hpp"
 #include "fictus/error_norms.hpp"
+#include "fictus/q1_element.hpp"
 
 namespace {
 
@@ -82,3 +84,23 @@ TEST(ErrorNorms, ZeroForTheInterpolantOfABilinearFunction) {
 }
 
 }  // namespace
+
+TEST(Q1Element, FactorizedTrilinearSampleMatchesTheShapeFunctions) {
+  // The 3-D error integrals sample û by nested linear interpolation: the same value and gradient as
+  // Σ_k u_k φ_k and Σ_k u_k ∇φ_k, at corners, on faces and inside.
+  const std::array<double, 8> u{0.3, -1.2, 2.5, 0.7, -0.4, 1.9, 3.1, -2.2};
+  const double h = 0.125;
+  for (const fictus::Point3 xi : {fictus::Point3{0, 0, 0}, fictus::Point3{1, 1, 1}, fictus::Point3{0.25, 0.5, 0.75},
+                                  fictus::Point3{0.9, 0.1, 0.0}, fictus::Point3{0.33, 1.0, 0.61}}) {
+    const fictus::Q1Element<3> element(xi, h);
+    double value = 0;
+    fictus::Point3 gradient{};
+    for (int k = 0; k < 8; ++k) {
+      value += u[std::size_t(k)] * element.value[std::size_t(k)];
+      gradient = gradient + u[std::size_t(k)] * element.gradient(k);
+    }
+    const auto sample = fictus::Q1Element<3>::interpolate(u, xi, h);
+    EXPECT_NEAR(sample.value, value, 1e-14);
+    for (int d = 0; d < 3; ++d) EXPECT_NEAR(sample.gradient[d], gradient[d], 1e-13) << "axis " << d;
+  }
+}
