@@ -21,14 +21,15 @@ constexpr double two_pi = 2.0 * std::numbers::pi;
 /// The point of the curve nearest to x (Newton on (p(t) − x)·p′(t) = 0 from t0, a few steps:
 /// x is within a cell or two of the curve) and the kink function q(d)⁺ there.
 struct Kink {
-  double t = 0.0;                                               // parameter of the nearest point, in [0, 2π)
-  double d = 0.0;                                               // signed distance, > 0 outside ω
-  double kappa = 0.0;                                           // curvature there
-  Point2 normal;                                                // outward unit normal there
-  Point2 foot;                                                  // the nearest point itself
-  double q() const { return d - 0.5 * kappa * d * d; }          // ψ outside ω, extended smoothly inside
-  double psi() const { return d > 0 ? q() : 0.0; }              // q(d)⁺
-  Point2 grad_q() const { return (1.0 - kappa * d) * normal; }  // ∇q (d small)
+  double t = 0.0;      // parameter of the nearest point, in [0, 2π)
+  double d = 0.0;      // signed distance, > 0 outside ω
+  double kappa = 0.0;  // curvature there
+  Point2 normal;       // outward unit normal there
+  Point2 foot;         // the nearest point itself
+  /// ψ outside ω, extended smoothly inside: q(d) = d − κd²/2 + κ²d³/3, with Δq = O(d²) (math.md).
+  double q() const { return d * (1.0 + d * (-0.5 * kappa + d * kappa * kappa / 3.0)); }
+  double psi() const { return d > 0 ? q() : 0.0; }                                     // q(d)⁺
+  Point2 grad_q() const { return (1.0 + d * (-kappa + d * kappa * kappa)) * normal; }  // q′(d)·n
 };
 
 double wrap(double t) {

@@ -3,7 +3,7 @@
 //
 // With multipliers on γ itself, û has a jump λ in its normal derivative across γ. Near γ write
 //   û = w − Σ_j λ_j ψ_j,   ψ_j = q(d)⁺ on the part of a band around γ that projects onto arc j,
-// with d the signed distance to γ (> 0 outside ω), q(d) = d − κd²/2 and w smooth across γ. The
+// with d the signed distance to γ (> 0 outside ω), q(d) = d − κd²/2 + κ²d³/3 and w smooth across γ. The
 // inside traces of û are those of w, which a centered stencil reproduces. Two corrections relate
 // the Q1 nodal values û_h to I_h w:
 //   I_h w ≈ û_h + Σ_j λ_j (I_hψ_j + A⁻¹ r_j),   r_j,k = a(ψ_j − I_hψ_j, φ_k),
