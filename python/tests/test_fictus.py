@@ -354,7 +354,7 @@ def test_surface_from_numpy_arrays_solves_like_the_sphere():
 
 
 def test_ctrl_c_stops_a_3d_solve():
-    """3-D: SIGINT during a solve (here the non-smooth variant at N = 128, about 12 s uninterrupted) raises
+    """3-D: SIGINT during a solve (here the non-smooth variant at N = 128, about 10 s uninterrupted) raises
     KeyboardInterrupt within a second, in the load (0.3 s) and in the kink correction (2.5 s)."""
     import signal
     geometry = dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.3)
