@@ -94,6 +94,15 @@ void CallbackErrors::raise_if_any() {
   if (!message.empty()) throw std::invalid_argument(message);
 }
 
+bool CallbackErrors::interrupt_requested() {
+  {
+    std::lock_guard lock(mutex);
+    if (interrupted) return true;
+  }
+  py::gil_scoped_acquire gil;
+  return PyErr_CheckSignals() != 0;
+}
+
 namespace {
 
 /// The callable, released under the GIL whenever the last copy of a field holding it goes.
@@ -108,6 +117,13 @@ std::shared_ptr<py::function> hold(py::function fn) {
 /// records the error in `errors` and returns NaN.
 void call_batch(const py::function& fn, const std::string& key, CallbackErrors& errors, std::size_t n,
                 std::initializer_list<const double*> coordinates, double* out) {
+  {  // after a failure or Ctrl-C in a callable, the solve only runs on to its next interruption check
+    std::lock_guard lock(errors.mutex);
+    if (errors.interrupted || !errors.message.empty()) {
+      std::fill(out, out + n, std::nan(""));
+      return;
+    }
+  }
   py::gil_scoped_acquire gil;
   std::string failure;
   try {

@@ -21,6 +21,9 @@ struct CallbackErrors {
 
   /// Raises what a callable raised: KeyboardInterrupt, or ValueError with `message`; else nothing.
   void raise_if_any();
+  /// The solver's interruption check: Ctrl-C seen by Python, or a KeyboardInterrupt raised inside a
+  /// callable (which consumed the signal). Takes the GIL; never holds the mutex and the GIL together.
+  bool interrupt_requested();
 };
 
 /// A numpy callable fn(x, y, z) -> array as a batch field; errors go to `errors` (the field returns NaN).

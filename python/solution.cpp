@@ -27,10 +27,7 @@ PySolution PyProblem::solve(bool field) {
     FictitiousDomainSolver solver(problem, spec.options);
     // Ctrl-C: Python's handler runs in PyErr_CheckSignals (this thread, under the GIL) and leaves
     // KeyboardInterrupt set; the solve stops at its next check.
-    solver.set_interrupt_check([] {
-      py::gil_scoped_acquire gil;
-      return PyErr_CheckSignals() != 0;
-    });
+    solver.set_interrupt_check([errors] { return errors->interrupt_requested(); });
     py::gil_scoped_release release;
     solution = std::make_shared<const Solution>(solver.solve(problem, spec.options, field));
   } catch (const Interrupted&) {

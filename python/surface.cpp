@@ -77,7 +77,9 @@ struct PySurfaceProblem {
           key != "output")
         throw std::invalid_argument(key + ": unknown section (domain, geometry, formulation, data, solver, output)");
       if (!py::isinstance<py::dict>(v)) throw std::invalid_argument(key + ": expected a dict");
-      sections[py::str(key)] = py::dict(v.cast<py::dict>());
+      py::dict copy;  // the caller's dict stays as it was (callables are replaced by placeholders below)
+      for (auto [kk, vv] : v.cast<py::dict>()) copy[kk] = vv;
+      sections[py::str(key)] = copy;
     }
     if (!sections.contains("domain")) sections["domain"] = py::dict();
     py::dict domain = sections["domain"];
@@ -131,10 +133,7 @@ PySurfaceSolution solve(const PySurfaceProblem& p) {
   try {
     // Ctrl-C: Python's handler runs in PyErr_CheckSignals (this thread, under the GIL) and leaves
     // KeyboardInterrupt set; the solve stops at its next check.
-    const auto interrupt = [] {
-      py::gil_scoped_acquire gil;
-      return PyErr_CheckSignals() != 0;
-    };
+    const auto interrupt = [errors] { return errors->interrupt_requested(); };
     py::gil_scoped_release release;
     solution = std::make_shared<const SurfaceSolution>(fictus::solve(problem, p.spec.options, {}, interrupt));
   } catch (const Interrupted&) {

@@ -29,7 +29,7 @@ struct Kink {
   /// ψ outside ω, extended smoothly inside: q(d) = d − κd²/2 + κ²d³/3, with Δq = O(d²) (math.md).
   double q() const { return d * (1.0 + d * (-0.5 * kappa + d * kappa * kappa / 3.0)); }
   double psi() const { return d > 0 ? q() : 0.0; }                                     // q(d)⁺
-  Point2 grad_q() const { return (1.0 + d * (-kappa + d * kappa * kappa)) * normal; }  // q′(d)·n
+  Point2 grad_q() const { return (1.0 + d * (-kappa + d * kappa * kappa)) * normal; }  // q′(d)·n, κ constant
 };
 
 double wrap(double t) {

@@ -666,7 +666,7 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   // 8. Errors.
   if (problem.exact || problem.exact_vectorized) {
     const VectorizedField3 exact = problem.exact_vectorized ? problem.exact_vectorized : vectorize(problem.exact);
-    const GradientField3 exact_gradient = problem.exact_vectorized ? GradientField3{} : problem.exact_gradient;
+    const GradientField3& exact_gradient = problem.exact_gradient;
     const std::array<std::vector<double>, 3> x = coordinates(sol.gamma.point);
     std::array<std::vector<double>, 3> du;
     std::vector<double> u(sol.gamma.point.size());

@@ -276,6 +276,40 @@ def test_surface_problem_from_a_dict_and_its_errors():
         fictus.SurfaceProblem(**sphere, data=dict(f=lambda x, y, z: x[:3], g="0")).solve()
 
 
+def test_surface_problem_leaves_the_callers_dicts_alone():
+    """Callables are replaced by placeholders in a copy: the same data dict builds a second problem."""
+    data = dict(f=lambda x, y, z: 10 * (x - 0.5), g="0.05 * sin(3 * z)")
+    geometry = dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.2)
+    first = fictus.SurfaceProblem(domain=dict(N=32), geometry=geometry, formulation=dict(variant="nonsmooth"), data=data)
+    assert callable(data["f"]) and "dim" not in geometry
+    second = fictus.SurfaceProblem.from_dict(dict(domain=dict(N=32), geometry=geometry,
+                                                  formulation=dict(variant="nonsmooth"), data=data))
+    np.testing.assert_array_equal(first.solve().lambda_, second.solve().lambda_)
+    assert np.count_nonzero(second.solve().contact) > 0
+
+
+def test_ctrl_c_inside_a_3d_callable_stops_the_solve():
+    """SIGINT while a callable runs raises KeyboardInterrupt inside it: the solve stops at its next check
+    (here within the load, about 4 s uninterrupted) and calls no more Python."""
+    import signal
+    calls = []
+
+    def slow(x, y, z):
+        calls.append(len(x))
+        time.sleep(0.001)
+        return x * 0 + 1.0
+    p = fictus.SurfaceProblem(domain=dict(N=64), geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.3),
+                              formulation=dict(variant="nonsmooth"), data=dict(f=slow, g="1"), solver=dict(threads=2))
+    start = time.perf_counter()
+    threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+    with pytest.raises(KeyboardInterrupt):
+        p.solve()
+    assert time.perf_counter() - start < 1.5
+    made = len(calls)
+    time.sleep(0.2)
+    assert len(calls) == made and made < 64 * 64
+
+
 def numpy_function(text):
     """A problem file's expression ("q0 = ..., q1 = ..., result": muParser syntax) as a numpy callable f(x, y, z)."""
     parts, depth, start = [], 0, 0
