@@ -270,7 +270,8 @@ json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& s) 
   j["newton"] = newton_json(s.newton);
   j["inner"] = {{"solver", to_string(s.options.inner)},
                 {"fast_solves", s.fast_solves},
-                {"krylov_iterations", s.inner_iterations}};
+                {"krylov_iterations", s.inner_iterations},
+                {"factorizations", s.factorizations}};
   if (s.far_field) {
     const FarFieldReport& a = s.far_field->assembly;
     j["inner"]["far_field"] = {{"far_fraction", a.far_pairs / (a.far_pairs + a.near_pairs)},

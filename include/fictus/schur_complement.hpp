@@ -120,6 +120,41 @@ class ImplicitSchur final : public SchurComplement {
   mutable std::size_t fast_solves_ = 0;
 };
 
+/// Solves with the Newton matrices S_𝒜 of one pair (S_B, S_C), keeping the LU of the last one factored.
+/// S_𝒜 differs from the factored S_𝒜₀ in the k rows where 𝒜 and 𝒜₀ differ: S_𝒜 = S_𝒜₀ + E Vᵀ, E the
+/// unit vectors of those rows, Vᵀ their differences (±(S_B − S_C) rows, and the bordering column). While
+/// k ≤ update_fraction·m, S_𝒜⁻¹ comes from that LU by the Sherman–Morrison–Woodbury formula
+///   S_𝒜⁻¹ r = y − Z (I + Vᵀ Z)⁻¹ Vᵀ y,   y = S_𝒜₀⁻¹ r,   Z = S_𝒜₀⁻¹ E,
+/// at 2m²k + O(mk²) flops against the LU's 2m³/3; beyond, S_𝒜 is factored anew and becomes S_𝒜₀.
+/// Newton's later steps change a few rows, so most of its solves avoid the LU (docs/math.md).
+class NewtonFactorization {
+ public:
+  /// The fraction of rows an update may change (its setup costs 3k/m of an LU).
+  static constexpr double update_fraction = 0.125;
+  NewtonFactorization(const Eigen::MatrixXd& S_B, const Eigen::MatrixXd& S_C) : S_B_(S_B), S_C_(S_C) {}
+  /// Makes `solve` that of S_𝒜 (bordered by `mode` when given).
+  void prepare(const ActiveSet& active, const ConstantMode* mode);
+  /// S_𝒜⁻¹ r for the prepared 𝒜 (through an update: refined once, to the round-off of an LU).
+  Eigen::VectorXd solve(const Eigen::VectorXd& r) const;
+  /// Whether the prepared S_𝒜 is solved through an update (else by its own LU).
+  bool updated() const { return !rows_.empty(); }
+  int factorizations() const { return factorizations_; }
+
+ private:
+  void factor(const ActiveSet& active, const ConstantMode* mode);
+  Eigen::VectorXd update_solve(const Eigen::VectorXd& r) const;  // the formula alone
+  const Eigen::MatrixXd &S_B_, &S_C_;
+  Eigen::MatrixXd factored_;                                            // S_𝒜₀, overwritten by its LU
+  std::optional<Eigen::PartialPivLU<Eigen::Ref<Eigen::MatrixXd>>> lu_;  // in place: no second m × m
+  ActiveSet base_;                                                      // 𝒜₀; empty: nothing factored
+  ActiveSet active_;                                                    // 𝒜 (with an update)
+  std::optional<ConstantMode> mode_;                                    // the bordering of S_𝒜₀
+  std::vector<Eigen::Index> rows_;                                      // where 𝒜 differs from 𝒜₀
+  Eigen::MatrixXd Z_, V_;                             // S_𝒜₀⁻¹ E and V (columns per changed row)
+  Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_;  // I + Vᵀ Z
+  int factorizations_ = 0;
+};
+
 class ExplicitSchur final : public SchurComplement {
  public:
   /// Assembles S_B and S_C from the Green's table (threaded over blocks of rows and columns; the far
@@ -130,6 +165,8 @@ class ExplicitSchur final : public SchurComplement {
                 const FarField& far_field = {}, FarFieldReport* report = nullptr);
   /// From given blocks (tests).
   ExplicitSchur(Eigen::MatrixXd S_B, Eigen::MatrixXd S_C) : S_B_(std::move(S_B)), S_C_(std::move(S_C)) {}
+  ExplicitSchur(const ExplicitSchur&) = delete;  // factorization_ refers to the blocks
+  ExplicitSchur& operator=(const ExplicitSchur&) = delete;
   int size() const override { return int(S_B_.rows()); }
   void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override;
   LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
@@ -140,9 +177,17 @@ class ExplicitSchur final : public SchurComplement {
   const Eigen::MatrixXd& S_C() const { return S_C_; }
   /// S_𝒜: row i of S_B (i ∈ 𝒜) or of S_C, bordered by `mode` when given.
   Eigen::MatrixXd newton_matrix(const ActiveSet& active, const ConstantMode* mode = nullptr) const;
+  /// y = S_𝒜 x without forming S_𝒜.
+  void apply_newton(const ActiveSet& active, const ConstantMode* mode, const Eigen::VectorXd& x,
+                    Eigen::VectorXd& y) const;
+  /// The solver of S_𝒜, kept between calls (NewtonFactorization); valid until the next call.
+  const NewtonFactorization& factorization(const ActiveSet& active, const ConstantMode* mode) const;
+  /// LU factorizations so far.
+  int factorizations() const { return factorization_.factorizations(); }
 
  private:
   Eigen::MatrixXd S_B_, S_C_;
+  mutable NewtonFactorization factorization_{S_B_, S_C_};
 };
 
 /// The exact S with the interpolated one as its preconditioner: `apply` is the exact S (one fast

@@ -160,6 +160,7 @@ struct SurfaceSolution {
   NewtonResult newton;
   std::size_t fast_solves = 0;
   int inner_iterations = 0;
+  int factorizations = 0;  // dense LUs of Newton matrices (green; the others by updates, NewtonFactorization)
   /// With solver.far_field: what the assembly interpolated, and the Newton steps run on the exact S
   /// (preconditioned by S̃) after those on S̃ (all counted in newton.iterations).
   struct FarFieldUse {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "fictus/fictitious_domain_solver.hpp"
@@ -140,3 +141,55 @@ TEST(SemismoothNewton, SolvesASmallVariationalInequalityWithAKnownAnswer) {
 }
 
 }  // namespace
+
+// The kept LU with low-rank updates (NewtonFactorization) against a fresh LU of each S_𝒜: a sequence
+// of active sets that changes a few rows of the factored one (solved through the update), more than
+// update_fraction of them (factored anew), and back; with and without the bordering of c = 0.
+TEST(NewtonFactorization, UpdatesSolveAsAFreshLu) {
+  const int m = 200;
+  Eigen::MatrixXd S_B(m, m), S_C(m, m);
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      S_B(i, j) = (i == j ? 4.0 : 0.0) + std::sin(0.37 * i + 1.3 * j) / (1.0 + std::abs(i - j));
+      S_C(i, j) = (i == j ? 3.0 : 0.0) + std::cos(0.11 * i - 0.7 * j) / (1.0 + std::abs(i - j));
+    }
+  fictus::ConstantMode mode;
+  mode.trace_B = Eigen::VectorXd::LinSpaced(m, 1.0, 2.0);
+  mode.trace_C = Eigen::VectorXd::LinSpaced(m, -0.5, 0.5);
+  mode.arc_weights = Eigen::VectorXd::Constant(m, 1.0 / m);
+  const fictus::ExplicitSchur schur(S_B, S_C);
+  const int cap = int(fictus::NewtonFactorization::update_fraction * m);  // 25 rows
+  for (const fictus::ConstantMode* bordering : std::array<const fictus::ConstantMode*, 2>{nullptr, &mode}) {
+    const int before = schur.factorizations();
+    fictus::ActiveSet base(m, 1);
+    for (int i = 0; i < m; i += 3) base[i] = 0;
+    const std::vector<int> sequence = {0, 1, 10, cap, cap + 1, cap + 1, 0};  // rows flipped against `base`
+    int expected_factorizations = 0;
+    bool was_updated = false;
+    fictus::ActiveSet factored;
+    for (const int flips : sequence) {
+      fictus::ActiveSet active = base;
+      for (int k = 0; k < flips; ++k) active[(7 * k + 3) % m] ^= 1;
+      const fictus::NewtonFactorization& f = schur.factorization(active, bordering);
+      // An LU happens at the first call and whenever the set is too far from the factored one.
+      int differ = 0;
+      for (int i = 0; i < m && !factored.empty(); ++i) differ += active[i] != factored[i];
+      if (factored.empty() || differ > cap) ++expected_factorizations, factored = active;
+      EXPECT_EQ(schur.factorizations() - before, expected_factorizations) << flips << " flips";
+      EXPECT_EQ(f.updated(), differ > 0 && differ <= cap) << flips << " flips";
+      was_updated = was_updated || f.updated();
+      const Eigen::MatrixXd S = schur.newton_matrix(active, bordering);
+      const Eigen::VectorXd r = Eigen::VectorXd::LinSpaced(S.rows(), -1.0, 3.0);
+      const Eigen::VectorXd x = f.solve(r), fresh = S.partialPivLu().solve(r);
+      EXPECT_LE((x - fresh).norm(), 1e-12 * fresh.norm()) << flips << " flips";
+      Eigen::VectorXd y;
+      schur.apply_newton(active, bordering, x, y);  // S_𝒜 x without forming S_𝒜
+      EXPECT_LE((y - S * x).norm(), 1e-13 * (S * x).norm());
+    }
+    EXPECT_TRUE(was_updated);
+    // Another bordering is another matrix: factored anew (all active: far from the next round's sets).
+    const int now = schur.factorizations();
+    schur.factorization(fictus::ActiveSet(m, 1), bordering ? nullptr : &mode);
+    EXPECT_EQ(schur.factorizations(), now + 1);
+  }
+}
