@@ -110,20 +110,42 @@ void NewtonFactorization::prepare(const ActiveSet& active, const ConstantMode* m
     if (active[i] != base_[i]) rows.push_back(i);
   if (rows == rows_) return;  // prepared already
   if (double(rows.size()) > update_fraction * double(m)) return factor(active, mode);
+  // Z's column of a row depends on the row alone (S_𝒜₀⁻¹e_i): keep those of rows already changed, solve
+  // for the new ones only.
+  const Eigen::Index k = Eigen::Index(rows.size());
+  Eigen::MatrixXd Z(n, k);
+  std::vector<Eigen::Index> fresh;  // columns of Z to solve for
+  for (Eigen::Index j = 0, p = 0; j < k; ++j) {
+    while (p < Eigen::Index(rows_.size()) && rows_[std::size_t(p)] < rows[std::size_t(j)]) ++p;
+    if (p < Eigen::Index(rows_.size()) && rows_[std::size_t(p)] == rows[std::size_t(j)])
+      Z.col(j) = Z_.col(p);
+    else
+      fresh.push_back(j);
+  }
   rows_ = std::move(rows);
   active_ = active;
+  Z_ = std::move(Z);
   if (rows_.empty()) return;
-  const Eigen::Index k = Eigen::Index(rows_.size());
-  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, k);
   V_.resize(n, k);
   for (Eigen::Index j = 0; j < k; ++j) {
-    const Eigen::Index i = rows_[j];
+    const Eigen::Index i = rows_[std::size_t(j)];
     const double sign = active[i] ? 1.0 : -1.0;  // S_B's row replaces S_C's, or the reverse
-    E(i, j) = 1.0;
     V_.col(j).head(m) = sign * (S_B_.row(i) - S_C_.row(i)).transpose();
     if (mode) V_(m, j) = sign * (mode->trace_B(i) - mode->trace_C(i));
   }
-  Z_ = lu_->solve(E);
+  // The new columns by blocks on the threads (Eigen's triangular solves keep to one).
+  const Eigen::Index f = Eigen::Index(fresh.size());
+  const int threads = std::max(1, Eigen::nbThreads());
+  const Eigen::Index width = (f + threads - 1) / threads;
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int t = 0; t < threads; ++t) {
+    const Eigen::Index begin = std::min(f, t * width), end = std::min(f, begin + width);
+    if (begin == end) continue;
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, end - begin);
+    for (Eigen::Index j = begin; j < end; ++j) E(rows_[std::size_t(fresh[std::size_t(j)])], j - begin) = 1.0;
+    const Eigen::MatrixXd solved = lu_->solve(E);
+    for (Eigen::Index j = begin; j < end; ++j) Z_.col(fresh[std::size_t(j)]) = solved.col(j - begin);
+  }
   capacitance_.compute(Eigen::MatrixXd::Identity(k, k) + V_.transpose() * Z_);
 }
 

@@ -125,7 +125,8 @@ class ImplicitSchur final : public SchurComplement {
 /// unit vectors of those rows, Vᵀ their differences (±(S_B − S_C) rows, and the bordering column). While
 /// k ≤ update_fraction·m, S_𝒜⁻¹ comes from that LU by the Sherman–Morrison–Woodbury formula
 ///   S_𝒜⁻¹ r = y − Z (I + Vᵀ Z)⁻¹ Vᵀ y,   y = S_𝒜₀⁻¹ r,   Z = S_𝒜₀⁻¹ E,
-/// at 2m²k + O(mk²) flops against the LU's 2m³/3; beyond, S_𝒜 is factored anew and becomes S_𝒜₀.
+/// at 2m²k + O(mk²) flops against the LU's 2m³/3 (Z's columns are kept for the rows that stay changed:
+/// only the newly changed rows cost a solve); beyond, S_𝒜 is factored anew and becomes S_𝒜₀.
 /// Newton's later steps change a few rows, so most of its solves avoid the LU (docs/math.md).
 class NewtonFactorization {
  public:
