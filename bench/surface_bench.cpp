@@ -82,8 +82,9 @@ int main(int argc, char** argv) {
         "∂²u/∂n² ≠ 0 on the free part), default m (patches of 8h smooth, 4h non-smooth) and δ = 1.5 s; one run per "
         "row; peak memory: see the end of the report\n\n";
 
-  // The non-smooth variant stops at N = 256: with patches of 4h its m is 18500 at N = 512, where the
-  // dense Newton matrices (2.7 GB each) and their LU (minutes per Newton step) would dominate.
+  // The non-smooth variant stops at N = 256: with patches of 4h its m is 18 530 at N = 512, where the
+  // dense Newton matrices (2.7 GB each) and their LUs (about 160 s each) make a 20-minute run
+  // (docs/math.md, the measured table of "The far field of the 3-D Schur complement").
   for (const fictus::Variant variant : {fictus::Variant::smooth, fictus::Variant::nonsmooth}) {
     const bool smooth = variant == fictus::Variant::smooth;
     md << (smooth ? "## End to end, smooth variant, green inner solver\n\n"
