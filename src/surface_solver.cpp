@@ -635,6 +635,8 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   }
   sol.fast_solves += schur->fast_solves();
   if (const auto* dense = dynamic_cast<const ExplicitSchur*>(schur.get())) sol.factorizations = dense->factorizations();
+  schur.reset();  // S_B, S_C and the kept LU (3m² doubles): freed before the field and the errors
+  exact.reset();
   for (const NewtonStep& step : sol.newton.history) sol.inner_iterations += step.inner_iterations;
   sol.lambda.assign(sol.newton.lambda.data(), sol.newton.lambda.data() + m);
   sol.lambda_total = row_sums(B_Gamma).dot(sol.newton.lambda);

@@ -133,6 +133,10 @@ class NewtonFactorization {
   /// The fraction of rows an update may change (its setup costs 3k/m of an LU).
   static constexpr double update_fraction = 0.125;
   NewtonFactorization(const Eigen::MatrixXd& S_B, const Eigen::MatrixXd& S_C) : S_B_(S_B), S_C_(S_C) {}
+  NewtonFactorization(Eigen::MatrixXd&&, const Eigen::MatrixXd&) = delete;  // keeps references to the blocks
+  NewtonFactorization(const Eigen::MatrixXd&, Eigen::MatrixXd&&) = delete;
+  NewtonFactorization(const NewtonFactorization&) = delete;  // the LU refers to factored_ in place
+  NewtonFactorization& operator=(const NewtonFactorization&) = delete;
   /// Makes `solve` that of S_𝒜 (bordered by `mode` when given).
   void prepare(const ActiveSet& active, const ConstantMode* mode);
   /// S_𝒜⁻¹ r for the prepared 𝒜 (through an update: refined once, to the round-off of an LU).
@@ -181,7 +185,8 @@ class ExplicitSchur final : public SchurComplement {
   /// y = S_𝒜 x without forming S_𝒜.
   void apply_newton(const ActiveSet& active, const ConstantMode* mode, const Eigen::VectorXd& x,
                     Eigen::VectorXd& y) const;
-  /// The solver of S_𝒜, kept between calls (NewtonFactorization); valid until the next call.
+  /// The solver of S_𝒜, kept between calls (NewtonFactorization); valid until the next call. `solve`
+  /// and this change that kept state: one ExplicitSchur serves one thread.
   const NewtonFactorization& factorization(const ActiveSet& active, const ConstantMode* mode) const;
   /// LU factorizations so far.
   int factorizations() const { return factorization_.factorizations(); }
@@ -193,9 +198,9 @@ class ExplicitSchur final : public SchurComplement {
 
 /// The exact S with the interpolated one as its preconditioner: `apply` is the exact S (one fast
 /// solve, ImplicitSchur), `solve` runs GMRES on the exact S_𝒜 right-preconditioned by the LU of
-/// S̃_𝒜 (ExplicitSchur with a far field), to `options`' tolerance. Newton runs first on S̃ alone (no
-/// fast solve), then on this from where it ended: the answer is that of the exact S, the cost a
-/// few fast solves.
+/// S̃_𝒜 (ExplicitSchur with a far field: its kept LU or an update of it), to `options`' tolerance. Newton runs first on
+/// S̃ alone (no fast solve), then on this from where it ended: the answer is that of the exact S, the cost a few fast
+/// solves.
 class PreconditionedSchur final : public SchurComplement {
  public:
   PreconditionedSchur(const ExplicitSchur& approximate, const ImplicitSchur& exact, const GmresOptions& options)

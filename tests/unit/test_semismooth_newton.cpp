@@ -143,8 +143,10 @@ TEST(SemismoothNewton, SolvesASmallVariationalInequalityWithAKnownAnswer) {
 }  // namespace
 
 // The kept LU with low-rank updates (NewtonFactorization) against a fresh LU of each S_𝒜: a sequence
-// of active sets that changes a few rows of the factored one (solved through the update), more than
-// update_fraction of them (factored anew), and back; with and without the bordering of c = 0.
+// of active sets that changes a few rows of the factored one (solved through the update, which keeps
+// the columns of rows changed before), more than update_fraction of them (factored anew), and back;
+// with and without the bordering of c = 0. (The refinement would hide an update wrong by 1e-6, not
+// a wrong column or sign.)
 TEST(NewtonFactorization, UpdatesSolveAsAFreshLu) {
   const int m = 200;
   Eigen::MatrixXd S_B(m, m), S_C(m, m);
@@ -163,25 +165,42 @@ TEST(NewtonFactorization, UpdatesSolveAsAFreshLu) {
     const int before = schur.factorizations();
     fictus::ActiveSet base(m, 1);
     for (int i = 0; i < m; i += 3) base[i] = 0;
-    const std::vector<int> sequence = {0, 1, 10, cap, cap + 1, cap + 1, 0};  // rows flipped against `base`
+    const auto flipped = [&](const std::vector<int>& rows) {
+      fictus::ActiveSet active = base;
+      for (const int i : rows) active[std::size_t(i)] ^= 1;
+      return active;
+    };
+    const auto first_rows = [&](int count) {  // rows 3, 10, 17, …
+      std::vector<int> rows;
+      for (int k = 0; k < count; ++k) rows.push_back((7 * k + 3) % m);
+      return rows;
+    };
+    std::vector<int> far = first_rows(cap + 5), far_and_more = far;
+    far_and_more.insert(far_and_more.end(), {150, 151, 190});
+    // The rows flipped against `base`, step by step: 1, 10, cap (updates, each keeping the earlier rows'
+    // columns), a set whose kept columns move ({3, 10, 17} → {10, 17, 24} → {10}), back to the base,
+    // the same set twice, cap + 1 and cap + 5 (factored anew), and updates from that new base.
+    const std::vector<std::vector<int>> sequence = {
+        {}, first_rows(1), first_rows(10), first_rows(cap),     {3, 10, 17}, {10, 17, 24}, {10},
+        {}, {10},          {10},           first_rows(cap + 1), far,         far_and_more, first_rows(cap + 1),
+        {}};
     int expected_factorizations = 0;
     bool was_updated = false;
     fictus::ActiveSet factored;
-    for (const int flips : sequence) {
-      fictus::ActiveSet active = base;
-      for (int k = 0; k < flips; ++k) active[(7 * k + 3) % m] ^= 1;
+    for (std::size_t step = 0; step < sequence.size(); ++step) {
+      const fictus::ActiveSet active = flipped(sequence[step]);
       const fictus::NewtonFactorization& f = schur.factorization(active, bordering);
       // An LU happens at the first call and whenever the set is too far from the factored one.
       int differ = 0;
-      for (int i = 0; i < m && !factored.empty(); ++i) differ += active[i] != factored[i];
-      if (factored.empty() || differ > cap) ++expected_factorizations, factored = active;
-      EXPECT_EQ(schur.factorizations() - before, expected_factorizations) << flips << " flips";
-      EXPECT_EQ(f.updated(), differ > 0 && differ <= cap) << flips << " flips";
+      for (int i = 0; i < m && !factored.empty(); ++i) differ += active[std::size_t(i)] != factored[std::size_t(i)];
+      if (factored.empty() || differ > cap) ++expected_factorizations, factored = active, differ = 0;
+      EXPECT_EQ(schur.factorizations() - before, expected_factorizations) << "step " << step;
+      EXPECT_EQ(f.updated(), differ > 0) << "step " << step;
       was_updated = was_updated || f.updated();
       const Eigen::MatrixXd S = schur.newton_matrix(active, bordering);
       const Eigen::VectorXd r = Eigen::VectorXd::LinSpaced(S.rows(), -1.0, 3.0);
       const Eigen::VectorXd x = f.solve(r), fresh = S.partialPivLu().solve(r);
-      EXPECT_LE((x - fresh).norm(), 1e-12 * fresh.norm()) << flips << " flips";
+      EXPECT_LE((x - fresh).norm(), 1e-12 * fresh.norm()) << "step " << step;
       Eigen::VectorXd y;
       schur.apply_newton(active, bordering, x, y);  // S_𝒜 x without forming S_𝒜
       EXPECT_LE((y - S * x).norm(), 1e-13 * (S * x).norm());
