@@ -16,6 +16,7 @@
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 
+#include "fictus/dense_lu.hpp"
 #include "fictus/fast_solver.hpp"
 #include "fictus/gmres.hpp"
 #include "fictus/green_table.hpp"
@@ -135,7 +136,7 @@ class NewtonFactorization {
   NewtonFactorization(const Eigen::MatrixXd& S_B, const Eigen::MatrixXd& S_C) : S_B_(S_B), S_C_(S_C) {}
   NewtonFactorization(Eigen::MatrixXd&&, const Eigen::MatrixXd&) = delete;  // keeps references to the blocks
   NewtonFactorization(const Eigen::MatrixXd&, Eigen::MatrixXd&&) = delete;
-  NewtonFactorization(const NewtonFactorization&) = delete;  // the LU refers to factored_ in place
+  NewtonFactorization(const NewtonFactorization&) = delete;
   NewtonFactorization& operator=(const NewtonFactorization&) = delete;
   /// Makes `solve` that of S_𝒜 (bordered by `mode` when given).
   void prepare(const ActiveSet& active, const ConstantMode* mode);
@@ -149,12 +150,11 @@ class NewtonFactorization {
   void factor(const ActiveSet& active, const ConstantMode* mode);
   Eigen::VectorXd update_solve(const Eigen::VectorXd& r) const;  // the formula alone
   const Eigen::MatrixXd &S_B_, &S_C_;
-  Eigen::MatrixXd factored_;                                            // S_𝒜₀, overwritten by its LU
-  std::optional<Eigen::PartialPivLU<Eigen::Ref<Eigen::MatrixXd>>> lu_;  // in place: no second m × m
-  ActiveSet base_;                                                      // 𝒜₀; empty: nothing factored
-  ActiveSet active_;                                                    // 𝒜 (with an update)
-  std::optional<ConstantMode> mode_;                                    // the bordering of S_𝒜₀
-  std::vector<Eigen::Index> rows_;                                      // where 𝒜 differs from 𝒜₀
+  DenseLu lu_;                                        // of S_𝒜₀ (in place: no second m × m)
+  ActiveSet base_;                                    // 𝒜₀; empty: nothing factored
+  ActiveSet active_;                                  // 𝒜 (with an update)
+  std::optional<ConstantMode> mode_;                  // the bordering of S_𝒜₀
+  std::vector<Eigen::Index> rows_;                    // where 𝒜 differs from 𝒜₀
   Eigen::MatrixXd Z_, V_;                             // S_𝒜₀⁻¹ E and V (columns per changed row)
   Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_;  // I + Vᵀ Z
   int factorizations_ = 0;
