@@ -47,18 +47,22 @@ class LapackThreads {
 void DenseLu::compute(Eigen::MatrixXd&& A) {
   if (A.rows() != A.cols()) throw std::invalid_argument("DenseLu: the matrix is not square");
   const int n = lapack_size(A.rows(), "matrix");
+  factors_.resize(0, 0);  // empty until the factors are done: a throw below leaves nothing to solve with
   pivots_.clear();
-  factors_ = std::move(A);
-  norm1_ = n > 0 ? factors_.cwiseAbs().colwise().sum().maxCoeff() : 0.0;
-  if (n == 0) return;
+  Eigen::MatrixXd factors = std::move(A);
+  const double norm1 = n > 0 ? factors.cwiseAbs().colwise().sum().maxCoeff() : 0.0;
   std::vector<int> pivots(static_cast<std::size_t>(n));
-  int info = 0;
-  {
-    const LapackThreads threads;
-    dgetrf_(&n, &n, factors_.data(), &n, pivots.data(), &info);
+  if (n > 0) {
+    int info = 0;
+    {
+      const LapackThreads threads;
+      dgetrf_(&n, &n, factors.data(), &n, pivots.data(), &info);
+    }
+    check(info, "dgetrf");  // info > 0: an exact zero pivot (singular); solutions are then not finite
   }
-  check(info, "dgetrf");  // info > 0: an exact zero pivot (singular); solutions are then not finite
+  factors_ = std::move(factors);
   pivots_ = std::move(pivots);
+  norm1_ = norm1;
 }
 
 void DenseLu::solve_in_place(Eigen::MatrixXd& B) const {
@@ -84,6 +88,7 @@ double DenseLu::reciprocal_condition() const {
   std::vector<double> work(4 * std::size_t(n));
   std::vector<int> iwork(static_cast<std::size_t>(n));
   int info = 0;
+  const LapackThreads threads;
   dgecon_("1", &n, factors_.data(), &n, &norm1_, &rcond, work.data(), iwork.data(), &info, 1);
   check(info, "dgecon");
   return rcond;

@@ -2,7 +2,7 @@
 // LU factorization with partial pivoting of a dense square matrix by LAPACK (dgetrf, dgetrs and
 // dgecon of OpenBLAS). It is blocked, threaded and vectorized for the machine it runs on (OpenBLAS
 // picks its kernels at run time): about 80 GFlop/s on 2 cores against Eigen's PartialPivLU's 25
-// (docs/performance.md). The dense Newton solves of 3-D problems are LUs of m ≈ 10⁴.
+// (docs/math.md, "Newton's linear solves in 3-D"). The dense Newton solves of 3-D problems are LUs of m ≈ 10⁴.
 #include <vector>
 
 #include <Eigen/Dense>
