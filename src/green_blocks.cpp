@@ -29,14 +29,6 @@ Index<dim> node_of(const SparseRows::Entry& e) {
     return {e.i, e.j, e.k};
 }
 
-/// G between two nodes (the written-out forms of the table's inner loop).
-double green_between(const GreenTable<2>& green, const Index<2>& a, const Index<2>& b) {
-  return green.G(a[0], a[1], b[0], b[1]);
-}
-double green_between(const GreenTable<3>& green, const Index<3>& a, const Index<3>& b) {
-  return green.G(a, b[0], b[1], b[2]);
-}
-
 /// Inclusive ranges of node indices.
 template <int dim>
 struct NodeBox {
@@ -167,15 +159,6 @@ struct Interpolation {
     int s = 1;
     for (int d = 0; d < dim; ++d) s *= int(nodes[std::size_t(d)].size());
     return s;
-  }
-  Index<dim> node(int flat) const {
-    Index<dim> a;
-    for (int d = 0; d < dim; ++d) {
-      const int p = int(nodes[std::size_t(d)].size());
-      a[d] = nodes[std::size_t(d)][std::size_t(flat % p)];
-      flat /= p;
-    }
-    return a;
   }
   /// row += value · Π_d L(a_d) over the tensor nodes (flat index, first axis fastest).
   void add(const Index<dim>& a, double value, double* row) const {
@@ -390,6 +373,12 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
   if (failure) std::rethrow_exception(failure);
   execution.throw_if_interrupted();
 
+  std::vector<Index<dim>> q_nodes;  // Q's entries' nodes and values, for the near blocks' sums
+  std::vector<double> q_values;
+  q_nodes.reserve(Q.entries.size());
+  q_values.reserve(Q.entries.size());
+  for (const SparseRows::Entry& e : Q.entries) q_nodes.push_back(node_of<dim>(e)), q_values.push_back(e.value);
+
   std::atomic<bool> stop = false;  // an interruption seen by thread 0 (the caller's) ends every thread's work
 #pragma omp parallel num_threads(execution.threads())
   {
@@ -404,10 +393,7 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
         if (b.far) {
           const Interpolation<dim>&Lx = *x_interp[std::size_t(b.x)], &Ly = *y_interp[std::size_t(b.y)];
           core.resize(Lx.size(), Ly.size());
-          for (int l = 0; l < Ly.size(); ++l) {
-            const Index<dim> q = Ly.node(l);
-            for (int p = 0; p < Lx.size(); ++p) core(p, l) = green_between(green, Lx.node(p), q);
-          }
+          green.G(Lx.nodes, Ly.nodes, core.data(), std::size_t(Lx.size()));
           half.noalias() = core * V[std::size_t(b.y)].transpose();
           for (std::size_t s = 0; s < row_sets.size(); ++s) {
             block.noalias() = U[std::size_t(b.x)][s] * half;
@@ -421,12 +407,9 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
         column.resize(nodes.nodes.size());
         for (int j = cy.begin; j < cy.end; ++j) {
           const int col = Y.item[std::size_t(j)];
-          for (std::size_t u = 0; u < nodes.nodes.size(); ++u) {
-            double sum = 0.0;
-            for (std::size_t q = Q.row_begin[std::size_t(col)]; q < Q.row_begin[std::size_t(col) + 1]; ++q)
-              sum += green_between(green, nodes.nodes[u], node_of<dim>(Q.entries[q])) * Q.entries[q].value;
-            column[u] = sum;
-          }
+          const std::size_t first = Q.row_begin[std::size_t(col)];
+          green.G(nodes.nodes.data(), nodes.nodes.size(), &q_nodes[first], &q_values[first],
+                  Q.row_begin[std::size_t(col) + 1] - first, column.data());
           std::size_t entry = 0;
           for (std::size_t s = 0; s < row_sets.size(); ++s) {
             const SparseRows& R = *row_sets[s];

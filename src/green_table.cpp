@@ -1,5 +1,7 @@
 #include "fictus/green_table.hpp"
 
+#include <cstdlib>
+
 #include "fftw_plan.hpp"
 #include "fictus/q1_symbol.hpp"
 
@@ -46,6 +48,117 @@ GreenTable<dim>::GreenTable(const Grid<dim>& grid, double c, const Execution& ex
   for (int d = dim - 1; d >= 0; --d) shape.push_back(int(size_[d]));
   detail::R2rPlan plan(shape, detail::R2rKind::dct1, execution.threads());
   plan.execute(table_.data());
+}
+
+template <int dim>
+void GreenTable<dim>::G(const std::array<std::vector<int>, dim>& a, const std::array<std::vector<int>, dim>& b,
+                        double* out, std::size_t ld) const {
+  // Per axis and pair of coordinates (b's slowest): the table offsets of a − b and (Dirichlet) a + b.
+  std::array<std::vector<std::size_t>, dim> minus, plus;
+  std::size_t stride = 1;
+  for (int d = 0; d < dim; ++d) {
+    const auto &ad = a[std::size_t(d)], &bd = b[std::size_t(d)];
+    for (int y : bd)
+      for (int x : ad) {
+        minus[std::size_t(d)].push_back(std::size_t(near_fold(x - y, period_[d])) * stride);
+        plus[std::size_t(d)].push_back(std::size_t(near_fold(x + y, period_[d])) * stride);
+      }
+    stride *= size_[d];
+  }
+  const double* t = table_.data();
+  const std::size_t na0 = a[0].size(), nb0 = b[0].size(), na1 = a[1].size(), nb1 = b[1].size();
+  if constexpr (dim == 2) {
+    for (std::size_t q1 = 0; q1 < nb1; ++q1)
+      for (std::size_t q0 = 0; q0 < nb0; ++q0) {
+        double* column = out + ld * (q1 * nb0 + q0);
+        const std::size_t *sm = &minus[0][q0 * na0], *sp = &plus[0][q0 * na0];
+        for (std::size_t p1 = 0; p1 < na1; ++p1) {
+          const double* tm = t + minus[1][q1 * na1 + p1];
+          double* o = column + p1 * na0;
+          if (periodic_) {
+            for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = tm[sm[p0]];
+            continue;
+          }
+          const double* tp = t + plus[1][q1 * na1 + p1];
+          for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = tm[sm[p0]] - tm[sp[p0]] - tp[sm[p0]] + tp[sp[p0]];
+        }
+      }
+  } else {
+    const std::size_t na2 = a[2].size(), nb2 = b[2].size();
+    for (std::size_t q2 = 0; q2 < nb2; ++q2)
+      for (std::size_t q1 = 0; q1 < nb1; ++q1)
+        for (std::size_t q0 = 0; q0 < nb0; ++q0) {
+          double* column = out + ld * ((q2 * nb1 + q1) * nb0 + q0);
+          const std::size_t *xm = &minus[0][q0 * na0], *xp = &plus[0][q0 * na0];
+          for (std::size_t p2 = 0; p2 < na2; ++p2)
+            for (std::size_t p1 = 0; p1 < na1; ++p1) {
+              const std::size_t ym = minus[1][q1 * na1 + p1], zm = minus[2][q2 * na2 + p2];
+              double* o = column + (p2 * na1 + p1) * na0;
+              if (periodic_) {
+                for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = t[zm + ym + xm[p0]];
+                continue;
+              }
+              const std::size_t yp = plus[1][q1 * na1 + p1], zp = plus[2][q2 * na2 + p2];
+              // (y, z) = (−, −), (+, −), (−, +), (+, +): the order of G(a, k0, k1, k2)'s sums.
+              const double *mm = t + ym + zm, *pm = t + yp + zm, *mp = t + ym + zp, *pp = t + yp + zp;
+              for (std::size_t p0 = 0; p0 < na0; ++p0) {
+                const std::size_t m = xm[p0], p = xp[p0];
+                o[p0] = (mm[m] - mm[p] - pm[m] + pm[p]) - (mp[m] - mp[p] - pp[m] + pp[p]);
+              }
+            }
+        }
+  }
+}
+
+template <int dim>
+void GreenTable<dim>::G(const Index* a, std::size_t n_a, const Index* b, const double* w, std::size_t n_b,
+                        double* out) const {
+  // 0 ≤ a_d, b_d ≤ n_d: |a − b| needs no reflection in a Dirichlet box (period 2n), a + b at most one;
+  // in a periodic box (period n) |a − b| needs one.
+  const int n0 = period_[0], n1 = period_[1];
+  const auto reflect = [](int s, int period) { return s > period / 2 ? period - s : s; };
+  const std::size_t s1 = size_[0];
+  const double* t = table_.data();
+  for (std::size_t u = 0; u < n_a; ++u) {
+    const Index& x = a[u];
+    double sum = 0.0;
+    if constexpr (dim == 2) {
+      if (periodic_) {
+        for (std::size_t k = 0; k < n_b; ++k)
+          sum += t[std::size_t(reflect(std::abs(x[1] - b[k][1]), n1)) * s1 +
+                   std::size_t(reflect(std::abs(x[0] - b[k][0]), n0))] *
+                 w[k];
+      } else {
+        for (std::size_t k = 0; k < n_b; ++k) {
+          const std::size_t sm = std::size_t(std::abs(x[0] - b[k][0])), sp = std::size_t(reflect(x[0] + b[k][0], n0));
+          const double* tm = t + std::size_t(std::abs(x[1] - b[k][1])) * s1;
+          const double* tp = t + std::size_t(reflect(x[1] + b[k][1], n1)) * s1;
+          sum += (tm[sm] - tm[sp] - tp[sm] + tp[sp]) * w[k];
+        }
+      }
+    } else {
+      const int n2 = period_[2];
+      const std::size_t s2 = size_[0] * size_[1];
+      if (periodic_) {
+        for (std::size_t k = 0; k < n_b; ++k)
+          sum += t[std::size_t(reflect(std::abs(x[2] - b[k][2]), n2)) * s2 +
+                   std::size_t(reflect(std::abs(x[1] - b[k][1]), n1)) * s1 +
+                   std::size_t(reflect(std::abs(x[0] - b[k][0]), n0))] *
+                 w[k];
+      } else {
+        for (std::size_t k = 0; k < n_b; ++k) {
+          const std::size_t xm = std::size_t(std::abs(x[0] - b[k][0])), xp = std::size_t(reflect(x[0] + b[k][0], n0));
+          const std::size_t ym = std::size_t(std::abs(x[1] - b[k][1])) * s1;
+          const std::size_t yp = std::size_t(reflect(x[1] + b[k][1], n1)) * s1;
+          const std::size_t zm = std::size_t(std::abs(x[2] - b[k][2])) * s2;
+          const std::size_t zp = std::size_t(reflect(x[2] + b[k][2], n2)) * s2;
+          const double *mm = t + ym + zm, *pm = t + yp + zm, *mp = t + ym + zp, *pp = t + yp + zp;
+          sum += ((mm[xm] - mm[xp] - pm[xm] + pm[xp]) - (mp[xm] - mp[xp] - pp[xm] + pp[xp])) * w[k];
+        }
+      }
+    }
+    out[u] = sum;
+  }
 }
 
 template class GreenTable<2>;

@@ -119,6 +119,8 @@ class PatchLocator {
       f.inverse_det = 1 / dot(n, n);  // a11·a22 − a12², without its cancellation on slivers
       f.longest = std::sqrt(std::max(f.a11, f.a22));
       f.normal = (1 / norm(n)) * n;
+      const Point3 middle = centroid(t);
+      f.corner = std::max({norm(t.a - middle), norm(t.b - middle), norm(t.c - middle)});
       frames_.push_back(f);
     }
     buckets_.reserve(surface.triangles.size());
@@ -141,6 +143,13 @@ class PatchLocator {
           for (; it != buckets_.end() && it->first == k; ++it)
             if (norm(centroids_[std::size_t(it->second)] - p) <= side_) out.push_back(it->second);
         }
+  }
+  /// Those of `candidates` that may hold a point of the surface within `reach` of p: their centroids
+  /// lie within reach + (the triangle's farthest corner from its centroid) of p.
+  void within(const Point3& p, double reach, const std::vector<int>& candidates, std::vector<int>& out) const {
+    out.clear();
+    for (int t : candidates)
+      if (norm(centroids_[std::size_t(t)] - p) <= reach + frames_[std::size_t(t)].corner) out.push_back(t);
   }
   /// The patch of p among the triangles `candidates`.
   int patch(const Point3& p, const std::vector<int>& candidates) const {
@@ -176,7 +185,7 @@ class PatchLocator {
   /// A triangle's corner a, edges e1 = b − a and e2 = c − a, their Gram matrix and unit normal.
   struct Frame {
     Point3 a, e1, e2, normal;
-    double a11, a12, a22, inverse_det, longest;
+    double a11, a12, a22, inverse_det, longest, corner;  // corner: the farthest corner from the centroid
   };
   const PatchedSurface& surface_;
   std::vector<Frame> frames_;
@@ -240,7 +249,10 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
   const double h = grid.h();
   const double band_width = 6 * h;  // the nodes of the two rings of voxels around the cut ones (≤ 5.2h)
   const double tolerance = 1e-13 * h;
-  const PatchLocator locate(patches, h);  // the feet of a voxel's points lie within 0.9h of its centre's
+  // The feet of a voxel's points lie within 0.9h of its centre's (a point farther is sought among
+  // all the triangles near the centre's); the triangles lie within 0.25h of γ.
+  const double spread = 0.9 * h, margin = 0.25 * h;
+  const PatchLocator locate(patches, h);
   const Box3 bounds = gamma.bounds();
   std::array<int, 3> first, last;
   for (int d = 0; d < 3; ++d) {
@@ -382,7 +394,7 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
   std::vector<std::vector<RowEntry>> by_voxel(voxels.size());  // summed in voxel order: any thread count
 #pragma omp parallel num_threads(execution.threads())
   {
-    std::vector<int> near;
+    std::vector<int> near, local;
     std::vector<std::pair<Point3, double>> inside;
 #pragma omp for schedule(dynamic, 16)
     for (std::size_t n = 0; n < voxels.size(); ++n) try {
@@ -393,9 +405,12 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
         const Point3 center = lower + Point3{h / 2, h / 2, h / 2};
         const SurfaceFoot centre = nearest_point(gamma, center, center, tolerance);
         locate.near(centre.foot, near);
-        bool one_patch = !near.empty();
-        for (int t : near)
-          one_patch = one_patch && patches.patch_of[std::size_t(t)] == patches.patch_of[std::size_t(near[0])];
+        // The triangles that can hold the feet within `spread` of the centre's (the margin covers the
+        // triangles' distance from γ): each point's patch is sought among those alone.
+        locate.within(centre.foot, spread + margin, near, local);
+        bool one_patch = !local.empty();
+        for (int t : local)
+          one_patch = one_patch && patches.patch_of[std::size_t(t)] == patches.patch_of[std::size_t(local[0])];
         // Sums per patch met in this voxel for its eight nodes.
         std::vector<std::pair<int, std::array<double, 8>>> sums;
         auto sums_of = [&](int patch) -> std::array<double, 8>& {
@@ -405,9 +420,11 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
         };
         auto add_point = [&](const Point3& x, double w) {
           const SurfaceFoot foot = nearest_point(gamma, x, centre.foot, tolerance);
-          const int patch = one_patch      ? patches.patch_of[std::size_t(near[0])]
-                            : near.empty() ? locate.patch(foot.foot)
-                                           : locate.patch(foot.foot, near);
+          const bool close = norm(foot.foot - centre.foot) <= spread;
+          const int patch = close && one_patch ? patches.patch_of[std::size_t(local[0])]
+                            : close            ? locate.patch(foot.foot, local)
+                            : near.empty()     ? locate.patch(foot.foot)
+                                               : locate.patch(foot.foot, near);
           Point3 xi;
           for (int d = 0; d < 3; ++d) xi[d] = (x[d] - lower[d]) / h;
           const Q1Element<3> basis(xi, h);

@@ -12,6 +12,7 @@
 // λ(p) comes from Q1Symbol. Built once per grid, boundary and c; lookups are const and thread-safe.
 #include <array>
 #include <cstddef>
+#include <vector>
 
 #include "fictus/execution.hpp"
 #include "fictus/grid.hpp"
@@ -52,24 +53,15 @@ class GreenTable {
     }
     return sum;
   }
-  /// The 2-D form, written out: the Schur assembly's inner loop.
-  double G(int i, int j, int k, int l) const requires(dim == 2) {
-    if (periodic_) return at2(near_fold(i - k, period_[0]), near_fold(j - l, period_[1]));
-    const int sm = near_fold(i - k, period_[0]), sp = near_fold(i + k, period_[0]);
-    const int tm = near_fold(j - l, period_[1]), tp = near_fold(j + l, period_[1]);
-    return at2(sm, tm) - at2(sp, tm) - at2(sm, tp) + at2(sp, tp);
-  }
-  double T(int s, int t) const requires(dim == 2) { return T(Index{s, t}); }
-  /// The 3-D form, written out: the 3-D Schur assembly's inner loop.
-  double G(const Index& a, int k0, int k1, int k2) const requires(dim == 3) {
-    if (periodic_)
-      return at3(near_fold(a[0] - k0, period_[0]), near_fold(a[1] - k1, period_[1]), near_fold(a[2] - k2, period_[2]));
-    const int xm = near_fold(a[0] - k0, period_[0]), xp = near_fold(a[0] + k0, period_[0]);
-    const int ym = near_fold(a[1] - k1, period_[1]), yp = near_fold(a[1] + k1, period_[1]);
-    const int zm = near_fold(a[2] - k2, period_[2]), zp = near_fold(a[2] + k2, period_[2]);
-    return (at3(xm, ym, zm) - at3(xp, ym, zm) - at3(xm, yp, zm) + at3(xp, yp, zm)) -
-           (at3(xm, ym, zp) - at3(xp, ym, zp) - at3(xm, yp, zp) + at3(xp, yp, zp));
-  }
+  /// G between every node of the tensor grid a[0] × … × a[dim−1] (flat index p, first axis fastest)
+  /// and every node of the tensor grid b (flat index q), 0 ≤ a_d, b_d ≤ n_d: out[p + ld·q]. The same
+  /// sums as G(a, b), with each axis's reflections folded once per pair of coordinates rather than once
+  /// per pair of nodes (the far blocks' cores in the Schur assembly).
+  void G(const std::array<std::vector<int>, dim>& a, const std::array<std::vector<int>, dim>& b, double* out,
+         std::size_t ld) const;
+  /// out[u] = Σ_k G(a_u, b_k)·w_k (k in order) for the nodes a_u, u < n_a, and the weighted nodes
+  /// (b_k, w_k), k < n_b: the near blocks' sums in the Schur assembly, the same sums as G's.
+  void G(const Index* a, std::size_t n_a, const Index* b, const double* w, std::size_t n_b, double* out) const;
   std::size_t memory_bytes() const { return table_.size() * sizeof(double); }
 
  private:
@@ -89,10 +81,6 @@ class GreenTable {
     std::size_t k = 0;
     for (int d = dim - 1; d >= 0; --d) k = k * size_[d] + std::size_t(s[d]);
     return table_[k];
-  }
-  double at2(int s, int t) const { return table_[std::size_t(t) * size_[0] + std::size_t(s)]; }
-  double at3(int s, int t, int r) const requires(dim == 3) {
-    return table_[(std::size_t(r) * size_[1] + std::size_t(t)) * size_[0] + std::size_t(s)];
   }
   Grid<dim> grid_;
   double c_;

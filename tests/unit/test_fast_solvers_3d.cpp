@@ -102,13 +102,4 @@ INSTANTIATE_TEST_SUITE_P(BoundariesAndReactions, FastSolver3d,
                                            Case{fictus::Boundary::periodic, 0.0}, Case{fictus::Boundary::periodic, 1.0},
                                            Case{fictus::Boundary::periodic, 100.0}));
 
-TEST(FastSolver3d, GenericGreenLookupEqualsTheWrittenOut2dForm) {
-  const fictus::Grid2 grid(fictus::Box2{{0.0, 0.0}, {1.0, 0.75}}, 16);
-  const fictus::GreenTable<2> green(grid, 1.0);
-  for (int i : {1, 5, 15})
-    for (int j : {1, 7, 11})
-      for (int k : {2, 9})
-        for (int l : {3, 10}) EXPECT_EQ(green.G({i, j}, {k, l}), green.G(i, j, k, l));
-}
-
 }  // namespace

@@ -1,6 +1,10 @@
 // G from the Green's table against columns of A⁻¹ computed with the DST solver.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
+#include <vector>
+
 #include "fictus/dst_solver.hpp"
 #include "fictus/green_table.hpp"
 
@@ -29,7 +33,7 @@ TEST_P(GreenTableTest, MatchesColumnsOfInverse) {
         if (!grid.has_unknown(i, j)) continue;
         const double ref = e[grid.index(i, j)];
         max_abs = std::max(max_abs, std::abs(ref));
-        max_diff = std::max(max_diff, std::abs(green.G(i, j, col[0], col[1]) - ref));
+        max_diff = std::max(max_diff, std::abs(green.G({i, j}, {col[0], col[1]}) - ref));
       }
     EXPECT_LE(max_diff / max_abs, 1e-12) << "column (" << col[0] << ", " << col[1] << ")";
   }
@@ -41,5 +45,65 @@ INSTANTIATE_TEST_SUITE_P(BoundariesAndReactions, GreenTableTest,
                                            Case{fictus::Boundary::dirichlet, 100.0},
                                            Case{fictus::Boundary::periodic, 0.0}, Case{fictus::Boundary::periodic, 1.0},
                                            Case{fictus::Boundary::periodic, 100.0}));
+
+/// The batch forms of the Schur assembly against G(a, b) node by node: the tensor form (far blocks'
+/// cores) and the weighted sums (near blocks), on both boxes, in 2-D and 3-D, nodes on the box's
+/// faces included (where a + b reflects).
+template <int dim>
+void expect_batch_forms_match(fictus::Boundary boundary) {
+  using Index = typename fictus::Grid<dim>::Index;
+  fictus::Box<dim> box;
+  for (int d = 0; d < dim; ++d) box.lower[d] = 0.0, box.upper[d] = 1.0 + 0.5 * d;  // 12, 18, 24 cells
+  const fictus::Grid<dim> grid(box, 12, boundary);
+  const fictus::GreenTable<dim> green(grid, 1.0);
+  std::array<std::vector<int>, dim> a, b;
+  for (int d = 0; d < dim; ++d) {
+    a[std::size_t(d)] = {0, 3, 4, grid.n(d) - 1};
+    b[std::size_t(d)] = {1, 7 + d, grid.n(d) - 1};
+  }
+  std::size_t na = 1, nb = 1;
+  for (int d = 0; d < dim; ++d) na *= a[std::size_t(d)].size(), nb *= b[std::size_t(d)].size();
+  const auto node = [](const std::array<std::vector<int>, dim>& axes, std::size_t flat) {
+    Index x;
+    for (int d = 0; d < dim; ++d) {
+      const std::size_t p = axes[std::size_t(d)].size();
+      x[d] = axes[std::size_t(d)][flat % p], flat /= p;
+    }
+    return x;
+  };
+  const std::size_t ld = na + 2;
+  std::vector<double> core(ld * nb, 0.0);
+  green.G(a, b, core.data(), ld);
+  double largest = 0.0;
+  for (std::size_t q = 0; q < nb; ++q)
+    for (std::size_t p = 0; p < na; ++p) largest = std::max(largest, std::abs(green.G(node(a, p), node(b, q))));
+  ASSERT_GT(largest, 0.0);
+  for (std::size_t q = 0; q < nb; ++q)
+    for (std::size_t p = 0; p < na; ++p)
+      EXPECT_NEAR(core[p + ld * q], green.G(node(a, p), node(b, q)), 1e-14 * largest) << "p " << p << ", q " << q;
+
+  std::vector<Index> rows, cols;
+  std::vector<double> w;
+  for (std::size_t p = 0; p < na; ++p) rows.push_back(node(a, p));
+  for (std::size_t q = 0; q < nb; ++q) cols.push_back(node(b, q)), w.push_back(1.0 + 0.5 * double(q % 3) - 0.2 * q);
+  std::vector<double> sums(na, -1.0);
+  green.G(rows.data(), rows.size(), cols.data(), w.data(), cols.size(), sums.data());
+  for (std::size_t p = 0; p < na; ++p) {
+    double expected = 0.0, scale = 0.0;
+    for (std::size_t q = 0; q < nb; ++q)
+      expected += green.G(rows[p], cols[q]) * w[q], scale += largest * std::abs(w[q]);
+    EXPECT_NEAR(sums[p], expected, 1e-14 * scale) << "row " << p;
+  }
+}
+
+TEST(GreenTableBatch, TensorAndWeightedFormsEqualNodeByNode2d) {
+  expect_batch_forms_match<2>(fictus::Boundary::dirichlet);
+  expect_batch_forms_match<2>(fictus::Boundary::periodic);
+}
+
+TEST(GreenTableBatch, TensorAndWeightedFormsEqualNodeByNode3d) {
+  expect_batch_forms_match<3>(fictus::Boundary::dirichlet);
+  expect_batch_forms_match<3>(fictus::Boundary::periodic);
+}
 
 }  // namespace
