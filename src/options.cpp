@@ -260,8 +260,9 @@ std::vector<OptionSpec> make_specs() {
     specs.push_back(f);
   }
   {
-    OptionSpec c = member(std::string("solver"), std::string("condition_number"), OptionType::boolean,
-                          &SolverOptions::condition_number, "compute cond(S) of the final Newton matrix (green only)");
+    OptionSpec c =
+        member(std::string("solver"), std::string("condition_number"), OptionType::boolean,
+               &SolverOptions::condition_number, "compute cond(S) of the final Newton matrix (2-D, green only)");
     c.rule = "true or false";
     c.violation = [](const OptionValue&) { return std::string(); };
     specs.push_back(c);
