@@ -408,7 +408,7 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
         for (int j = cy.begin; j < cy.end; ++j) {
           const int col = Y.item[std::size_t(j)];
           const std::size_t first = Q.row_begin[std::size_t(col)];
-          green.G(nodes.nodes.data(), nodes.nodes.size(), &q_nodes[first], &q_values[first],
+          green.G(nodes.nodes.data(), nodes.nodes.size(), q_nodes.data() + first, q_values.data() + first,
                   Q.row_begin[std::size_t(col) + 1] - first, column.data());
           std::size_t entry = 0;
           for (std::size_t s = 0; s < row_sets.size(); ++s) {

@@ -1,7 +1,5 @@
 #include "fictus/green_table.hpp"
 
-#include <cstdlib>
-
 #include "fftw_plan.hpp"
 #include "fictus/q1_symbol.hpp"
 
@@ -50,6 +48,21 @@ GreenTable<dim>::GreenTable(const Grid<dim>& grid, double c, const Execution& ex
   plan.execute(table_.data());
 }
 
+namespace {
+
+/// Σ over the reflections from the table rows at the folded (y, z) offsets (3-D: (−,−), (+,−), (−,+),
+/// (+,+); 2-D: y = −, +) and the folded x offsets m = |a − b|, p = a + b: the order of the
+/// node-by-node form's sums.
+inline double reflections(const double* mm, const double* pm, const double* mp, const double* pp, std::size_t m,
+                          std::size_t p) {
+  return (mm[m] - mm[p] - pm[m] + pm[p]) - (mp[m] - mp[p] - pp[m] + pp[p]);
+}
+inline double reflections(const double* tm, const double* tp, std::size_t m, std::size_t p) {
+  return tm[m] - tm[p] - tp[m] + tp[p];
+}
+
+}  // namespace
+
 template <int dim>
 void GreenTable<dim>::G(const std::array<std::vector<int>, dim>& a, const std::array<std::vector<int>, dim>& b,
                         double* out, std::size_t ld) const {
@@ -61,7 +74,7 @@ void GreenTable<dim>::G(const std::array<std::vector<int>, dim>& a, const std::a
     for (int y : bd)
       for (int x : ad) {
         minus[std::size_t(d)].push_back(std::size_t(near_fold(x - y, period_[d])) * stride);
-        plus[std::size_t(d)].push_back(std::size_t(near_fold(x + y, period_[d])) * stride);
+        if (!periodic_) plus[std::size_t(d)].push_back(std::size_t(near_fold(x + y, period_[d])) * stride);
       }
     stride *= size_[d];
   }
@@ -71,7 +84,8 @@ void GreenTable<dim>::G(const std::array<std::vector<int>, dim>& a, const std::a
     for (std::size_t q1 = 0; q1 < nb1; ++q1)
       for (std::size_t q0 = 0; q0 < nb0; ++q0) {
         double* column = out + ld * (q1 * nb0 + q0);
-        const std::size_t *sm = &minus[0][q0 * na0], *sp = &plus[0][q0 * na0];
+        const std::size_t* sm = minus[0].data() + q0 * na0;
+        const std::size_t* sp = plus[0].data() + q0 * na0;  // empty in a periodic box
         for (std::size_t p1 = 0; p1 < na1; ++p1) {
           const double* tm = t + minus[1][q1 * na1 + p1];
           double* o = column + p1 * na0;
@@ -80,7 +94,7 @@ void GreenTable<dim>::G(const std::array<std::vector<int>, dim>& a, const std::a
             continue;
           }
           const double* tp = t + plus[1][q1 * na1 + p1];
-          for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = tm[sm[p0]] - tm[sp[p0]] - tp[sm[p0]] + tp[sp[p0]];
+          for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = reflections(tm, tp, sm[p0], sp[p0]);
         }
       }
   } else {
@@ -89,7 +103,8 @@ void GreenTable<dim>::G(const std::array<std::vector<int>, dim>& a, const std::a
       for (std::size_t q1 = 0; q1 < nb1; ++q1)
         for (std::size_t q0 = 0; q0 < nb0; ++q0) {
           double* column = out + ld * ((q2 * nb1 + q1) * nb0 + q0);
-          const std::size_t *xm = &minus[0][q0 * na0], *xp = &plus[0][q0 * na0];
+          const std::size_t* xm = minus[0].data() + q0 * na0;
+          const std::size_t* xp = plus[0].data() + q0 * na0;  // empty in a periodic box
           for (std::size_t p2 = 0; p2 < na2; ++p2)
             for (std::size_t p1 = 0; p1 < na1; ++p1) {
               const std::size_t ym = minus[1][q1 * na1 + p1], zm = minus[2][q2 * na2 + p2];
@@ -99,12 +114,8 @@ void GreenTable<dim>::G(const std::array<std::vector<int>, dim>& a, const std::a
                 continue;
               }
               const std::size_t yp = plus[1][q1 * na1 + p1], zp = plus[2][q2 * na2 + p2];
-              // (y, z) = (−, −), (+, −), (−, +), (+, +): the order of G(a, k0, k1, k2)'s sums.
               const double *mm = t + ym + zm, *pm = t + yp + zm, *mp = t + ym + zp, *pp = t + yp + zp;
-              for (std::size_t p0 = 0; p0 < na0; ++p0) {
-                const std::size_t m = xm[p0], p = xp[p0];
-                o[p0] = (mm[m] - mm[p] - pm[m] + pm[p]) - (mp[m] - mp[p] - pp[m] + pp[p]);
-              }
+              for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = reflections(mm, pm, mp, pp, xm[p0], xp[p0]);
             }
         }
   }
@@ -113,11 +124,9 @@ void GreenTable<dim>::G(const std::array<std::vector<int>, dim>& a, const std::a
 template <int dim>
 void GreenTable<dim>::G(const Index* a, std::size_t n_a, const Index* b, const double* w, std::size_t n_b,
                         double* out) const {
-  // 0 ≤ a_d, b_d ≤ n_d: |a − b| needs no reflection in a Dirichlet box (period 2n), a + b at most one;
-  // in a periodic box (period n) |a − b| needs one.
-  const int n0 = period_[0], n1 = period_[1];
-  const auto reflect = [](int s, int period) { return s > period / 2 ? period - s : s; };
-  const std::size_t s1 = size_[0];
+  // The folded offsets of a_d ± b_d times the axes' strides in the table.
+  const std::size_t s1 = size_[0], s2 = dim == 3 ? size_[0] * size_[1] : 0;
+  const int p0 = period_[0], p1 = period_[1], p2 = period_[dim - 1];
   const double* t = table_.data();
   for (std::size_t u = 0; u < n_a; ++u) {
     const Index& x = a[u];
@@ -125,35 +134,31 @@ void GreenTable<dim>::G(const Index* a, std::size_t n_a, const Index* b, const d
     if constexpr (dim == 2) {
       if (periodic_) {
         for (std::size_t k = 0; k < n_b; ++k)
-          sum += t[std::size_t(reflect(std::abs(x[1] - b[k][1]), n1)) * s1 +
-                   std::size_t(reflect(std::abs(x[0] - b[k][0]), n0))] *
-                 w[k];
+          sum += t[std::size_t(near_fold(x[1] - b[k][1], p1)) * s1 + std::size_t(near_fold(x[0] - b[k][0], p0))] * w[k];
       } else {
         for (std::size_t k = 0; k < n_b; ++k) {
-          const std::size_t sm = std::size_t(std::abs(x[0] - b[k][0])), sp = std::size_t(reflect(x[0] + b[k][0], n0));
-          const double* tm = t + std::size_t(std::abs(x[1] - b[k][1])) * s1;
-          const double* tp = t + std::size_t(reflect(x[1] + b[k][1], n1)) * s1;
-          sum += (tm[sm] - tm[sp] - tp[sm] + tp[sp]) * w[k];
+          const double* tm = t + std::size_t(near_fold(x[1] - b[k][1], p1)) * s1;
+          const double* tp = t + std::size_t(near_fold(x[1] + b[k][1], p1)) * s1;
+          sum += reflections(tm, tp, std::size_t(near_fold(x[0] - b[k][0], p0)),
+                             std::size_t(near_fold(x[0] + b[k][0], p0))) *
+                 w[k];
         }
       }
     } else {
-      const int n2 = period_[2];
-      const std::size_t s2 = size_[0] * size_[1];
       if (periodic_) {
         for (std::size_t k = 0; k < n_b; ++k)
-          sum += t[std::size_t(reflect(std::abs(x[2] - b[k][2]), n2)) * s2 +
-                   std::size_t(reflect(std::abs(x[1] - b[k][1]), n1)) * s1 +
-                   std::size_t(reflect(std::abs(x[0] - b[k][0]), n0))] *
+          sum += t[std::size_t(near_fold(x[2] - b[k][2], p2)) * s2 + std::size_t(near_fold(x[1] - b[k][1], p1)) * s1 +
+                   std::size_t(near_fold(x[0] - b[k][0], p0))] *
                  w[k];
       } else {
         for (std::size_t k = 0; k < n_b; ++k) {
-          const std::size_t xm = std::size_t(std::abs(x[0] - b[k][0])), xp = std::size_t(reflect(x[0] + b[k][0], n0));
-          const std::size_t ym = std::size_t(std::abs(x[1] - b[k][1])) * s1;
-          const std::size_t yp = std::size_t(reflect(x[1] + b[k][1], n1)) * s1;
-          const std::size_t zm = std::size_t(std::abs(x[2] - b[k][2])) * s2;
-          const std::size_t zp = std::size_t(reflect(x[2] + b[k][2], n2)) * s2;
-          const double *mm = t + ym + zm, *pm = t + yp + zm, *mp = t + ym + zp, *pp = t + yp + zp;
-          sum += ((mm[xm] - mm[xp] - pm[xm] + pm[xp]) - (mp[xm] - mp[xp] - pp[xm] + pp[xp])) * w[k];
+          const std::size_t ym = std::size_t(near_fold(x[1] - b[k][1], p1)) * s1;
+          const std::size_t yp = std::size_t(near_fold(x[1] + b[k][1], p1)) * s1;
+          const std::size_t zm = std::size_t(near_fold(x[2] - b[k][2], p2)) * s2;
+          const std::size_t zp = std::size_t(near_fold(x[2] + b[k][2], p2)) * s2;
+          sum += reflections(t + ym + zm, t + yp + zm, t + ym + zp, t + yp + zp,
+                             std::size_t(near_fold(x[0] - b[k][0], p0)), std::size_t(near_fold(x[0] + b[k][0], p0))) *
+                 w[k];
         }
       }
     }

@@ -145,7 +145,8 @@ class PatchLocator {
         }
   }
   /// Those of `candidates` that may hold a point of the surface within `reach` of p: their centroids
-  /// lie within reach + (the triangle's farthest corner from its centroid) of p.
+  /// lie within reach + (the triangle's farthest corner from its centroid) of p. (Only those of
+  /// `candidates`: near() keeps the triangles within its own reach of the point.)
   void within(const Point3& p, double reach, const std::vector<int>& candidates, std::vector<int>& out) const {
     out.clear();
     for (int t : candidates)
@@ -250,7 +251,8 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
   const double band_width = 6 * h;  // the nodes of the two rings of voxels around the cut ones (≤ 5.2h)
   const double tolerance = 1e-13 * h;
   // The feet of a voxel's points lie within 0.9h of its centre's (a point farther is sought among
-  // all the triangles near the centre's); the triangles lie within 0.25h of γ.
+  // all the triangles near the centre's); the triangles (edges about h) lie within 0.25h of γ, their
+  // sag, which is O(κh²).
   const double spread = 0.9 * h, margin = 0.25 * h;
   const PatchLocator locate(patches, h);
   const Box3 bounds = gamma.bounds();
@@ -420,11 +422,11 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
         };
         auto add_point = [&](const Point3& x, double w) {
           const SurfaceFoot foot = nearest_point(gamma, x, centre.foot, tolerance);
-          const bool close = norm(foot.foot - centre.foot) <= spread;
+          const bool close = norm(foot.foot - centre.foot) <= spread && !local.empty();
+          const std::vector<int>& pool = close ? local : near;
           const int patch = close && one_patch ? patches.patch_of[std::size_t(local[0])]
-                            : close            ? locate.patch(foot.foot, local)
-                            : near.empty()     ? locate.patch(foot.foot)
-                                               : locate.patch(foot.foot, near);
+                            : pool.empty()     ? locate.patch(foot.foot)
+                                               : locate.patch(foot.foot, pool);
           Point3 xi;
           for (int d = 0; d < 3; ++d) xi[d] = (x[d] - lower[d]) / h;
           const Q1Element<3> basis(xi, h);

@@ -71,10 +71,9 @@ class GreenTable {
     s = s < 0 ? s + period : s;
     return s > period / 2 ? period - s : s;
   }
-  /// fold() for |s| ≤ period: one reflection instead of a remainder.
+  /// fold() for |s| ≤ period: one reflection instead of a remainder (|s| = period gives 0).
   static int near_fold(int s, int period) {
     s = s < 0 ? -s : s;
-    s = s == period ? 0 : s;
     return s > period / 2 ? period - s : s;
   }
   double at(const Index& s) const {
