@@ -397,6 +397,7 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
 #pragma omp parallel num_threads(execution.threads())
   {
     std::vector<int> near, local;
+    std::vector<std::pair<int, std::array<double, 8>>> sums;  // per patch met in a voxel, for its eight nodes
     std::vector<std::pair<Point3, double>> inside;
 #pragma omp for schedule(dynamic, 16)
     for (std::size_t n = 0; n < voxels.size(); ++n) try {
@@ -413,8 +414,7 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
         bool one_patch = !local.empty();
         for (int t : local)
           one_patch = one_patch && patches.patch_of[std::size_t(t)] == patches.patch_of[std::size_t(local[0])];
-        // Sums per patch met in this voxel for its eight nodes.
-        std::vector<std::pair<int, std::array<double, 8>>> sums;
+        sums.clear();
         auto sums_of = [&](int patch) -> std::array<double, 8>& {
           for (auto& [p, v] : sums)
             if (p == patch) return v;
@@ -452,6 +452,7 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
           std::array<double, 8>& v = sums_of(b->patch);
           for (int k = 0; k < 8; ++k) v[k] -= b->psi * (K[l][k] + c * M[l][k]);
         }
+        by_voxel[n].reserve(8 * sums.size());
         for (const auto& [patch, v] : sums)
           for (int k = 0; k < 8; ++k) {
             const Grid3::Index node{cell[0] + Q1Element<3>::offset(k, 0), cell[1] + Q1Element<3>::offset(k, 1),
