@@ -3,6 +3,9 @@
 of each phase (Markdown). Used to check that a change does not slow a solve down:
 
     bench/compare_builds.py BEFORE_EXE AFTER_EXE [--N 4096] [--repeats 5] [--threads 2]
+                            [--problem FILE] [--variants nonsmooth,smooth]
+
+Without --problem it solves the paper's problem; with it, the problem file (2-D or 3-D) at --N.
 """
 import argparse
 import json
@@ -17,13 +20,17 @@ parser.add_argument("after")
 parser.add_argument("--N", type=int, default=4096)
 parser.add_argument("--repeats", type=int, default=5)
 parser.add_argument("--threads", type=int, default=2)
+parser.add_argument("--problem", help="a problem file (default: the paper's problem)")
+parser.add_argument("--variants", default="nonsmooth,smooth")
 args = parser.parse_args()
 
-PHASES = ["load", "u0", "geometry", "green_table", "schur", "newton", "final_solve", "check", "errors", "total"]
+PHASES = ["load", "u0", "geometry", "kink_correction", "green_table", "schur", "newton", "final_solve", "check",
+          "errors", "total"]
 
 
 def run(exe, variant, out):
-    subprocess.run([exe, "solve", "--N", str(args.N), "--variant", variant, "--threads", str(args.threads),
+    problem = [args.problem] if args.problem else []
+    subprocess.run([exe, "solve", *problem, "--N", str(args.N), "--variant", variant, "--threads", str(args.threads),
                     "--no-condition", "--files", "results.json", "--out", out], check=True, capture_output=True)
     with open(os.path.join(out, "results.json")) as f:
         r = json.load(f)
@@ -33,7 +40,7 @@ def run(exe, variant, out):
 print(f"| variant | build | " + " | ".join(PHASES) + " | rel. L2(ω) |")
 print("|---|---|" + "---|" * (len(PHASES) + 1))
 with tempfile.TemporaryDirectory() as tmp:
-    for variant in ["nonsmooth", "smooth"]:
+    for variant in args.variants.split(","):
         times = {"before": [], "after": []}
         errors = {}
         for _ in range(args.repeats):
