@@ -121,7 +121,7 @@ void print_progress_lines(fictus::FictitiousDomainSolver& solver) {
   const auto start = std::chrono::steady_clock::now();
   solver.set_progress([start](const std::string& phase, double seconds) {
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::fprintf(stderr, "fictus:   %-12s %8.2f s   (elapsed %.1f s, peak memory %.2f GiB)\n", phase.c_str(), seconds,
+    std::fprintf(stderr, "fictus:   %-16s %8.2f s   (elapsed %.1f s, peak memory %.2f GiB)\n", phase.c_str(), seconds,
                  elapsed, fictus::peak_memory_bytes() / double(1 << 30));
     std::fflush(stderr);
   });
@@ -172,7 +172,7 @@ int run_solve_surface(const std::string& text, const SolveCommand& command) {
   if (long_run)
     progress = [start](const std::string& phase, double seconds) {
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      std::fprintf(stderr, "fictus:   %-12s %8.2f s   (elapsed %.1f s, peak memory %.2f GiB)\n", phase.c_str(), seconds,
+      std::fprintf(stderr, "fictus:   %-16s %8.2f s   (elapsed %.1f s, peak memory %.2f GiB)\n", phase.c_str(), seconds,
                    elapsed, fictus::peak_memory_bytes() / double(1 << 30));
       std::fflush(stderr);
     };
@@ -190,6 +190,12 @@ int run_solve_surface(const std::string& text, const SolveCommand& command) {
                 fictus::to_string(s.options.inner));
     std::printf("Newton: %d steps, converged, %ld active of %d; fast solves %zu\n", s.newton.iterations, active,
                 s.gamma.m, s.fast_solves);
+    if (s.nested_start && s.nested_start->skipped.empty())
+      std::printf("Newton started from the contact set of the N = %d solve (m = %d, %d Newton steps, %.2f s)\n",
+                  s.nested_start->N, s.nested_start->multipliers, s.nested_start->newton_steps,
+                  s.nested_start->seconds);
+    else if (s.nested_start)
+      std::printf("no nested start (%s)\n", s.nested_start->skipped.c_str());
     if (s.far_field) {
       const fictus::FarFieldReport& a = s.far_field->assembly;
       std::printf("Schur complement: %.1f%% of the pairs interpolated; the last %d Newton steps on the exact one\n",

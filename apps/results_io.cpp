@@ -249,6 +249,7 @@ json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& s) 
                   {"normal_shift", o.normal_shift},
                   {"schur", to_string(o.inner)},
                   {"far_field", o.far_field},
+                  {"nested_start", o.nested_start},
                   {"rho", o.rho},
                   {"newton_tolerance", o.newton_tolerance},
                   {"threads", o.threads},
@@ -268,6 +269,15 @@ json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& s) 
   j["surface"] = {{"area", area}, {"triangles", s.gamma.triangles.size()}, {"delta", s.delta}};
   j["alpha"] = s.alpha;
   j["newton"] = newton_json(s.newton);
+  if (s.nested_start) {
+    const SurfaceSolution::NestedStart& n = *s.nested_start;
+    j["newton"]["nested_start"] = n.skipped.empty() ? json{{"N", n.N},
+                                                           {"multipliers", n.multipliers},
+                                                           {"newton_steps", n.newton_steps},
+                                                           {"active", n.active},
+                                                           {"seconds", n.seconds}}
+                                                    : json{{"skipped", n.skipped}, {"seconds", n.seconds}};
+  }
   j["inner"] = {{"solver", to_string(s.options.inner)},
                 {"fast_solves", s.fast_solves},
                 {"krylov_iterations", s.inner_iterations},

@@ -1,8 +1,8 @@
 // fictus 3-D benchmark: the manufactured sphere (tests/convergence/manufactured3d.py), both variants,
 // end to end per phase with peak memory at N = 64 … --max-N (non-smooth up to 256), the exact and the
-// far-field assembly of S compared in the same run at N = 128, and the green and krylov inner solvers
-// at N = 64. Writes a Markdown report (machine, compiler, threads, commit beside
-// the figures). Not part of the test suite: `make bench`.
+// far-field assembly of S compared in the same run at N = 128, Newton's two starts at N = 256, and the green and krylov
+// inner solvers at N = 64. Writes a Markdown report (machine, compiler, threads, commit beside the figures). Not part
+// of the test suite: `make bench`.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -49,8 +49,8 @@ double max_relative_difference(const std::vector<double>& a, const std::vector<d
   return difference / largest;
 }
 
-const char* phases[] = {"load",  "u0",     "geometry",    "kink_correction", "green_table",
-                        "schur", "newton", "final_solve", "errors"};
+const char* phases[] = {"nested_start", "load",  "u0",     "geometry",    "kink_correction",
+                        "green_table",  "schur", "newton", "final_solve", "errors"};
 
 }  // namespace
 
@@ -132,6 +132,32 @@ int main(int argc, char** argv) {
                  fictus::to_string(variant), max_relative_difference(far.lambda, exact.lambda),
                  far.newton.active == exact.newton.active ? "identical" : "DIFFERENT",
                  exact.timings["schur"] / far.timings["schur"], exact.timings.total / far.timings.total);
+  }
+  // Newton's start: from every point active, or from the N/2 solve's active set (solver.nested_start,
+  // the default from N = 160 on).
+  if (max_N >= 256) {
+    md << "\n## Newton's start: all active vs nested (same run, N = 256, non-smooth variant)\n\n"
+       << "| start | Newton | exact steps | LUs | fast solves | nested_start [s] | newton [s] | total [s] | rel L2(ω) "
+          "|\n|---|---|---|---|---|---|---|---|---|\n";
+    fictus::SolverOptions o;
+    o.threads = threads;
+    o.variant = fictus::Variant::nonsmooth;
+    o.nested_start = 0;
+    const fictus::SurfaceSolution plain = run(256, o);
+    o.nested_start = fictus::SolverOptions{}.nested_start;
+    const fictus::SurfaceSolution nested = run(256, o);
+    for (const fictus::SurfaceSolution* s : {&plain, &nested})
+      md << format(
+          "| %s | %d | %d | %d | %zu | %.2f | %.2f | %.2f | %.3e |\n",
+          !s->nested_start                   ? "all"
+          : s->nested_start->skipped.empty() ? "nested"
+                                             : ("all (no nested start: " + s->nested_start->skipped + ")").c_str(),
+          s->newton.iterations, s->far_field ? s->far_field->exact_steps : 0, s->factorizations, s->fast_solves,
+          s->timings["nested_start"], s->timings["newton"], s->timings.total, s->errors->rel_l2_omega);
+    md << format("\nmax |λ_nested − λ_all| / max |λ| = %.2e; active sets %s; the N/2 solve took %d Newton steps\n",
+                 max_relative_difference(nested.lambda, plain.lambda),
+                 nested.newton.active == plain.newton.active ? "identical" : "DIFFERENT",
+                 nested.nested_start ? nested.nested_start->newton_steps : 0);
   }
   md << "\n## green vs krylov (same run, N = 64, m = 129, Krylov tolerance 1e-12)\n\n"
      << "| inner | Newton | fast solves | Krylov iterations | schur [s] | newton [s] | total [s] |\n"

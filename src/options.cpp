@@ -259,6 +259,9 @@ std::vector<OptionSpec> make_specs() {
     f.violation = [](const OptionValue&) { return std::string(); };
     specs.push_back(f);
   }
+  specs.push_back(integer("solver", "nested_start", &SolverOptions::nested_start, 0, 1048576,
+                          "3-D: from this N on, Newton starts from the active set of the same problem solved "
+                          "on the grid of N/2 (0: never)"));
   {
     OptionSpec c =
         member(std::string("solver"), std::string("condition_number"), OptionType::boolean,

@@ -19,6 +19,11 @@ NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::
   ActiveSet active(m, 1);
   if (!options.start_all_active)
     for (int i = 0; i < m; ++i) active[i] = (c0(i) - rho * (b0(i) - g(i))) > 0;
+  if (options.start_active) {
+    if (Eigen::Index(options.start_active->size()) != m)
+      throw std::invalid_argument("solve_semismooth_newton: the start's active set is of another size");
+    active = *options.start_active;
+  }
   if (options.start) {
     if (options.start->lambda.size() != m || Eigen::Index(options.start->active.size()) != m)
       throw std::invalid_argument("solve_semismooth_newton: the start is of another size");

@@ -452,6 +452,78 @@ std::vector<Triangle3> offset_triangles(const std::vector<Triangle3>& triangles,
   return out;
 }
 
+/// The nested start's coarse solve: `problem` on the grid of N/2 (m/4 points when m is given; Γ at the
+/// same distance δ from γ; no error integrals), its points and active set in `points` and `active`, or
+/// `skipped` set to why not: the coarse grid checks the box's margin (2h), the surface's reach and
+/// δ ≥ 4h with its own h, and may refuse what this grid takes. Its steps are reported through
+/// `execution` as "N/2 <step>"; an interrupt asked there ends this solve too.
+void solve_coarse(const SurfaceProblem& problem, const SolverOptions& options, const Execution& execution,
+                  const std::function<bool()>& interrupt, SurfaceSolution::NestedStart& report,
+                  std::vector<Point3>& points, ActiveSet& active) {
+  if (problem.N % 2 != 0) {
+    report.skipped = "N is odd";
+    return;
+  }
+  if (problem.N / 2 < minimum_nested_grid) {
+    report.skipped = "N/2 is below " + std::to_string(minimum_nested_grid);
+    return;
+  }
+  SurfaceProblem coarse = problem;
+  coarse.N = problem.N / 2;
+  coarse.exact = {};
+  coarse.exact_vectorized = {};
+  coarse.exact_gradient = {};
+  SolverOptions coarse_options = options;
+  if (options.multipliers > 0)
+    coarse_options.multipliers = std::max(minimum_multipliers, int(std::lround(options.multipliers / 4.0)));
+  coarse_options.offset = options.offset / 2;  // δ = offset·s, and s doubles
+  bool stop_asked = false;  // a data callback may turn an interrupt into invalid_argument (Python's Ctrl-C)
+  const auto check = [&interrupt, &stop_asked] { return stop_asked = stop_asked || (interrupt && interrupt()); };
+  try {
+    const auto progress = [&execution](const std::string& phase, double seconds) {
+      execution.report("N/2 " + phase, seconds);
+    };
+    const SurfaceSolution s = solve(coarse, coarse_options, progress, check);
+    if (!s.newton.converged) {
+      report.skipped = "the solve on the grid of N/2 did not converge: " + s.newton.failure;
+      return;
+    }
+    report.N = coarse.N;
+    report.multipliers = s.options.multipliers;
+    report.newton_steps = s.newton.iterations;
+    report.active = int(std::count(s.newton.active.begin(), s.newton.active.end(), 1));
+    points = s.gamma.point;
+    active = s.newton.active;
+  } catch (const Interrupted&) {
+    throw;
+  } catch (const std::runtime_error& e) {  // e.g. an empty patch
+    if (stop_asked) throw Interrupted();
+    report.skipped = std::string("the solve on the grid of N/2 failed: ") + e.what();
+  } catch (const std::invalid_argument& e) {  // a grid too coarse for the surface or the box
+    if (stop_asked) throw Interrupted();
+    report.skipped = std::string("the grid of N/2 does not take the problem: ") + e.what();
+  }
+}
+
+/// Each of `points` takes the flag of the nearest of `from`.
+ActiveSet nearest_flags(const std::vector<Point3>& from, const ActiveSet& flags, const std::vector<Point3>& points,
+                        const Execution& execution) {
+  ActiveSet out(points.size());
+  const std::ptrdiff_t n = std::ptrdiff_t(points.size());
+#pragma omp parallel for num_threads(execution.threads()) schedule(static)
+  for (std::ptrdiff_t p = 0; p < n; ++p) {
+    double best = std::numeric_limits<double>::infinity();
+    std::size_t nearest = 0;
+    for (std::size_t q = 0; q < from.size(); ++q) {
+      const Point3 d = from[q] - points[std::size_t(p)];
+      const double d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+      if (d2 < best) best = d2, nearest = q;
+    }
+    out[std::size_t(p)] = flags[nearest];
+  }
+  return out;
+}
+
 }  // namespace
 
 SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
@@ -459,7 +531,7 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   options.validate();
   Execution execution(options.threads);
   execution.set_progress(std::move(progress));
-  execution.set_interrupt_check(std::move(interrupt));
+  execution.set_interrupt_check(interrupt);  // a copy: the nested start's coarse solve asks it too
   if (!problem.gamma) throw std::invalid_argument("geometry: no surface given");
   if (!problem.f && !problem.f_vectorized) throw std::invalid_argument("data.f: not given");
   if (!problem.g && !problem.g_vectorized) throw std::invalid_argument("data.g: not given");
@@ -472,6 +544,17 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   Eigen::setNbThreads(options.threads);
 
   check_inside_box(gamma, grid, 0, "geometry");  // before any work
+
+  // Nested start: the same problem on the grid of N/2 first (before this grid's arrays exist).
+  std::vector<Point3> coarse_points;
+  ActiveSet coarse_active;
+  if (options.nested_start > 0 && problem.N >= options.nested_start) {
+    sol.nested_start.emplace();
+    solve_coarse(problem, options, execution, interrupt, *sol.nested_start, coarse_points, coarse_active);
+    clock.mark("nested_start");
+    sol.nested_start->seconds = sol.timings.phases.back().second;
+    execution.throw_if_interrupted();
+  }
 
   // 0. The load and u₀.
   std::unique_ptr<FastSolver<3>> fast = make_fast_solver(grid, problem.c, execution);
@@ -615,6 +698,11 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   const NewtonOptions newton_options = detail::newton_options(options, execution);
   NewtonOptions first = newton_options;
   if (exact) first.hand_on_at_changes = std::max(1, int(far_field_hand_on * m));
+  ActiveSet start;
+  if (!coarse_points.empty()) {
+    start = nearest_flags(coarse_points, coarse_active, sol.gamma.point, execution);
+    first.start_active = &start;
+  }
   sol.newton =
       solve_semismooth_newton(*schur, to_eigen(b0), to_eigen(c0), to_eigen(sol.g), first, mode ? &*mode : nullptr);
   if (exact) {  // on with the exact S from where S̃ left the active set nearly settled

@@ -3,7 +3,8 @@
 //   u(λ) = u₀ + A⁻¹B_Γᵀλ,  b(λ) = B_γ u = b₀ + S_B λ,  c(λ) = C_γ u = c₀ + S_C λ,
 //   F(λ) = c(λ) − max{0, c(λ) − ρ(b(λ) − g)} = 0.
 // Algorithm (numbered as in the code):
-//   0. λ = 0; 𝒜 = all points ("all" start) or 𝒜 = {i : (c₀ − ρ(b₀ − g))_i > 0} ("zero" start);
+//   0. λ = 0; 𝒜 = all points ("all" start) or 𝒜 = {i : (c₀ − ρ(b₀ − g))_i > 0} ("zero" start)
+//      or a given 𝒜 (NewtonOptions::start_active: the 3-D nested start's, from a coarser grid);
 //      or λ, α and 𝒜 of an earlier run (NewtonOptions::start: another S takes over from there).
 //   1. Linear solve: S_𝒜 λ = d, rows i ∈ 𝒜: (S_B λ)_i = g_i − b₀_i (contact, u = g),
 //                               rows i ∉ 𝒜: (S_C λ)_i = −c₀_i     (free, ∂u/∂n = 0).
@@ -34,6 +35,7 @@ struct NewtonOptions {
   double tolerance = SolverOptions{}.newton_tolerance;  // ‖F‖∞ ≤ tolerance · max(‖b‖∞, ‖c‖∞, ‖g‖∞)
   std::function<void()> between_steps;                  // called before each linear solve (may throw)
   const NewtonResult* start = nullptr;                  // go on from an earlier run's active set, λ and α (not owned)
+  const ActiveSet* start_active = nullptr;              // the first active set, with λ = 0 (not owned)
   /// Hand on (stop, not converged, `active` the next set to try) once a step changes at most this
   /// many points; negative: never.
   int hand_on_at_changes = -1;

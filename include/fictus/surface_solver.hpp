@@ -143,6 +143,8 @@ inline constexpr FarField default_far_field_3d_nonsmooth{5, 2.0, 2};
 inline constexpr double far_field_hand_on = 0.05;
 /// GMRES's relative residual for the Newton steps on the exact S behind an interpolated far field.
 inline constexpr double far_field_gmres_tolerance = 1e-13;
+/// The nested start's coarse grid has at least this many cells along x (solver.nested_start).
+inline constexpr int minimum_nested_grid = 8;
 /// Default m for a surface of `area` on a grid of cell h.
 int default_patches(double area, double h, Variant variant);
 
@@ -168,6 +170,18 @@ struct SurfaceSolution {
     int exact_steps = 0;
   };
   std::optional<FarFieldUse> far_field;
+  /// With solver.nested_start (N at or above it): the solve of the same problem on the grid of N/2
+  /// whose active set, taken at each point from the nearest coarse point, started Newton here; or,
+  /// when that solve could not be made, why (`skipped`), and Newton started as solver.start says.
+  struct NestedStart {
+    int N = 0;             // the coarse grid's
+    int multipliers = 0;   // the coarse m
+    int newton_steps = 0;  // the coarse solve's (not counted in newton.iterations)
+    int active = 0;        // its points in contact
+    double seconds = 0;    // the whole coarse solve, its own nested start included
+    std::string skipped;   // non-empty: no nested start, and why
+  };
+  std::optional<NestedStart> nested_start;
   SignoriniCheck signorini;
   std::optional<ErrorNorms> errors;
   std::optional<PointErrors> point_errors;

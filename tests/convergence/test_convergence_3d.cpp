@@ -6,8 +6,11 @@
 
 #include <algorithm>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "fictus/convergence_table.hpp"
+#include "fictus/execution.hpp"
 #include "fictus/mesh_surface.hpp"
 #include "manufactured_solutions_3d.hpp"
 
@@ -31,6 +34,16 @@ fictus::LevelResult level_of(const fictus::SurfaceSolution& s) {
   r.h1_omega = s.errors->rel_h1semi_omega;
   r.l2_gamma = s.errors->rel_l2_gamma;
   return r;
+}
+
+/// max |λ_a − λ_b| / max |λ_b|.
+double lambda_difference(const fictus::SurfaceSolution& a, const fictus::SurfaceSolution& b) {
+  double largest = 0, difference = 0;
+  for (std::size_t i = 0; i < b.lambda.size(); ++i) {
+    largest = std::max(largest, std::abs(b.lambda[i]));
+    difference = std::max(difference, std::abs(a.lambda[i] - b.lambda[i]));
+  }
+  return difference / largest;
 }
 
 void expect_signorini_at_round_off(const fictus::SurfaceSolution& s) {
@@ -97,12 +110,7 @@ TEST(Manufactured3d, GreenAndKrylovAgree) {
   const fictus::SurfaceSolution krylov = fictus::solve(problem("sphere", 64), o);
   ASSERT_TRUE(green.newton.converged && krylov.newton.converged);
   EXPECT_EQ(green.newton.active, krylov.newton.active);
-  double largest = 0, difference = 0;
-  for (std::size_t i = 0; i < green.lambda.size(); ++i) {
-    largest = std::max(largest, std::abs(green.lambda[i]));
-    difference = std::max(difference, std::abs(green.lambda[i] - krylov.lambda[i]));
-  }
-  EXPECT_LT(difference, 1e-7 * largest);
+  EXPECT_LT(lambda_difference(krylov, green), 1e-7);
   EXPECT_GT(krylov.fast_solves, 20u);
 }
 
@@ -125,15 +133,86 @@ TEST(Manufactured3d, InterpolatedFarFieldGivesTheExactAnswer) {
     EXPECT_GE(far.far_field->exact_steps, 1);
     EXPECT_EQ(far.newton.active, exact.newton.active);
     EXPECT_LE(far.newton.iterations, exact.newton.iterations + 1);
-    double largest = 0, difference = 0;
-    for (std::size_t i = 0; i < far.lambda.size(); ++i) {
-      largest = std::max(largest, std::abs(exact.lambda[i]));
-      difference = std::max(difference, std::abs(far.lambda[i] - exact.lambda[i]));
-    }
-    EXPECT_LT(difference, 1e-10 * largest);
+    EXPECT_LT(lambda_difference(far, exact), 1e-10);
     expect_signorini_at_round_off(far);
     EXPECT_NEAR(far.errors->rel_l2_omega, exact.errors->rel_l2_omega, 1e-6 * exact.errors->rel_l2_omega);
   }
+}
+
+TEST(Manufactured3d, NestedStartGivesTheSameAnswerInFewerSteps) {
+  // solver.nested_start: Newton starts from the active set of the same problem solved on the grid of
+  // N/2. It solves the same discrete problem, so the answer is the plain start's (λ to GMRES's
+  // tolerance, the same active set), in fewer steps on this grid. The smooth variant's m is given (150,
+  // patches of 8.3h): the coarse solve takes m/4 = 38 (the default m there would be 41), with Γ at
+  // the same distance from γ, inside the box (the coarse default m and offset would put Γ beyond it).
+  for (const auto variant : {fictus::Variant::smooth, fictus::Variant::nonsmooth}) {
+    const bool smooth = variant == fictus::Variant::smooth;
+    const int N = smooth ? 96 : 80;
+    fictus::SolverOptions o;
+    o.threads = 2;
+    o.variant = variant;
+    o.multipliers = smooth ? 150 : 0;
+    o.nested_start = 0;
+    const fictus::SurfaceSolution plain = fictus::solve(problem("sphere", N), o);
+    o.nested_start = N;
+    const fictus::SurfaceSolution nested = fictus::solve(problem("sphere", N), o);
+    ASSERT_TRUE(plain.newton.converged && nested.newton.converged);
+    EXPECT_FALSE(plain.nested_start.has_value());
+    ASSERT_TRUE(nested.nested_start.has_value());
+    EXPECT_EQ(nested.nested_start->skipped, "");
+    EXPECT_EQ(nested.nested_start->N, N / 2);
+    EXPECT_EQ(nested.nested_start->multipliers,
+              smooth ? 38 : fictus::default_patches(problem("sphere", N / 2).gamma->area(), 2.0 / N, variant));
+    EXPECT_GE(nested.nested_start->newton_steps, 1);
+    EXPECT_GT(nested.nested_start->active, 0);
+    EXPECT_EQ(nested.newton.active, plain.newton.active);
+    EXPECT_LT(nested.newton.iterations, plain.newton.iterations);
+    EXPECT_LT(lambda_difference(nested, plain), 1e-10);
+    expect_signorini_at_round_off(nested);
+  }
+}
+
+fictus::SolverOptions nonsmooth_options(int nested_start) {
+  fictus::SolverOptions o;
+  o.threads = 2;
+  o.variant = fictus::Variant::nonsmooth;
+  o.nested_start = nested_start;
+  return o;
+}
+
+TEST(Manufactured3d, NestedStartSkipsAGridTooCoarseForTheSurface) {
+  // The torus's tube (r = 0.1) is too thin for the non-smooth variant's band at N = 32: the nested
+  // start says why it was skipped, and Newton starts as solver.start says (the plain start's run).
+  fictus::SolverOptions o = nonsmooth_options(0);
+  const fictus::SurfaceSolution plain = fictus::solve(problem("torus", 64), o);
+  o.nested_start = 64;
+  const fictus::SurfaceSolution skipped = fictus::solve(problem("torus", 64), o);
+  ASSERT_TRUE(skipped.nested_start.has_value());
+  EXPECT_NE(skipped.nested_start->skipped.find("formulation.variant: the surface folds"), std::string::npos)
+      << skipped.nested_start->skipped;
+  EXPECT_EQ(skipped.newton.iterations, plain.newton.iterations);
+  EXPECT_EQ(skipped.newton.active, plain.newton.active);
+  EXPECT_LT(lambda_difference(skipped, plain), 1e-12);
+}
+
+TEST(Manufactured3d, NestedStartSkipsAnOddGrid) {
+  fictus::SolverOptions o = nonsmooth_options(60);
+  const fictus::SurfaceSolution s = fictus::solve(problem("sphere", 63), o);
+  ASSERT_TRUE(s.nested_start.has_value());
+  EXPECT_EQ(s.nested_start->skipped, "N is odd");
+  EXPECT_TRUE(s.newton.converged);
+}
+
+TEST(Manufactured3d, AnInterruptInTheNestedStartEndsTheSolve) {
+  // Asked while the N/2 solve runs (after its geometry), the interrupt ends the whole solve: no skip
+  // and no fine Newton.
+  fictus::SolverOptions o = nonsmooth_options(64);
+  std::vector<std::string> phases;
+  const auto progress = [&phases](const std::string& phase, double) { phases.push_back(phase); };
+  const auto interrupt = [&phases] { return std::find(phases.begin(), phases.end(), "N/2 geometry") != phases.end(); };
+  EXPECT_THROW(fictus::solve(problem("sphere", 64), o, progress, interrupt), fictus::Interrupted);
+  EXPECT_NE(std::find(phases.begin(), phases.end(), "N/2 geometry"), phases.end());
+  EXPECT_EQ(std::find(phases.begin(), phases.end(), "nested_start"), phases.end());
 }
 
 TEST(Manufactured3d, NonSmoothVariantConvergesWithTheKinkCorrection) {
