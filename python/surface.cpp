@@ -271,6 +271,19 @@ void bind_surface(py::module_& m) {
                                d["total"] = of(self).timings.total;
                                return d;
                              })
+      .def_property_readonly("nested_start",
+                             [](py::object self) -> py::object {
+                               const auto& n = of(self).nested_start;
+                               if (!n) return py::none();
+                               py::dict d;
+                               if (n->skipped.empty())
+                                 d["N"] = n->N, d["multipliers"] = n->multipliers, d["newton_steps"] = n->newton_steps,
+                                 d["active"] = n->active;
+                               else
+                                 d["skipped"] = n->skipped;
+                               d["seconds"] = n->seconds;
+                               return d;
+                             })
       .def_property_readonly("signorini",
                              [](py::object self) {
                                const SignoriniCheck& c = of(self).signorini;

@@ -310,6 +310,20 @@ def test_ctrl_c_inside_a_3d_callable_stops_the_solve():
     assert len(calls) == made and made < 64 * 64
 
 
+def test_surface_solution_reports_the_nested_start():
+    sphere = dict(geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.3),
+                  formulation=dict(variant="nonsmooth"), data=dict(f="-1", g="0.2 * (x - 0.5)"))
+    plain = fictus.SurfaceProblem(domain=dict(N=64), solver=dict(threads=2, nested_start=0), **sphere).solve()
+    nested = fictus.SurfaceProblem(domain=dict(N=64), solver=dict(threads=2, nested_start=64), **sphere).solve()
+    assert plain.nested_start is None
+    assert nested.nested_start["N"] == 32 and nested.nested_start["newton_steps"] >= 1, nested.nested_start
+    assert "nested_start" in nested.timings
+    assert np.array_equal(nested.contact, plain.contact)
+    assert np.abs(nested.lambda_ - plain.lambda_).max() <= 1e-9 * np.abs(plain.lambda_).max()
+    odd = fictus.SurfaceProblem(domain=dict(N=63), solver=dict(threads=2, nested_start=60), **sphere).solve()
+    assert odd.nested_start["skipped"] == "N is odd", odd.nested_start
+
+
 def numpy_function(text):
     """A problem file's expression ("q0 = ..., q1 = ..., result": muParser syntax) as a numpy callable f(x, y, z)."""
     parts, depth, start = [], 0, 0
