@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -222,6 +223,41 @@ TEST(Manufactured3d, NonSmoothVariantConvergesWithTheKinkCorrection) {
   // (40 % of γ is): the bands leave room of about 2× in the rates' spread and 1.5× in the error, and a
   // stalled error (3e-4 at N = 96) or a lagging contact set (29 %) fails them.
   converges("sphere", {64, 80, 96}, fictus::Variant::nonsmooth, {1.5, 3.5, 0.8, 1.5, 3}, 8e-5);
+}
+
+/// The relative L²(ω) errors of `name` (no contact: ∂u/∂n = 0 on all of γ) at each N.
+std::vector<double> pure_neumann_errors(const std::string& name, const std::vector<int>& sizes,
+                                        fictus::Variant variant) {
+  std::vector<double> errors;
+  for (int N : sizes) {
+    fictus::SolverOptions o;
+    o.threads = 2;
+    o.variant = variant;
+    const fictus::SurfaceSolution s = fictus::solve(problem(name, N), o);
+    EXPECT_TRUE(s.newton.converged) << "N = " << N << ": " << s.newton.failure;
+    EXPECT_EQ(std::count(s.newton.active.begin(), s.newton.active.end(), char(1)), 0) << "N = " << N;
+    std::cout << name << ", N = " << N << ": L2(omega) " << s.errors->rel_l2_omega << "\n";
+    errors.push_back(s.errors->rel_l2_omega);
+  }
+  return errors;
+}
+
+TEST(Manufactured3d, PureNeumannSphereConvergesInTheSmoothVariant) {
+  // ∂u/∂n = 0 on all of γ and c = 1: a bias ε in the mean of the discrete ∂u/∂n moves u by about 10ε,
+  // which a contact part would hide. Measured: 2.54e-4 and 6.49e-5 (rate 4.7; 4.42e-5 at N = 160).
+  const std::vector<double> e = pure_neumann_errors("sphere_neumann", {96, 128}, fictus::Variant::smooth);
+  EXPECT_LT(e[1], 1e-4);
+  EXPECT_GT(std::log(e[0] / e[1]) / std::log(128.0 / 96.0), 1.8);
+}
+
+// Known defect, kept as a reproducer and not run by ctest: the non-smooth variant does not converge on
+// the pure Neumann sphere. Measured L²(ω): 1.59e-3, 1.87e-3, 7.53e-4 at N = 96, 128, 160 (and 6.7e-4 at
+// N = 256), a nearly constant error, i.e. a bias of about 1e-4 in the mean of the kink-corrected ∂u/∂n
+// (docs/math.md, "The non-smooth variant's Neumann bias"). Run with --gtest_also_run_disabled_tests.
+TEST(Manufactured3dKnownDefect, DISABLED_PureNeumannSphereConvergesInTheNonSmoothVariant) {
+  const std::vector<double> e = pure_neumann_errors("sphere_neumann", {96, 128, 160}, fictus::Variant::nonsmooth);
+  EXPECT_LT(e[2], 1e-4);
+  EXPECT_GT(std::log(e[0] / e[2]) / std::log(160.0 / 96.0), 1.0);
 }
 
 TEST(Manufactured3d, NonSmoothShiftedRuleStallsWithoutTheKinkCorrection) {
