@@ -242,22 +242,27 @@ std::vector<double> pure_neumann_errors(const std::string& name, const std::vect
   return errors;
 }
 
+/// Pure Neumann sphere at N = 96 and 128: below 1e-4 at N = 128 and at least halved from N = 96.
+void pure_neumann_sphere_converges(fictus::Variant variant) {
+  const std::vector<double> e = pure_neumann_errors("sphere_neumann", {96, 128}, variant);
+  EXPECT_LT(e[1], 1e-4);
+  EXPECT_LT(e[1], 0.5 * e[0]);
+}
+
 TEST(Manufactured3d, PureNeumannSphereConvergesInTheSmoothVariant) {
   // ∂u/∂n = 0 on all of γ and c = 1: a bias ε in the mean of the discrete ∂u/∂n moves u by about 10ε,
-  // which a contact part would hide. Measured: 2.54e-4 and 6.49e-5 (rate 4.7; 4.42e-5 at N = 160).
-  const std::vector<double> e = pure_neumann_errors("sphere_neumann", {96, 128}, fictus::Variant::smooth);
-  EXPECT_LT(e[1], 1e-4);
-  EXPECT_GT(std::log(e[0] / e[1]) / std::log(128.0 / 96.0), 1.8);
+  // which a contact part would hide. Measured: 2.54e-4 and 6.49e-5 (4.42e-5 at N = 160: the fall from
+  // 96 to 128 is faster than the asymptotic rate, so only the finest error and the fall are asserted).
+  pure_neumann_sphere_converges(fictus::Variant::smooth);
 }
 
 // Known defect, kept as a reproducer and not run by ctest: the non-smooth variant does not converge on
-// the pure Neumann sphere. Measured L²(ω): 1.59e-3, 1.87e-3, 7.53e-4 at N = 96, 128, 160 (and 6.7e-4 at
-// N = 256), a nearly constant error, i.e. a bias of about 1e-4 in the mean of the kink-corrected ∂u/∂n
-// (docs/math.md, "The non-smooth variant's Neumann bias"). Run with --gtest_also_run_disabled_tests.
+// the pure Neumann sphere. Measured L²(ω): 1.59e-3 and 1.87e-3 at N = 96 and 128 (7.53e-4 at 160, 6.7e-4
+// at 256): an error that does not fall with N, nearly a constant offset in space, a bias of 3e-4 to
+// 1e-4 in the mean of the kink-corrected ∂u/∂n (docs/math.md, "The non-smooth variant's Neumann bias").
+// Run with --gtest_also_run_disabled_tests --gtest_filter='Manufactured3dKnownDefect.*'.
 TEST(Manufactured3dKnownDefect, DISABLED_PureNeumannSphereConvergesInTheNonSmoothVariant) {
-  const std::vector<double> e = pure_neumann_errors("sphere_neumann", {96, 128, 160}, fictus::Variant::nonsmooth);
-  EXPECT_LT(e[2], 1e-4);
-  EXPECT_GT(std::log(e[0] / e[2]) / std::log(160.0 / 96.0), 1.0);
+  pure_neumann_sphere_converges(fictus::Variant::nonsmooth);
 }
 
 TEST(Manufactured3d, NonSmoothShiftedRuleStallsWithoutTheKinkCorrection) {
