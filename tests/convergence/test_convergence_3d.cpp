@@ -23,6 +23,14 @@ fictus::SurfaceProblem problem(const std::string& name, int N) {
   throw std::invalid_argument(name);
 }
 
+/// `name` at N in `variant` with the default options, on 2 threads.
+fictus::SurfaceSolution solve_with_defaults(const std::string& name, int N, fictus::Variant variant) {
+  fictus::SolverOptions o;
+  o.threads = 2;
+  o.variant = variant;
+  return fictus::solve(problem(name, N), o);
+}
+
 fictus::LevelResult level_of(const fictus::SurfaceSolution& s) {
   fictus::LevelResult r;
   r.N = s.grid.nx();
@@ -63,10 +71,7 @@ void converges(const std::string& name, const std::vector<int>& sizes, fictus::V
                double largest_finest_error = 1.0) {
   std::vector<fictus::LevelResult> rows;
   for (int N : sizes) {
-    fictus::SolverOptions o;
-    o.threads = 2;
-    o.variant = variant;
-    const fictus::SurfaceSolution s = fictus::solve(problem(name, N), o);
+    const fictus::SurfaceSolution s = solve_with_defaults(name, N, variant);
     ASSERT_TRUE(s.newton.converged) << "N = " << N << ": " << s.newton.failure;
     EXPECT_LE(s.newton.iterations, 10);
     expect_signorini_at_round_off(s);
@@ -230,10 +235,7 @@ std::vector<double> pure_neumann_errors(const std::string& name, const std::vect
                                         fictus::Variant variant) {
   std::vector<double> errors;
   for (int N : sizes) {
-    fictus::SolverOptions o;
-    o.threads = 2;
-    o.variant = variant;
-    const fictus::SurfaceSolution s = fictus::solve(problem(name, N), o);
+    const fictus::SurfaceSolution s = solve_with_defaults(name, N, variant);
     EXPECT_TRUE(s.newton.converged) << "N = " << N << ": " << s.newton.failure;
     EXPECT_EQ(std::count(s.newton.active.begin(), s.newton.active.end(), char(1)), 0) << "N = " << N;
     std::cout << name << ", N = " << N << ": L2(omega) " << s.errors->rel_l2_omega << "\n";
