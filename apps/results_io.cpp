@@ -250,6 +250,7 @@ json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& s) 
                   {"schur", to_string(o.inner)},
                   {"far_field", o.far_field},
                   {"nested_start", o.nested_start},
+                  {"flux_balance", o.flux_balance},
                   {"rho", o.rho},
                   {"newton_tolerance", o.newton_tolerance},
                   {"threads", o.threads},
@@ -282,6 +283,10 @@ json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& s) 
                 {"fast_solves", s.fast_solves},
                 {"krylov_iterations", s.inner_iterations},
                 {"factorizations", s.factorizations}};
+  if (s.flux_balance)
+    j["flux_balance"] = {{"scatter", s.flux_balance->scatter},
+                         {"mean", s.flux_balance->mean},
+                         {"data_shift", s.flux_balance->data_shift}};
   if (s.far_field) {
     const FarFieldReport& a = s.far_field->assembly;
     j["inner"]["far_field"] = {{"far_fraction", a.far_pairs / (a.far_pairs + a.near_pairs)},

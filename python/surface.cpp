@@ -284,6 +284,14 @@ void bind_surface(py::module_& m) {
                                d["seconds"] = n->seconds;
                                return d;
                              })
+      .def_property_readonly("flux_balance",
+                             [](py::object self) -> py::object {
+                               const auto& b = of(self).flux_balance;
+                               if (!b) return py::none();
+                               py::dict d;
+                               d["scatter"] = b->scatter, d["mean"] = b->mean, d["data_shift"] = b->data_shift;
+                               return d;
+                             })
       .def_property_readonly("signorini",
                              [](py::object self) {
                                const SignoriniCheck& c = of(self).signorini;

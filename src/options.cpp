@@ -195,6 +195,15 @@ std::vector<OptionSpec> make_specs() {
                          "normal_shift cells inside ω; first order at best)"));
   specs.push_back(number("formulation", "normal_shift", &SolverOptions::normal_shift, 0.0, false, 8.0, false,
                          "shifted rule only: C_γ is taken this many cells h inside ω"));
+  {
+    OptionSpec b = member(std::string("formulation"), std::string("flux_balance"), OptionType::boolean,
+                          &SolverOptions::flux_balance,
+                          "3-D non-smooth: correct the readings ∂u/∂n so that each patch's multiplier and the data "
+                          "move their area-weighted sum over γ by the discrete field's flux c∫_ω u − ∫_ω f");
+    b.rule = "true or false";
+    b.violation = [](const OptionValue&) { return std::string(); };
+    specs.push_back(b);
+  }
   // [data]
   specs.push_back(number("data", "c", &Problem::c, 0.0, false, 1e12, false, "reaction coefficient of −Δu + c·u = f"));
   // [solver]

@@ -16,6 +16,7 @@
 
 #include <omp.h>
 #include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
 
 #include "fictus/q1_element.hpp"
 #include "fictus/quadrature.hpp"
@@ -506,6 +507,168 @@ void SurfaceKink::add_kinks(const std::vector<double>& lambda, GridVector& u) co
   const State& st = *state_;
   for (const BandNode& b : st.band)
     if (b.patch >= 0 && st.grid.has_unknown(b.node)) u[st.grid.index(b.node)] += lambda[std::size_t(b.patch)] * b.psi;
+}
+
+
+std::vector<double> SurfaceKink::band_sums(const GridVector& weights) const {
+  const State& st = *state_;
+  std::vector<double> sums(std::size_t(st.m), 0.0);
+  for (const BandNode& b : st.band)
+    if (b.patch >= 0 && st.grid.has_unknown(b.node)) sums[std::size_t(b.patch)] += b.psi * weights[st.grid.index(b.node)];
+  return sums;
+}
+
+namespace {
+
+/// The patches' neighbours: W_ij = Σ_k (B_Γ)_ik (B_Γ)_jk over the nodes their rows share (symmetric).
+Eigen::SparseMatrix<double> row_overlaps(const SparseRows& rows) {
+  struct NodeValue {
+    std::size_t node;
+    int row;
+    double value;
+  };
+  std::vector<NodeValue> by_node;
+  by_node.reserve(rows.entries.size());
+  for (int r = 0; r < rows.n_rows(); ++r)
+    for (std::size_t e = rows.row_begin[std::size_t(r)]; e < rows.row_begin[std::size_t(r) + 1]; ++e)
+      by_node.push_back({rows.entries[e].index, r, rows.entries[e].value});
+  std::sort(by_node.begin(), by_node.end(), [](const NodeValue& a, const NodeValue& b) {
+    return std::tie(a.node, a.row) < std::tie(b.node, b.row);
+  });
+  std::vector<Eigen::Triplet<double>> overlap;
+  for (std::size_t first = 0; first < by_node.size();) {
+    std::size_t last = first;
+    while (last < by_node.size() && by_node[last].node == by_node[first].node) ++last;
+    for (std::size_t p = first; p < last; ++p)
+      for (std::size_t q = p + 1; q < last; ++q)
+        if (by_node[p].row != by_node[q].row) {
+          const double w = by_node[p].value * by_node[q].value;
+          overlap.emplace_back(by_node[p].row, by_node[q].row, w);
+          overlap.emplace_back(by_node[q].row, by_node[p].row, w);
+        }
+    first = last;
+  }
+  Eigen::SparseMatrix<double> W(rows.n_rows(), rows.n_rows());
+  W.setFromTriplets(overlap.begin(), overlap.end());
+  return W;
+}
+
+/// The connected parts of the graph W: a label per vertex, and the number of parts.
+std::pair<std::vector<int>, int> connected_parts(const Eigen::SparseMatrix<double>& W) {
+  const int n = int(W.rows());
+  std::vector<int> part(std::size_t(n), -1);
+  int parts = 0;
+  for (int start = 0; start < n; ++start) {
+    if (part[std::size_t(start)] >= 0) continue;
+    std::vector<int> stack{start};
+    part[std::size_t(start)] = parts;
+    while (!stack.empty()) {
+      const int i = stack.back();
+      stack.pop_back();
+      for (Eigen::SparseMatrix<double>::InnerIterator it(W, i); it; ++it)
+        if (part[std::size_t(it.row())] < 0) part[std::size_t(it.row())] = parts, stack.push_back(int(it.row()));
+    }
+    ++parts;
+  }
+  return {part, parts};
+}
+
+}  // namespace
+
+FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, const SparseRows& C_gamma,
+                         const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C,
+                         const GridVector& load_of_omega, const FastSolver<3>& fast) {
+  const int m = B_Gamma.n_rows();
+  FluxBalance result;
+  result.area.assign(std::size_t(m), 0.0);  // ∫_{P_j} 1 dS (no wall node lies near γ)
+  for (int j = 0; j < m; ++j)
+    for (std::size_t e = B_Gamma.row_begin[std::size_t(j)]; e < B_Gamma.row_begin[std::size_t(j) + 1]; ++e)
+      result.area[std::size_t(j)] += B_Gamma.entries[e].value;
+  const std::vector<double>& a = result.area;
+  const Eigen::Map<const Eigen::VectorXd> a_vector(a.data(), m);
+
+  // Σ_i a_i S_ij = (B_Γ + R)_j·y + (D_Cᵀa)_j with y = A⁻¹C_γᵀa (one adjoint solve).
+  std::vector<double> share;
+  {
+    GridVector y(fast.grid().n_unknowns(), 0.0);
+    C_gamma.add_transposed(a, y);
+    fast.solve_in_place(y);
+    loads.multiply(y, share);
+    ++result.fast_solves;
+  }
+  const Eigen::VectorXd from_direct = D_C.transpose() * a_vector;
+  // c∫_ω of the field of a unit layer on patch j, I_h w_j = A⁻¹(B_Γ + R)ᵀe_j + I_hψ_j: with
+  // Φ = A⁻¹ℓ (ℓ_k = ∫_ω φ_k), c((B_Γ + R)_j·Φ + Σ_k ψ_j(x_k)ℓ_k).
+  std::vector<double> flux(std::size_t(m), 0.0);
+  if (fast.c() != 0.0) {
+    GridVector phi = load_of_omega;
+    fast.solve_in_place(phi);
+    ++result.fast_solves;
+    loads.multiply(phi, flux);
+    const std::vector<double> band = kink.band_sums(load_of_omega);
+    for (int j = 0; j < m; ++j) flux[std::size_t(j)] = fast.c() * (flux[std::size_t(j)] + band[std::size_t(j)]);
+  }
+  Eigen::VectorXd beta(m);
+  for (int j = 0; j < m; ++j) beta[j] = share[std::size_t(j)] + from_direct[j] - flux[std::size_t(j)];
+  {
+    double mean = 0, square = 0;
+    for (int j = 0; j < m; ++j) mean += beta[j] / a[std::size_t(j)] / m;
+    for (int j = 0; j < m; ++j) square += std::pow(beta[j] / a[std::size_t(j)] - mean, 2) / m;
+    result.scatter = std::sqrt(square);
+    result.mean = beta.sum() / a_vector.sum();
+  }
+
+  // On each connected part of γ: μ = Σβ/Σa, and Lφ = (β − μa)/2 with φ = 0 at the part's first patch
+  // (L is singular there; its right-hand side sums to zero over the part, so the pinned row holds too).
+  const Eigen::SparseMatrix<double> W = row_overlaps(B_Gamma);
+  const auto [part, parts] = connected_parts(W);
+  std::vector<double> beta_sum(std::size_t(parts), 0.0), area_sum(std::size_t(parts), 0.0);
+  std::vector<int> pinned(std::size_t(parts), -1);
+  for (int j = 0; j < m; ++j) {
+    const std::size_t p = std::size_t(part[std::size_t(j)]);
+    beta_sum[p] += beta[j], area_sum[p] += a[std::size_t(j)];
+    if (pinned[p] < 0) pinned[p] = j;
+  }
+  std::vector<double> mu(std::size_t(parts), 0.0);
+  for (int p = 0; p < parts; ++p) mu[std::size_t(p)] = beta_sum[std::size_t(p)] / area_sum[std::size_t(p)];
+  const auto is_pinned = [&](int j) { return pinned[std::size_t(part[std::size_t(j)])] == j; };
+  std::vector<Eigen::Triplet<double>> laplacian;
+  Eigen::VectorXd rhs(m);
+  for (int j = 0; j < m; ++j) {
+    if (is_pinned(j)) {
+      laplacian.emplace_back(j, j, 1.0);
+      rhs[j] = 0;
+      continue;
+    }
+    rhs[j] = 0.5 * (beta[j] - mu[std::size_t(part[std::size_t(j)])] * a[std::size_t(j)]);
+    double degree = 0;
+    for (Eigen::SparseMatrix<double>::InnerIterator it(W, j); it; ++it) {
+      degree += it.value();
+      if (!is_pinned(int(it.row()))) laplacian.emplace_back(j, int(it.row()), -it.value());
+    }
+    laplacian.emplace_back(j, j, degree);
+  }
+  Eigen::SparseMatrix<double> L(m, m);
+  L.setFromTriplets(laplacian.begin(), laplacian.end());
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factor(L);
+  if (factor.info() != Eigen::Success)
+    throw std::runtime_error("flux balance: the patches' graph Laplacian could not be factorized");
+  const Eigen::VectorXd phi = factor.solve(rhs);
+
+  // X_ik = W_ik(φ_i − φ_k)/a_i beside each neighbour, X_ii = −Σ_k X_ik − μ.
+  std::vector<Eigen::Triplet<double>> x;
+  for (int i = 0; i < m; ++i) {
+    double diagonal = -mu[std::size_t(part[std::size_t(i)])];
+    for (Eigen::SparseMatrix<double>::InnerIterator it(W, i); it; ++it) {
+      const double exchange = it.value() * (phi[i] - phi[it.row()]) / a[std::size_t(i)];
+      x.emplace_back(i, int(it.row()), exchange);
+      diagonal -= exchange;
+    }
+    x.emplace_back(i, i, diagonal);
+  }
+  result.correction.resize(m, m);
+  result.correction.setFromTriplets(x.begin(), x.end());
+  return result;
 }
 
 }  // namespace fictus

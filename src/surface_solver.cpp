@@ -283,6 +283,66 @@ void for_each_omega_point(const Grid3& grid, const Surface& gamma, int q, const 
   });
 }
 
+GridVector omega_load(const Grid3& grid, const Surface& gamma, int q, const Execution& execution) {
+  const double h = grid.h();
+  const GaussRule& rule = gauss_legendre(q);
+  const Box3 bounds = gamma.bounds();
+  std::array<int, 3> first, last;
+  for (int d = 0; d < 3; ++d) {
+    first[d] = grid.cell(d, bounds.lower[d]);
+    last[d] = grid.cell(d, bounds.upper[d]);
+  }
+  GridVector load(grid.n_unknowns(), 0.0);
+  // A voxel adds to the node planes z = k and k + 1 only, so the layers of one parity run in parallel.
+  std::atomic<bool> stop = false;
+  for (int parity = 0; parity < 2; ++parity) {
+#pragma omp parallel for num_threads(execution.threads()) schedule(dynamic, 1)
+    for (int iz = first[2] + parity; iz <= last[2]; iz += 2) {
+      if (omp_get_thread_num() == 0 && execution.interrupt_requested()) stop = true;
+      if (stop) continue;
+      for (int iy = first[1]; iy <= last[1]; ++iy)
+        for (int ix = first[0]; ix <= last[0]; ++ix) {
+          const Grid3::Index cell{ix, iy, iz};
+          const Point3 lower{grid.x(ix), grid.y(iy), grid.z(iz)};
+          std::array<double, 8> sums{};
+          const Point3 center = lower + Point3{h / 2, h / 2, h / 2};
+          if (!near_surface(gamma, center, 0.87 * h)) {  // wholly inside or outside: ∫φ_k = h³/8
+            if (gamma.level(center) > 0) continue;
+            sums.fill(h * h * h / 8);
+          } else {
+            omega_part(grid, gamma, cell, rule, [&](const Point3& x, double w) {
+              const Q1Element<3> basis((1 / h) * (x - lower), h);
+              for (int l = 0; l < 8; ++l) sums[std::size_t(l)] += w * basis.value[l];
+            });
+          }
+          for (int l = 0; l < 8; ++l) {
+            const Grid3::Index node{ix + Q1Element<3>::offset(l, 0), iy + Q1Element<3>::offset(l, 1),
+                                    iz + Q1Element<3>::offset(l, 2)};
+            if (grid.has_unknown(node)) load[grid.index(node)] += sums[std::size_t(l)];
+          }
+        }
+    }
+  }
+  if (stop) throw Interrupted();
+  return load;
+}
+
+double omega_integral(const Grid3& grid, const Surface& gamma, const VectorizedField3& f, int q,
+                      const Execution& execution) {
+  std::vector<double> sums(std::size_t(execution.threads()), 0.0);
+  std::vector<std::array<std::vector<double>, 4>> buffers(std::size_t(execution.threads()));
+  for_each_omega_row(grid, gamma, q, execution, [&](int thread, const std::vector<OmegaPoint>& row) {
+    auto& [x, y, z, value] = buffers[std::size_t(thread)];
+    x.resize(row.size()), y.resize(row.size()), z.resize(row.size()), value.resize(row.size());
+    for (std::size_t p = 0; p < row.size(); ++p) x[p] = row[p].x.x, y[p] = row[p].x.y, z[p] = row[p].x.z;
+    f(row.size(), x.data(), y.data(), z.data(), value.data());
+    for (std::size_t p = 0; p < row.size(); ++p) sums[std::size_t(thread)] += row[p].weight * value[p];
+  });
+  double total = 0;
+  for (double s : sums) total += s;
+  return total;
+}
+
 double omega_volume(const Grid3& grid, const Surface& gamma, int q, const Execution& execution) {
   std::vector<double> sums(execution.threads(), 0.0);
   for_each_omega_point(grid, gamma, q, execution,
@@ -646,6 +706,28 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
     execution.throw_if_interrupted();
   }
   const SparseRows loads = kink ? add_rows(B_Gamma, kink->galerkin()) : B_Gamma;
+  // The flux balance (flux_balance in surface_kink.hpp): X joins D_C, and the data's readings move
+  // by one constant so that their area-weighted sum is c∫_ω u₀ − ∫_ω f, the discrete field's flux.
+  Eigen::SparseMatrix<double> balance;
+  double data_shift = 0;
+  if (kink && options.flux_balance && !fast->singular()) {
+    const GridVector load_of_omega = omega_load(grid, gamma, 3, execution);
+    FluxBalance b = flux_balance(*kink, B_Gamma, C_gamma, loads, direct.normal_derivative, load_of_omega, *fast);
+    direct.normal_derivative += b.correction;
+    balance = std::move(b.correction);
+    std::vector<double> c_u0;
+    C_gamma.multiply(u0, c_u0);
+    double readings = 0, area_total = 0, u0_integral = 0;
+    for (int i = 0; i < m; ++i) readings += b.area[std::size_t(i)] * c_u0[std::size_t(i)], area_total += b.area[std::size_t(i)];
+    for (std::size_t k = 0; k < u0.size(); ++k) u0_integral += load_of_omega[k] * u0[k];
+    const double f_integral = omega_integral(
+        grid, gamma, problem.f_vectorized ? problem.f_vectorized : vectorize(problem.f), 3, execution);
+    data_shift = (problem.c * u0_integral - f_integral - readings) / area_total;
+    sol.flux_balance = SurfaceSolution::FluxBalanceUse{b.scatter, b.mean, data_shift};
+    sol.fast_solves += b.fast_solves;
+    clock.mark("flux_balance");
+    execution.throw_if_interrupted();
+  }
 
   // 3. Schur blocks.
   std::unique_ptr<GreenTable<3>> green;
@@ -693,6 +775,8 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   std::vector<double> b0, c0;
   B_gamma.multiply(u0, b0);
   C_gamma.multiply(u0, c0);
+  if (balance.nonZeros() > 0)  // the data's readings: their area-weighted sum is c∫_ω u₀ − ∫_ω f
+    for (double& v : c0) v += data_shift;
   std::optional<ConstantMode> mode;
   if (fast->singular()) mode = ConstantMode{row_sums(B_gamma), row_sums(C_gamma), row_sums(B_Gamma), load_total};
   const NewtonOptions newton_options = detail::newton_options(options, execution);
@@ -749,6 +833,11 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   sol.u = std::move(u);
   B_gamma.multiply(sol.u, sol.trace);
   C_gamma.multiply(sol.u, sol.normal_derivative);
+  if (balance.nonZeros() > 0) {  // the readings of the Newton system: C_γ I_h w + Xλ + the data's shift
+    Eigen::Map<Eigen::VectorXd>(sol.normal_derivative.data(), m) +=
+        balance * Eigen::Map<const Eigen::VectorXd>(sol.lambda.data(), m);
+    for (double& v : sol.normal_derivative) v += data_shift;
+  }
   clock.mark("final_solve");
   execution.throw_if_interrupted();
 

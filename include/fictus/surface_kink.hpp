@@ -19,6 +19,7 @@
 #include <Eigen/SparseCore>
 
 #include "fictus/execution.hpp"
+#include "fictus/fast_solver.hpp"
 #include "fictus/grid.hpp"
 #include "fictus/surface_solver.hpp"
 #include "fictus/trace_operators.hpp"
@@ -70,6 +71,8 @@ class SurfaceKink {
   /// u += Σ_j λ_j ψ_j at the nodes of the band (0 < d ≤ 6h: every trace stencil and the voxels of
   /// r stay in it): turns u₀ + A⁻¹(B_Γ + R)ᵀλ into the kink-corrected field I_h w.
   void add_kinks(const std::vector<double>& lambda, GridVector& u) const;
+  /// Σ_k ψ_j(x_k)·weights_k over the band's nodes, per patch (with weights ℓ_k = ∫_ω φ_k: ∫_ω I_hψ_j).
+  std::vector<double> band_sums(const GridVector& weights) const;
   /// The number of cut voxels (for reports).
   std::size_t cut_voxels() const;
 
@@ -77,5 +80,24 @@ class SurfaceKink {
   struct State;
   std::unique_ptr<State> state_;
 };
+
+/// The flux balance of the patches (docs/math.md, "The flux balance of the patches"). For f = 0 the
+/// flux through γ of the field of a unit layer on patch j, I_h w_j = A⁻¹(B_Γ + R)ᵀe_j + I_hψ_j, is
+/// c∫_ω I_h w_j; the readings S = C_γ A⁻¹(B_Γ + R)ᵀ + D_C give it as Σ_i a_i S_ij (a_i the patch
+/// areas) and miss it by β_j. X, added to D_C, makes every column right (Σ_i a_i (S + X)_ij =
+/// c∫_ω I_h w_j) and shifts the readings of a constant λ by the same −μλ at every point: each pair of
+/// neighbouring patches (W_ij = Σ_k (B_Γ)_ik (B_Γ)_jk, their rows' overlap) exchanges
+/// W_ij(φ_i − φ_j)(λ_j − λ_i), with Lφ = (β − μa)/2 for the weighted graph Laplacian L of W on each
+/// connected part of γ and μ = Σβ/Σa there. Two fast solves (one when c = 0); not for a singular A.
+struct FluxBalance {
+  Eigen::SparseMatrix<double> correction;  // X, m × m
+  std::vector<double> area;                // a_j = ∫_{P_j} 1 dS, B_Γ's row sums
+  double scatter = 0;                      // the standard deviation of β_j/a_j: each patch's error
+  double mean = 0;                         // μ over all of γ: a constant layer's error per unit λ
+  int fast_solves = 0;
+};
+FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, const SparseRows& C_gamma,
+                         const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C,
+                         const GridVector& load_of_omega, const FastSolver<3>& fast);
 
 }  // namespace fictus

@@ -182,6 +182,14 @@ struct SurfaceSolution {
     std::string skipped;   // non-empty: no nested start, and why
   };
   std::optional<NestedStart> nested_start;
+  /// With formulation.flux_balance (non-smooth): how far the kink-corrected readings missed the
+  /// discrete flux balance before the correction (docs/math.md, "The flux balance of the patches").
+  struct FluxBalanceUse {
+    double scatter = 0;     // the standard deviation over the patches of β_j/a_j
+    double mean = 0;        // μ: a constant layer's error of the mean reading, per unit λ
+    double data_shift = 0;  // what every reading of the data's field u₀ moved by
+  };
+  std::optional<FluxBalanceUse> flux_balance;
   SignoriniCheck signorini;
   std::optional<ErrorNorms> errors;
   std::optional<PointErrors> point_errors;
@@ -222,6 +230,14 @@ bool near_surface(const Surface& gamma, const Point3& center, double radius);
 /// `depth` > 0 splits the half-voxels where γ meets the faces across the line direction up to that many times more.
 void for_each_omega_point_in_voxel(const Grid3& grid, const Surface& gamma, const Grid3::Index& cell, int q,
                                    const std::function<void(const Point3& x, double weight)>& visit, int depth = 0);
+
+/// ∫_ω φ_k for every node with an unknown: h³/8 per corner of a voxel wholly inside γ, the rule above
+/// on the voxels near γ (the load of f = 1_ω).
+GridVector omega_load(const Grid3& grid, const Surface& gamma, int q = 3, const Execution& execution = Execution{});
+
+/// ∫_ω f by that rule, f evaluated one voxel row at a time.
+double omega_integral(const Grid3& grid, const Surface& gamma, const VectorizedField3& f, int q = 3,
+                      const Execution& execution = Execution{});
 
 /// The volume of ω by that rule (a test of it).
 double omega_volume(const Grid3& grid, const Surface& gamma, int q = 3, const Execution& execution = Execution{});
