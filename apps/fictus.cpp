@@ -197,8 +197,9 @@ int run_solve_surface(const std::string& text, const SolveCommand& command) {
     else if (s.nested_start)
       std::printf("no nested start (%s)\n", s.nested_start->skipped.c_str());
     if (s.flux_balance)
-      std::printf("flux balance: the patches' readings missed it by %.2e (scatter) and %.2e (mean), the data's by %.2e\n",
-                  s.flux_balance->scatter, s.flux_balance->mean, s.flux_balance->data_shift);
+      std::printf(
+          "flux balance: the patches' readings missed it by %.2e (scatter) and %.2e (mean), the data's by %.2e\n",
+          s.flux_balance->scatter, s.flux_balance->mean, s.flux_balance->data_shift);
     if (s.far_field) {
       const fictus::FarFieldReport& a = s.far_field->assembly;
       std::printf("Schur complement: %.1f%% of the pairs interpolated; the last %d Newton steps on the exact one\n",

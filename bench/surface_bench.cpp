@@ -49,7 +49,7 @@ double max_relative_difference(const std::vector<double>& a, const std::vector<d
   return difference / largest;
 }
 
-const char* phases[] = {"nested_start", "load",  "u0",     "geometry",    "kink_correction",
+const char* phases[] = {"nested_start", "load",  "u0",     "geometry",    "kink_correction", "flux_balance",
                         "green_table",  "schur", "newton", "final_solve", "errors"};
 
 }  // namespace

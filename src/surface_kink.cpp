@@ -509,12 +509,12 @@ void SurfaceKink::add_kinks(const std::vector<double>& lambda, GridVector& u) co
     if (b.patch >= 0 && st.grid.has_unknown(b.node)) u[st.grid.index(b.node)] += lambda[std::size_t(b.patch)] * b.psi;
 }
 
-
 std::vector<double> SurfaceKink::band_sums(const GridVector& weights) const {
   const State& st = *state_;
   std::vector<double> sums(std::size_t(st.m), 0.0);
   for (const BandNode& b : st.band)
-    if (b.patch >= 0 && st.grid.has_unknown(b.node)) sums[std::size_t(b.patch)] += b.psi * weights[st.grid.index(b.node)];
+    if (b.patch >= 0 && st.grid.has_unknown(b.node))
+      sums[std::size_t(b.patch)] += b.psi * weights[st.grid.index(b.node)];
   return sums;
 }
 
@@ -532,9 +532,8 @@ Eigen::SparseMatrix<double> row_overlaps(const SparseRows& rows) {
   for (int r = 0; r < rows.n_rows(); ++r)
     for (std::size_t e = rows.row_begin[std::size_t(r)]; e < rows.row_begin[std::size_t(r) + 1]; ++e)
       by_node.push_back({rows.entries[e].index, r, rows.entries[e].value});
-  std::sort(by_node.begin(), by_node.end(), [](const NodeValue& a, const NodeValue& b) {
-    return std::tie(a.node, a.row) < std::tie(b.node, b.row);
-  });
+  std::sort(by_node.begin(), by_node.end(),
+            [](const NodeValue& a, const NodeValue& b) { return std::tie(a.node, a.row) < std::tie(b.node, b.row); });
   std::vector<Eigen::Triplet<double>> overlap;
   for (std::size_t first = 0; first < by_node.size();) {
     std::size_t last = first;

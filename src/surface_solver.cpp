@@ -718,10 +718,12 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
     std::vector<double> c_u0;
     C_gamma.multiply(u0, c_u0);
     double readings = 0, area_total = 0, u0_integral = 0;
-    for (int i = 0; i < m; ++i) readings += b.area[std::size_t(i)] * c_u0[std::size_t(i)], area_total += b.area[std::size_t(i)];
+    for (int i = 0; i < m; ++i)
+      readings += b.area[std::size_t(i)] * c_u0[std::size_t(i)], area_total += b.area[std::size_t(i)];
     for (std::size_t k = 0; k < u0.size(); ++k) u0_integral += load_of_omega[k] * u0[k];
-    const double f_integral = omega_integral(
-        grid, gamma, problem.f_vectorized ? problem.f_vectorized : vectorize(problem.f), 3, execution);
+    const double f_integral =
+        omega_integral(grid, gamma, problem.f_vectorized ? problem.f_vectorized : vectorize(problem.f),
+                       options.load_quadrature, execution);
     data_shift = (problem.c * u0_integral - f_integral - readings) / area_total;
     sol.flux_balance = SurfaceSolution::FluxBalanceUse{b.scatter, b.mean, data_shift};
     sol.fast_solves += b.fast_solves;

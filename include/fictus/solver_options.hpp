@@ -30,7 +30,7 @@ struct SolverOptions {
   int max_newton = 50;
   int load_quadrature = 2;       // Gauss points per direction per cell for the load vector
   int error_quadrature = 3;      // Gauss points per direction for the error integrals (exact for |∇e|²)
-  bool flux_balance = true;       // 3-D non-smooth: readings that keep the discrete flux balance (surface_kink.hpp)
+  bool flux_balance = true;      // 3-D non-smooth: readings that keep the discrete flux balance (surface_kink.hpp)
   bool far_field = true;         // 3-D green: interpolate the far pairs of S, then Newton on the exact S from there
   int nested_start = 160;        // 3-D: from this N on, Newton starts from the active set of a solve on the N/2 grid
   bool condition_number = true;  // of the final Newton matrix (2-D green path only)
