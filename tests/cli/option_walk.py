@@ -44,6 +44,7 @@ WALK = {
     "load_quadrature": 3,
     "error_quadrature": 4,
     "far_field": False,
+    "flux_balance": False,
     "nested_start": 96,
     "condition_number": False,
 }
