@@ -198,7 +198,8 @@ int run_solve_surface(const std::string& text, const SolveCommand& command) {
       std::printf("no nested start (%s)\n", s.nested_start->skipped.c_str());
     if (s.flux_balance)
       std::printf(
-          "flux balance: the patches' readings missed it by %.2e (scatter) and %.2e (mean), the data's by %.2e\n",
+          "flux balance: before it each patch's reading missed its share of the flux by %.2e (scatter), "
+          "a constant layer's by %.2e; the data's readings moved by %.2e\n",
           s.flux_balance->scatter, s.flux_balance->mean, s.flux_balance->data_shift);
     if (s.far_field) {
       const fictus::FarFieldReport& a = s.far_field->assembly;

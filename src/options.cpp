@@ -198,8 +198,9 @@ std::vector<OptionSpec> make_specs() {
   {
     OptionSpec b = member(std::string("formulation"), std::string("flux_balance"), OptionType::boolean,
                           &SolverOptions::flux_balance,
-                          "3-D non-smooth: correct the readings ∂u/∂n so that each patch's multiplier and the data "
-                          "move their area-weighted sum over γ by the discrete field's flux c∫_ω u − ∫_ω f");
+                          "3-D non-smooth, reconstructed traces (not a periodic box with c = 0): correct the "
+                          "readings ∂u/∂n so that each patch's multiplier and the data move their area-weighted "
+                          "sum over γ by the discrete field's flux c∫_ω u − ∫_ω f");
     b.rule = "true or false";
     b.violation = [](const OptionValue&) { return std::string(); };
     specs.push_back(b);

@@ -542,6 +542,7 @@ Eigen::SparseMatrix<double> row_overlaps(const SparseRows& rows) {
       for (std::size_t q = p + 1; q < last; ++q)
         if (by_node[p].row != by_node[q].row) {
           const double w = by_node[p].value * by_node[q].value;
+          if (!(w > 0)) continue;  // a touch at one corner with no weight is no neighbour
           overlap.emplace_back(by_node[p].row, by_node[q].row, w);
           overlap.emplace_back(by_node[q].row, by_node[p].row, w);
         }
@@ -575,9 +576,13 @@ std::pair<std::vector<int>, int> connected_parts(const Eigen::SparseMatrix<doubl
 }  // namespace
 
 FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, const SparseRows& C_gamma,
-                         const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C,
-                         const GridVector& load_of_omega, const FastSolver<3>& fast) {
+                         const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C, GridVector load_of_omega,
+                         const FastSolver<3>& fast) {
   const int m = B_Gamma.n_rows();
+  if (fast.singular()) throw std::invalid_argument("flux_balance: A is singular (a periodic box with c = 0)");
+  if (C_gamma.n_rows() != m || loads.n_rows() != m || D_C.rows() != m || D_C.cols() != m ||
+      (fast.c() != 0.0 && load_of_omega.size() != fast.grid().n_unknowns()))
+    throw std::invalid_argument("flux_balance: the rows, D_C and the load of ω do not match");
   FluxBalance result;
   result.area.assign(std::size_t(m), 0.0);  // ∫_{P_j} 1 dS (no wall node lies near γ)
   for (int j = 0; j < m; ++j)
@@ -600,11 +605,10 @@ FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, con
   // Φ = A⁻¹ℓ (ℓ_k = ∫_ω φ_k), c((B_Γ + R)_j·Φ + Σ_k ψ_j(x_k)ℓ_k).
   std::vector<double> flux(std::size_t(m), 0.0);
   if (fast.c() != 0.0) {
-    GridVector phi = load_of_omega;
-    fast.solve_in_place(phi);
-    ++result.fast_solves;
-    loads.multiply(phi, flux);
     const std::vector<double> band = kink.band_sums(load_of_omega);
+    fast.solve_in_place(load_of_omega);  // now Φ
+    ++result.fast_solves;
+    loads.multiply(load_of_omega, flux);
     for (int j = 0; j < m; ++j) flux[std::size_t(j)] = fast.c() * (flux[std::size_t(j)] + band[std::size_t(j)]);
   }
   Eigen::VectorXd beta(m);

@@ -214,6 +214,17 @@ void cut_cube(const Surface& gamma, const Point3& lower, double side, const Gaus
     }
 }
 
+/// The voxels of γ's bounding box, the only ones that can meet ω: first and last index per axis.
+std::pair<std::array<int, 3>, std::array<int, 3>> bounding_voxels(const Grid3& grid, const Surface& gamma) {
+  const Box3 bounds = gamma.bounds();
+  std::array<int, 3> first, last;
+  for (int d = 0; d < 3; ++d) {
+    first[d] = grid.cell(d, bounds.lower[d]);
+    last[d] = grid.cell(d, bounds.upper[d]);
+  }
+  return {first, last};
+}
+
 /// The rule's points in ω ∩ one voxel: q³ Gauss points when γ stays away from it, else its eight
 /// half-voxels by cut_cube.
 template <class Visit>
@@ -248,12 +259,7 @@ void for_each_omega_point_in_voxel(const Grid3& grid, const Surface& gamma, cons
 void for_each_omega_row(const Grid3& grid, const Surface& gamma, int q, const Execution& execution,
                         const OmegaRowVisitor& visit) {
   const GaussRule& rule = gauss_legendre(q);
-  const Box3 bounds = gamma.bounds();
-  std::array<int, 3> first, last;
-  for (int d = 0; d < 3; ++d) {
-    first[d] = grid.cell(d, bounds.lower[d]);
-    last[d] = grid.cell(d, bounds.upper[d]);
-  }
+  const auto [first, last] = bounding_voxels(grid, gamma);
   std::atomic<bool> stop = false;
 #pragma omp parallel num_threads(execution.threads())
   {
@@ -286,12 +292,7 @@ void for_each_omega_point(const Grid3& grid, const Surface& gamma, int q, const 
 GridVector omega_load(const Grid3& grid, const Surface& gamma, int q, const Execution& execution) {
   const double h = grid.h();
   const GaussRule& rule = gauss_legendre(q);
-  const Box3 bounds = gamma.bounds();
-  std::array<int, 3> first, last;
-  for (int d = 0; d < 3; ++d) {
-    first[d] = grid.cell(d, bounds.lower[d]);
-    last[d] = grid.cell(d, bounds.upper[d]);
-  }
+  const auto [first, last] = bounding_voxels(grid, gamma);
   GridVector load(grid.n_unknowns(), 0.0);
   // A voxel adds to the node planes z = k and k + 1 only, so the layers of one parity run in parallel.
   std::atomic<bool> stop = false;
@@ -329,17 +330,21 @@ GridVector omega_load(const Grid3& grid, const Surface& gamma, int q, const Exec
 
 double omega_integral(const Grid3& grid, const Surface& gamma, const VectorizedField3& f, int q,
                       const Execution& execution) {
-  std::vector<double> sums(std::size_t(execution.threads()), 0.0);
+  // One sum per voxel row, added in row order afterwards: the same total on any number of threads.
+  const std::size_t rows_per_layer = std::size_t(grid.ny() + 1);
+  std::vector<double> per_row(rows_per_layer * std::size_t(grid.nz() + 1), 0.0);
   std::vector<std::array<std::vector<double>, 4>> buffers(std::size_t(execution.threads()));
   for_each_omega_row(grid, gamma, q, execution, [&](int thread, const std::vector<OmegaPoint>& row) {
     auto& [x, y, z, value] = buffers[std::size_t(thread)];
     x.resize(row.size()), y.resize(row.size()), z.resize(row.size()), value.resize(row.size());
     for (std::size_t p = 0; p < row.size(); ++p) x[p] = row[p].x.x, y[p] = row[p].x.y, z[p] = row[p].x.z;
     f(row.size(), x.data(), y.data(), z.data(), value.data());
-    for (std::size_t p = 0; p < row.size(); ++p) sums[std::size_t(thread)] += row[p].weight * value[p];
+    double sum = 0;
+    for (std::size_t p = 0; p < row.size(); ++p) sum += row[p].weight * value[p];
+    per_row[std::size_t(row[0].cell[2]) * rows_per_layer + std::size_t(row[0].cell[1])] = sum;
   });
   double total = 0;
-  for (double s : sums) total += s;
+  for (double s : per_row) total += s;
   return total;
 }
 
@@ -711,19 +716,23 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   Eigen::SparseMatrix<double> balance;
   double data_shift = 0;
   if (kink && options.flux_balance && !fast->singular()) {
-    const GridVector load_of_omega = omega_load(grid, gamma, 3, execution);
-    FluxBalance b = flux_balance(*kink, B_Gamma, C_gamma, loads, direct.normal_derivative, load_of_omega, *fast);
+    constexpr int load_points = 3;  // per Gauss line of the cut-voxel rule, as the error integrals'
+    GridVector load_of_omega = problem.c != 0.0 ? omega_load(grid, gamma, load_points, execution) : GridVector();
+    double u0_integral = 0;  // ∫_ω u₀
+    for (std::size_t k = 0; k < load_of_omega.size(); ++k) u0_integral += load_of_omega[k] * u0[k];
+    FluxBalance b =
+        flux_balance(*kink, B_Gamma, C_gamma, loads, direct.normal_derivative, std::move(load_of_omega), *fast);
     direct.normal_derivative += b.correction;
     balance = std::move(b.correction);
     std::vector<double> c_u0;
     C_gamma.multiply(u0, c_u0);
-    double readings = 0, area_total = 0, u0_integral = 0;
+    double readings = 0, area_total = 0;
     for (int i = 0; i < m; ++i)
       readings += b.area[std::size_t(i)] * c_u0[std::size_t(i)], area_total += b.area[std::size_t(i)];
-    for (std::size_t k = 0; k < u0.size(); ++k) u0_integral += load_of_omega[k] * u0[k];
     const double f_integral =
         omega_integral(grid, gamma, problem.f_vectorized ? problem.f_vectorized : vectorize(problem.f),
                        options.load_quadrature, execution);
+    if (!std::isfinite(f_integral)) throw std::invalid_argument("data.f: not finite somewhere in ω");
     data_shift = (problem.c * u0_integral - f_integral - readings) / area_total;
     sol.flux_balance = SurfaceSolution::FluxBalanceUse{b.scatter, b.mean, data_shift};
     sol.fast_solves += b.fast_solves;
@@ -777,7 +786,7 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   std::vector<double> b0, c0;
   B_gamma.multiply(u0, b0);
   C_gamma.multiply(u0, c0);
-  if (balance.nonZeros() > 0)  // the data's readings: their area-weighted sum is c∫_ω u₀ − ∫_ω f
+  if (sol.flux_balance)  // the data's readings: their area-weighted sum is c∫_ω u₀ − ∫_ω f
     for (double& v : c0) v += data_shift;
   std::optional<ConstantMode> mode;
   if (fast->singular()) mode = ConstantMode{row_sums(B_gamma), row_sums(C_gamma), row_sums(B_Gamma), load_total};
@@ -835,7 +844,7 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   sol.u = std::move(u);
   B_gamma.multiply(sol.u, sol.trace);
   C_gamma.multiply(sol.u, sol.normal_derivative);
-  if (balance.nonZeros() > 0) {  // the readings of the Newton system: C_γ I_h w + Xλ + the data's shift
+  if (sol.flux_balance) {  // the readings of the Newton system: C_γ I_h w + Xλ + the data's shift
     Eigen::Map<Eigen::VectorXd>(sol.normal_derivative.data(), m) +=
         balance * Eigen::Map<const Eigen::VectorXd>(sol.lambda.data(), m);
     for (double& v : sol.normal_derivative) v += data_shift;

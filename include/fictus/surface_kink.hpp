@@ -86,9 +86,11 @@ class SurfaceKink {
 /// c∫_ω I_h w_j; the readings S = C_γ A⁻¹(B_Γ + R)ᵀ + D_C give it as Σ_i a_i S_ij (a_i the patch
 /// areas) and miss it by β_j. X, added to D_C, makes every column right (Σ_i a_i (S + X)_ij =
 /// c∫_ω I_h w_j) and shifts the readings of a constant λ by the same −μλ at every point: each pair of
-/// neighbouring patches (W_ij = Σ_k (B_Γ)_ik (B_Γ)_jk, their rows' overlap) exchanges
-/// W_ij(φ_i − φ_j)(λ_j − λ_i), with Lφ = (β − μa)/2 for the weighted graph Laplacian L of W on each
-/// connected part of γ and μ = Σβ/Σa there. Two fast solves (one when c = 0); not for a singular A.
+/// neighbouring patches (W_ij = Σ_k (B_Γ)_ik (B_Γ)_jk > 0, their rows' overlap) adds the same
+/// W_ij(φ_i − φ_j)(λ_j − λ_i) to both of their area-weighted readings (nothing when λ_i = λ_j), with
+/// Lφ = (β − μa)/2 for the weighted graph Laplacian L of W on each connected part of γ and μ = Σβ/Σa
+/// there. load_of_omega: ℓ_k = ∫_ω φ_k (unused when c = 0). Two fast solves (one when c = 0);
+/// throws std::invalid_argument for a singular A.
 struct FluxBalance {
   Eigen::SparseMatrix<double> correction;  // X, m × m
   std::vector<double> area;                // a_j = ∫_{P_j} 1 dS, B_Γ's row sums
@@ -97,7 +99,7 @@ struct FluxBalance {
   int fast_solves = 0;
 };
 FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, const SparseRows& C_gamma,
-                         const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C,
-                         const GridVector& load_of_omega, const FastSolver<3>& fast);
+                         const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C, GridVector load_of_omega,
+                         const FastSolver<3>& fast);
 
 }  // namespace fictus

@@ -232,10 +232,12 @@ void for_each_omega_point_in_voxel(const Grid3& grid, const Surface& gamma, cons
                                    const std::function<void(const Point3& x, double weight)>& visit, int depth = 0);
 
 /// ∫_ω φ_k for every node with an unknown: h³/8 per corner of a voxel wholly inside γ, the rule above
-/// on the voxels near γ (the load of f = 1_ω).
+/// on the voxels near γ (the load of f = 1_ω). γ must stay a cell away from the walls (solve checks
+/// 2h), so that no two of the parallel voxel layers write one node plane of a periodic grid.
 GridVector omega_load(const Grid3& grid, const Surface& gamma, int q = 3, const Execution& execution = Execution{});
 
-/// ∫_ω f by that rule, f evaluated one voxel row at a time.
+/// ∫_ω f by that rule, f evaluated one voxel row at a time and the rows summed in order (the same
+/// result on any number of threads).
 double omega_integral(const Grid3& grid, const Surface& gamma, const VectorizedField3& f, int q = 3,
                       const Execution& execution = Execution{});
 

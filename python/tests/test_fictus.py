@@ -324,6 +324,20 @@ def test_surface_solution_reports_the_nested_start():
     assert odd.nested_start["skipped"] == "N is odd", odd.nested_start
 
 
+def test_surface_solution_reports_the_flux_balance():
+    sphere = dict(domain=dict(N=48), geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.3),
+                  data=dict(f="-1", g="0.2 * (x - 0.5)"))
+    balanced = fictus.SurfaceProblem(formulation=dict(variant="nonsmooth"), solver=dict(threads=2), **sphere).solve()
+    without = fictus.SurfaceProblem(formulation=dict(variant="nonsmooth", flux_balance=False), solver=dict(threads=2),
+                                    **sphere).solve()
+    smooth = fictus.SurfaceProblem(formulation=dict(variant="smooth", multipliers=129), solver=dict(threads=2),
+                                   **dict(sphere, domain=dict(N=64))).solve()
+    assert set(balanced.flux_balance) == {"scatter", "mean", "data_shift"}
+    assert 0 < balanced.flux_balance["scatter"] < 0.1, balanced.flux_balance
+    assert "flux_balance" in balanced.timings
+    assert without.flux_balance is None and smooth.flux_balance is None
+
+
 def numpy_function(text):
     """A problem file's expression ("q0 = ..., q1 = ..., result": muParser syntax) as a numpy callable f(x, y, z)."""
     parts, depth, start = [], 0, 0

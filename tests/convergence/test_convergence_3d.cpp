@@ -12,6 +12,7 @@
 
 #include "fictus/convergence_table.hpp"
 #include "fictus/execution.hpp"
+#include "fictus/load_vector.hpp"
 #include "fictus/mesh_surface.hpp"
 #include "manufactured_solutions_3d.hpp"
 
@@ -268,6 +269,35 @@ TEST(Manufactured3d, PureNeumannSphereConvergesInTheNonSmoothVariant) {
   const std::vector<double> e = pure_neumann_errors("sphere_neumann", {96, 128}, fictus::Variant::nonsmooth);
   EXPECT_LT(e[1], 6e-5);
   EXPECT_GT(std::log(e[0] / e[1]) / std::log(128.0 / 96), 1.5);
+}
+
+TEST(Manufactured3d, TheFluxBalanceHoldsOnTheSolution) {
+  // With the flux balance the readings Newton enforces sum, weighted by the patch areas, to the
+  // discrete field's own flux c∫_ω û − ∫_ω f (the same rules for ℓ_k = ∫_ω φ_k and ∫_ω f as the
+  // solver's). On the pure Neumann sphere every reading is 0, so the flux must vanish to Newton's
+  // tolerance; without the balance it does not.
+  const fictus::SurfaceProblem p = problem("sphere_neumann", 48);
+  const auto flux = [&p](bool balance) {
+    fictus::SolverOptions o;
+    o.threads = 2;
+    o.variant = fictus::Variant::nonsmooth;
+    o.flux_balance = balance;
+    const fictus::SurfaceSolution s = fictus::solve(p, o);
+    EXPECT_TRUE(s.newton.converged);
+    EXPECT_EQ(s.flux_balance.has_value(), balance);
+    const fictus::Execution execution(2);
+    const fictus::GridVector load = fictus::omega_load(s.grid, *p.gamma, 3, execution);
+    double u_integral = 0, readings = 0;
+    for (std::size_t k = 0; k < load.size(); ++k) u_integral += load[k] * s.u[k];
+    for (int i = 0; i < s.gamma.m; ++i) readings += s.gamma.area[std::size_t(i)] * s.normal_derivative[std::size_t(i)];
+    const double f_integral =
+        fictus::omega_integral(s.grid, *p.gamma, fictus::vectorize(p.f), o.load_quadrature, execution);
+    std::cout << (balance ? "balanced" : "without") << ": c∫u − ∫f = " << p.c * u_integral - f_integral
+              << ", Σ a_i ∂u/∂n_i = " << readings << ", ∫f = " << f_integral << "\n";
+    return std::abs(p.c * u_integral - f_integral - readings) / std::abs(f_integral);
+  };
+  EXPECT_LT(flux(true), 1e-8);
+  EXPECT_GT(flux(false), 1e-6);
 }
 
 TEST(Manufactured3d, NonSmoothShiftedRuleStallsWithoutTheKinkCorrection) {
