@@ -20,6 +20,7 @@
 
 #include "fictus/q1_element.hpp"
 #include "fictus/quadrature.hpp"
+#include "solve_steps.hpp"
 
 namespace fictus {
 
@@ -584,23 +585,19 @@ FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, con
       (fast.c() != 0.0 && load_of_omega.size() != fast.grid().n_unknowns()))
     throw std::invalid_argument("flux_balance: the rows, D_C and the load of ω do not match");
   FluxBalance result;
-  result.area.assign(std::size_t(m), 0.0);  // ∫_{P_j} 1 dS (no wall node lies near γ)
-  for (int j = 0; j < m; ++j)
-    for (std::size_t e = B_Gamma.row_begin[std::size_t(j)]; e < B_Gamma.row_begin[std::size_t(j) + 1]; ++e)
-      result.area[std::size_t(j)] += B_Gamma.entries[e].value;
-  const std::vector<double>& a = result.area;
-  const Eigen::Map<const Eigen::VectorXd> a_vector(a.data(), m);
+  result.area = detail::row_sums(B_Gamma);  // ∫_{P_j} 1 dS (no wall node lies near γ)
+  const Eigen::VectorXd& a = result.area;
 
   // Σ_i a_i S_ij = (B_Γ + R)_j·y + (D_Cᵀa)_j with y = A⁻¹C_γᵀa (one adjoint solve).
   std::vector<double> share;
   {
     GridVector y(fast.grid().n_unknowns(), 0.0);
-    C_gamma.add_transposed(a, y);
+    C_gamma.add_transposed(std::vector<double>(a.begin(), a.end()), y);
     fast.solve_in_place(y);
     loads.multiply(y, share);
     ++result.fast_solves;
   }
-  const Eigen::VectorXd from_direct = D_C.transpose() * a_vector;
+  const Eigen::VectorXd from_direct = D_C.transpose() * a;
   // c∫_ω of the field of a unit layer on patch j, I_h w_j = A⁻¹(B_Γ + R)ᵀe_j + I_hψ_j: with
   // Φ = A⁻¹ℓ (ℓ_k = ∫_ω φ_k), c((B_Γ + R)_j·Φ + Σ_k ψ_j(x_k)ℓ_k).
   std::vector<double> flux(std::size_t(m), 0.0);
@@ -615,10 +612,10 @@ FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, con
   for (int j = 0; j < m; ++j) beta[j] = share[std::size_t(j)] + from_direct[j] - flux[std::size_t(j)];
   {
     double mean = 0, square = 0;
-    for (int j = 0; j < m; ++j) mean += beta[j] / a[std::size_t(j)] / m;
-    for (int j = 0; j < m; ++j) square += std::pow(beta[j] / a[std::size_t(j)] - mean, 2) / m;
+    for (int j = 0; j < m; ++j) mean += beta[j] / a[j] / m;
+    for (int j = 0; j < m; ++j) square += std::pow(beta[j] / a[j] - mean, 2) / m;
     result.scatter = std::sqrt(square);
-    result.mean = beta.sum() / a_vector.sum();
+    result.mean = beta.sum() / a.sum();
   }
 
   // On each connected part of γ: μ = Σβ/Σa, and Lφ = (β − μa)/2 with φ = 0 at the part's first patch
@@ -629,7 +626,7 @@ FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, con
   std::vector<int> pinned(std::size_t(parts), -1);
   for (int j = 0; j < m; ++j) {
     const std::size_t p = std::size_t(part[std::size_t(j)]);
-    beta_sum[p] += beta[j], area_sum[p] += a[std::size_t(j)];
+    beta_sum[p] += beta[j], area_sum[p] += a[j];
     if (pinned[p] < 0) pinned[p] = j;
   }
   std::vector<double> mu(std::size_t(parts), 0.0);
@@ -643,7 +640,7 @@ FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, con
       rhs[j] = 0;
       continue;
     }
-    rhs[j] = 0.5 * (beta[j] - mu[std::size_t(part[std::size_t(j)])] * a[std::size_t(j)]);
+    rhs[j] = 0.5 * (beta[j] - mu[std::size_t(part[std::size_t(j)])] * a[j]);
     double degree = 0;
     for (Eigen::SparseMatrix<double>::InnerIterator it(W, j); it; ++it) {
       degree += it.value();
@@ -663,9 +660,9 @@ FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, con
   for (int i = 0; i < m; ++i) {
     double diagonal = -mu[std::size_t(part[std::size_t(i)])];
     for (Eigen::SparseMatrix<double>::InnerIterator it(W, i); it; ++it) {
-      const double exchange = it.value() * (phi[i] - phi[it.row()]) / a[std::size_t(i)];
-      x.emplace_back(i, int(it.row()), exchange);
-      diagonal -= exchange;
+      const double off_diagonal = it.value() * (phi[i] - phi[it.row()]) / a[i];
+      x.emplace_back(i, int(it.row()), off_diagonal);
+      diagonal -= off_diagonal;
     }
     x.emplace_back(i, i, diagonal);
   }

@@ -726,9 +726,7 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
     balance = std::move(b.correction);
     std::vector<double> c_u0;
     C_gamma.multiply(u0, c_u0);
-    double readings = 0, area_total = 0;
-    for (int i = 0; i < m; ++i)
-      readings += b.area[std::size_t(i)] * c_u0[std::size_t(i)], area_total += b.area[std::size_t(i)];
+    const double readings = b.area.dot(to_eigen(c_u0)), area_total = b.area.sum();
     const double f_integral =
         omega_integral(grid, gamma, problem.f_vectorized ? problem.f_vectorized : vectorize(problem.f),
                        options.load_quadrature, execution);

@@ -93,7 +93,7 @@ class SurfaceKink {
 /// throws std::invalid_argument for a singular A.
 struct FluxBalance {
   Eigen::SparseMatrix<double> correction;  // X, m × m
-  std::vector<double> area;                // a_j = ∫_{P_j} 1 dS, B_Γ's row sums
+  Eigen::VectorXd area;                    // a_j = ∫_{P_j} 1 dS, B_Γ's row sums
   double scatter = 0;                      // the standard deviation of β_j/a_j: each patch's error
   double mean = 0;                         // μ over all of γ: a constant layer's error per unit λ
   int fast_solves = 0;
