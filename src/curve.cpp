@@ -58,6 +58,13 @@ Point2 TransformedCurve::position(double t) const {
   return c + rotate(base_->position(t) - c) + shift_;
 }
 
+std::vector<Point2> TransformedCurve::polygon_vertices() const {
+  std::vector<Point2> vertices = base_->polygon_vertices();
+  const Point2 c = base_->center();
+  for (Point2& v : vertices) v = c + rotate(v - c) + shift_;
+  return vertices;
+}
+
 ArcLengthTable::ArcLengthTable(const Curve& curve, int panels)
     : ArcLengthTable([&curve](double t) { return curve.speed(t); }, panels) {}
 

@@ -181,6 +181,11 @@ Point2 StarCurve::position(double t) const {
 Point2 ReversedCurve::position(double t) const { return base_->position(two_pi - t); }
 Point2 ReversedCurve::derivative(double t) const { return -1.0 * base_->derivative(two_pi - t); }
 Point2 ReversedCurve::second_derivative(double t) const { return base_->second_derivative(two_pi - t); }
+std::vector<Point2> ReversedCurve::polygon_vertices() const {
+  std::vector<Point2> vertices = base_->polygon_vertices();  // t ↦ 2π − t: v0, v(n−1), …, v1
+  if (!vertices.empty()) std::reverse(vertices.begin() + 1, vertices.end());
+  return vertices;
+}
 std::vector<double> ReversedCurve::corners() const {
   std::vector<double> t;
   for (double c : base_->corners()) t.push_back(c == 0.0 ? 0.0 : two_pi - c);
@@ -226,9 +231,90 @@ Point2 centroid(const Curve& curve) {
   return {mx / area, my / area};
 }
 
+namespace {
+
+[[noreturn]] void touches_itself(const std::string& what, Point2 near) {
+  std::ostringstream msg;
+  msg << what << ": the curve intersects or touches itself near (" << near.x << ", " << near.y << ")";
+  throw std::invalid_argument(msg.str());
+}
+
+/// The extent of the closed polyline p; throws when it is zero or overflows.
+double checked_extent(const std::vector<Point2>& p, const std::string& what) {
+  double x0 = p[0].x, x1 = x0, y0 = p[0].y, y1 = y0;
+  for (const Point2& q : p) {
+    if (!std::isfinite(q.x) || !std::isfinite(q.y)) throw std::invalid_argument(what + ": the curve is not finite");
+    x0 = std::min(x0, q.x), x1 = std::max(x1, q.x), y0 = std::min(y0, q.y), y1 = std::max(y1, q.y);
+  }
+  const double size = std::max(x1 - x0, y1 - y0);
+  if (!(size > 0 && size <= 1e100))  // an extent that overflows (semi-axes of 1e308) or a point
+    throw std::invalid_argument(what + ": the curve's extent is " + (size > 0 ? "beyond 1e100" : "zero"));
+  return size;
+}
+
+/// The closed polyline through p (edge k from p[k] to p[k+1], the last one back to p[0]) is simple:
+/// edges that are not neighbours do not meet (decided exactly) nor come within `closeness`;
+/// neighbours meet only in their common vertex. The edges are bucketed on a coarse grid so that the
+/// check stays near-linear.
+void check_simple_polyline(const std::vector<Point2>& p, double closeness, const std::string& what) {
+  const std::size_t n = p.size();
+  for (std::size_t k = 0; k < n; ++k) {  // neighbours: no fold back along a line, no near-overlap
+    const Point2 a = p[k], b = p[(k + 1) % n], c = p[(k + 2) % n];
+    const Point2 ab = b - a, bc = c - b;
+    if (orientation(a, b, c) == 0 && ab.x * bc.x + ab.y * bc.y < 0) touches_itself(what, b);
+    if (distance_to_segment(a, b, c) <= closeness || distance_to_segment(c, a, b) <= closeness) touches_itself(what, b);
+  }
+  double x0 = p[0].x, x1 = x0, y0 = p[0].y, y1 = y0;
+  for (const Point2& q : p)
+    x0 = std::min(x0, q.x), x1 = std::max(x1, q.x), y0 = std::min(y0, q.y), y1 = std::max(y1, q.y);
+  const int cells = std::clamp(int(std::sqrt(double(n))), 1, 64);
+  const double wx = (x1 - x0) / cells + 1e-300, wy = (y1 - y0) / cells + 1e-300;
+  std::vector<std::vector<std::size_t>> bucket(cells * cells);
+  auto cell = [&](double v, double origin, double w) { return std::clamp(int((v - origin) / w), 0, cells - 1); };
+  const double grow = closeness;  // an edge within `closeness` of another shares a bucket with it
+  for (std::size_t k = 0; k < n; ++k) {
+    const Point2 a = p[k], b = p[(k + 1) % n];
+    for (int i = cell(std::min(a.x, b.x) - grow, x0, wx); i <= cell(std::max(a.x, b.x) + grow, x0, wx); ++i)
+      for (int j = cell(std::min(a.y, b.y) - grow, y0, wy); j <= cell(std::max(a.y, b.y) + grow, y0, wy); ++j)
+        bucket[j * cells + i].push_back(k);
+  }
+  for (const auto& edges : bucket)
+    for (std::size_t u = 0; u < edges.size(); ++u)
+      for (std::size_t v = u + 1; v < edges.size(); ++v) {
+        const std::size_t a = edges[u], b = edges[v];
+        if (a == b || (a + 1) % n == b || (b + 1) % n == a) continue;
+        if (segments_meet(p[a], p[(a + 1) % n], p[b], p[(b + 1) % n], closeness)) touches_itself(what, p[a]);
+      }
+}
+
+}  // namespace
+
+void check_simple_polygon(const std::vector<Point2>& vertices, const std::string& what) {
+  if (vertices.size() < 3) throw std::invalid_argument(what + ": a polygon needs at least 3 vertices");
+  const double size = checked_extent(vertices, what);
+  check_simple_polyline(vertices, 1e-12 * size, what);
+}
+
 void check_simple(const Curve& curve, const std::string& what, int samples) {
-  std::vector<double> t = curve.corners();
-  for (int k = 0; k < samples; ++k) t.push_back(two_pi * k / samples);
+  if (const std::vector<Point2> vertices = curve.polygon_vertices(); !vertices.empty())
+    return check_simple_polygon(vertices, what);
+  // Samples equally spaced in t, and the corners; a sample within a quarter spacing of a corner is
+  // left out (a corner one rounding step from a sample would leave a piece of 1e-16 whose
+  // neighbours "touch").
+  std::vector<double> corners = curve.corners();
+  for (double& c : corners) c = wrap_parameter(c);
+  std::sort(corners.begin(), corners.end());
+  const double spacing = two_pi / samples;
+  auto near_corner = [&](double t) {
+    for (double c : corners) {
+      const double d = std::abs(t - c);
+      if (std::min(d, two_pi - d) < spacing / 4) return true;
+    }
+    return false;
+  };
+  std::vector<double> t = corners;
+  for (int k = 0; k < samples; ++k)
+    if (!near_corner(spacing * k)) t.push_back(spacing * k);
   std::sort(t.begin(), t.end());
   t.erase(std::unique(t.begin(), t.end()), t.end());
   std::vector<Point2> p;
@@ -240,14 +326,7 @@ void check_simple(const Curve& curve, const std::string& what, int samples) {
       throw std::invalid_argument(msg.str());
     }
   }
-  const std::size_t n = p.size();
-  // Bucket the segments on a coarse grid so the check stays near-linear.
-  double x0 = p[0].x, x1 = x0, y0 = p[0].y, y1 = y0;
-  for (const Point2& q : p)
-    x0 = std::min(x0, q.x), x1 = std::max(x1, q.x), y0 = std::min(y0, q.y), y1 = std::max(y1, q.y);
-  const double size = std::max(x1 - x0, y1 - y0);
-  if (!(size > 0 && size <= 1e100))  // an extent that overflows (semi-axes of 1e308) or a point
-    throw std::invalid_argument(what + ": the curve's extent is " + (size > 0 ? "beyond 1e100" : "zero"));
+  const double size = checked_extent(p, what);
   {  // closed: p(2π) = p(0) (a jump of x(t), y(t) or r(t) at 2π is not a closed curve)
     const Point2 gap = curve.position(two_pi) - curve.position(0.0);
     if (!(norm(gap) <= 1e-9 * size)) {
@@ -256,27 +335,7 @@ void check_simple(const Curve& curve, const std::string& what, int samples) {
       throw std::invalid_argument(msg.str());
     }
   }
-  const int cells = 64;
-  const double wx = (x1 - x0) / cells + 1e-300, wy = (y1 - y0) / cells + 1e-300;
-  std::vector<std::vector<std::size_t>> bucket(cells * cells);
-  auto cell = [&](double v, double origin, double w) { return std::clamp(int((v - origin) / w), 0, cells - 1); };
-  for (std::size_t k = 0; k < n; ++k) {
-    const Point2 a = p[k], b = p[(k + 1) % n];
-    for (int i = cell(std::min(a.x, b.x), x0, wx); i <= cell(std::max(a.x, b.x), x0, wx); ++i)
-      for (int j = cell(std::min(a.y, b.y), y0, wy); j <= cell(std::max(a.y, b.y), y0, wy); ++j)
-        bucket[j * cells + i].push_back(k);
-  }
-  for (const auto& segs : bucket)
-    for (std::size_t u = 0; u < segs.size(); ++u)
-      for (std::size_t v = u + 1; v < segs.size(); ++v) {
-        const std::size_t a = segs[u], b = segs[v];
-        if (a == b || (a + 1) % n == b || (b + 1) % n == a) continue;
-        if (segments_meet(p[a], p[(a + 1) % n], p[b], p[(b + 1) % n], 1e-12 * size)) {
-          std::ostringstream msg;
-          msg << what << ": the curve intersects or touches itself near (" << p[a].x << ", " << p[a].y << ")";
-          throw std::invalid_argument(msg.str());
-        }
-      }
+  check_simple_polyline(p, 1e-12 * size, what);
 }
 
 void check_inside_box(const Curve& curve, const Box2& box, double margin, const std::string& what, int samples) {

@@ -24,6 +24,9 @@ class Curve {
   virtual std::vector<double> corners() const { return {}; }
   /// Has a continuous tangent (the smooth variant's offset curve needs one).
   virtual bool smooth() const { return true; }
+  /// The vertices, in the order of t, when the curve is exactly the closed polygon through them;
+  /// empty for any other curve. Checks of a polygon use its own edges, not samples.
+  virtual std::vector<Point2> polygon_vertices() const { return {}; }
 
   double speed(double t) const { return norm(derivative(t)); }
   Point2 outward_normal(double t) const;
@@ -75,6 +78,7 @@ class TransformedCurve final : public Curve {
   Point2 center() const override { return base_->center() + shift_; }
   std::vector<double> corners() const override { return base_->corners(); }  // the same parameter t
   bool smooth() const override { return base_->smooth(); }
+  std::vector<Point2> polygon_vertices() const override;
 
  private:
   Point2 rotate(Point2 v) const { return {cos_ * v.x - sin_ * v.y, sin_ * v.x + cos_ * v.y}; }

@@ -24,6 +24,7 @@ class PolygonCurve final : public Curve {
   Point2 center() const override { return centroid_; }
   std::vector<double> corners() const override;
   bool smooth() const override { return false; }
+  std::vector<Point2> polygon_vertices() const override { return vertices_; }
   const std::vector<Point2>& vertices() const { return vertices_; }
 
  private:
@@ -72,6 +73,7 @@ class ReversedCurve final : public Curve {
   Point2 center() const override { return base_->center(); }
   std::vector<double> corners() const override;
   bool smooth() const override { return base_->smooth(); }
+  std::vector<Point2> polygon_vertices() const override;
 
  private:
   std::shared_ptr<const Curve> base_;
@@ -92,9 +94,16 @@ int orientation(Point2 a, Point2 b, Point2 c);
 /// come within `closeness` of each other?
 bool segments_meet(Point2 a, Point2 b, Point2 c, Point2 d, double closeness);
 
-/// Throws std::invalid_argument("<what>: the curve intersects itself near (x, y)") if the polyline
-/// through `samples` points of the curve (and all corners) crosses itself.
+/// Throws std::invalid_argument("<what>: the curve intersects or touches itself near (x, y)") if the
+/// curve is not simple. A polygon (polygon_vertices() not empty) is checked on its own edges: two
+/// edges that are not neighbours must not meet or come within 1e-12 of its extent, and neighbours
+/// must meet only in their common vertex (no fold back along a line). Any other curve is checked on
+/// the polyline through `samples` points equally spaced in t and its corners; a sample closer than a
+/// quarter of the spacing to a corner is left out, so that no piece is shorter than that.
 void check_simple(const Curve& curve, const std::string& what, int samples = 4096);
+
+/// check_simple() of the closed polygon through `vertices` (the closing edge implied).
+void check_simple_polygon(const std::vector<Point2>& vertices, const std::string& what);
 
 /// Throws std::invalid_argument("<what>: …") if the curve comes closer than `margin` to ∂box.
 void check_inside_box(const Curve& curve, const Box2& box, double margin, const std::string& what, int samples = 4096);
