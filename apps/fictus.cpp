@@ -14,6 +14,7 @@
 #include <iostream>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -55,15 +56,22 @@ int report(const std::string& message, int code) {
   return code;
 }
 
-/// CLI11's parse errors in the "<what>: <why>" form of every other error.
-std::string parse_error_line(const std::string& message) {
+/// CLI11's parse errors in the "<what>: <why>" form of every other error; an unknown flag names the
+/// nearest of `flags` (the command's long flags).
+std::string parse_error_line(const std::string& message, const std::vector<std::string>& flags) {
   static const std::regex extras(R"(The following arguments? (?:was|were) not expected: (.*))");
+  static const std::regex at_most(R"((\S+): At Most 1 required but received (\d+))");
   std::smatch match;
   if (std::regex_match(message, match, extras)) {
-    const std::string what = match[1].str();
-    return what.find(' ') == std::string::npos && !what.empty() ? what + ": not expected"
-                                                                : "arguments: not expected: " + what;
+    std::istringstream words(match[1].str());
+    std::string word, first;
+    while (words >> word)
+      if (first.empty() && word.size() > 1 && word[0] == '-') first = word;
+    if (!first.empty()) return first.substr(0, 60) + ": not expected" + fictus::did_you_mean(first, flags);
+    return "arguments: not expected: " + match[1].str().substr(0, 60);
   }
+  if (std::regex_match(message, match, at_most))
+    return match[1].str() + ": given " + match[2].str() + " times; it takes one value";
   const std::size_t colon = message.find(": ");
   if (colon == std::string::npos || message.find(' ') < colon) return "arguments: " + message;
   return message;
@@ -94,6 +102,21 @@ void print_summary(const fictus::Solution& s) {
   for (std::size_t k = 0; k < s.timings.phases.size(); ++k)
     std::printf("%s%s %.3f", k ? ", " : "", s.timings.phases[k].first.c_str(), s.timings.phases[k].second);
   std::printf("), peak memory %.1f MiB\n", s.peak_memory_bytes / 1048576.0);
+}
+
+/// With any VTK file among `files`, solution.vtm naming them all (one file opens the run in ParaView).
+void add_multiblock(std::vector<fictus::cli::OutputFile>& files) {
+  static const std::vector<std::pair<std::string, std::string>> blocks = {{"solution.vti", "field"},
+                                                                          {"curves.vtp", "gamma"},
+                                                                          {"offset_curve.vtp", "Gamma"},
+                                                                          {"surface.vtp", "gamma"},
+                                                                          {"offset_surface.vtp", "Gamma"}};
+  std::vector<std::pair<std::string, std::string>> named;  // (block, file)
+  for (const auto& [file, block] : blocks)
+    if (std::any_of(files.begin(), files.end(), [&](const auto& f) { return f.name == file; }))
+      named.emplace_back(block, file);
+  if (!named.empty())
+    files.push_back({"solution.vtm", [named](std::ostream& out) { fictus::cli::write_vtm(out, named); }});
 }
 
 std::pair<int, int> parse_levels(const std::string& text) {
@@ -182,6 +205,7 @@ int run_solve_surface(const std::string& text, const SolveCommand& command) {
   }
   fictus::SurfaceSolution s = fictus::solve(spec.problem, spec.options, progress);
   s.peak_memory_bytes = fictus::peak_memory_bytes();
+  for (const std::string& w : s.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
   if (!s.newton.converged) throw NewtonFailure("solver.max_newton: Newton did not converge: " + s.newton.failure);
   if (!command.quiet) {
     const long active = long(std::count(s.newton.active.begin(), s.newton.active.end(), 1));
@@ -224,8 +248,12 @@ int run_solve_surface(const std::string& text, const SolveCommand& command) {
       else if (file == "solution.vti")
         files.push_back({file, [&](std::ostream& out) { fictus::cli::write_vti(out, spec.problem, s); }});
       else if (file == "surface.vtp")
-        files.push_back({file, [&](std::ostream& out) { fictus::cli::write_vtp(out, s); }});
+        files.push_back({file, [&](std::ostream& out) { fictus::cli::write_surface_vtp(out, s); }});
+      if (file == "surface.vtp" && s.delta > 0)
+        files.push_back(
+            {"offset_surface.vtp", [&](std::ostream& out) { fictus::cli::write_offset_surface_vtp(out, s); }});
     }
+    add_multiblock(files);
     fictus::cli::write_output_set(spec.output.dir, files);
     if (!command.quiet) std::printf("wrote %zu files to %s/\n", files.size(), spec.output.dir.c_str());
   }
@@ -281,6 +309,7 @@ int run_solve(const SolveCommand& command) {
   if (long_run) print_progress_lines(solver);
   fictus::Solution solution = solver.solve(problem, spec.options);
   solution.peak_memory_bytes = fictus::peak_memory_bytes();
+  for (const std::string& w : solution.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
   if (!solution.newton.converged) throw NewtonFailure(fictus::describe_newton_failure(solution));
   if (!command.quiet) print_summary(solution);
   if (!spec.output.dir.empty()) {
@@ -296,8 +325,12 @@ int run_solve(const SolveCommand& command) {
       else if (name == "solution.vti")
         files.push_back({name, [&](std::ostream& out) { fictus::cli::write_vti(out, problem, solution); }});
       else if (name == "curves.vtp")
-        files.push_back({name, [&](std::ostream& out) { fictus::cli::write_vtp(out, solution); }});
+        files.push_back({name, [&](std::ostream& out) { fictus::cli::write_curve_vtp(out, solution); }});
+      if (name == "curves.vtp" && solution.delta > 0)
+        files.push_back(
+            {"offset_curve.vtp", [&](std::ostream& out) { fictus::cli::write_offset_curve_vtp(out, solution); }});
     }
+    add_multiblock(files);
     fictus::cli::write_output_set(dir, files);
     if (!command.quiet) {
       std::uintmax_t bytes = 0;
@@ -314,7 +347,7 @@ int run_solve(const SolveCommand& command) {
 }
 
 /// Runs the plot script with an argument vector (no shell: any folder name is safe).
-int run_plot(const std::string& folder) {
+int run_plot(const std::string& folder, bool with_lambda) {
   if (!fs::is_directory(folder)) throw std::invalid_argument("plot: " + folder + " is not a folder");
   // An installed fictus (cmake --install) finds its script beside it in share/fictus; the build tree's
   // uses the one in the sources.
@@ -324,7 +357,7 @@ int run_plot(const std::string& folder) {
   const pid_t child = fork();
   if (child < 0) throw std::runtime_error("plot: cannot start " FICTUS_PYTHON);
   if (child == 0) {
-    const char* argv[] = {FICTUS_PYTHON, script.c_str(), folder.c_str(), nullptr};
+    const char* argv[] = {FICTUS_PYTHON, script.c_str(), folder.c_str(), with_lambda ? "--lambda" : nullptr, nullptr};
     execv(FICTUS_PYTHON, const_cast<char* const*>(argv));
     std::fprintf(stderr, "fictus: error: plot: cannot run %s\n", FICTUS_PYTHON);
     _exit(127);
@@ -429,8 +462,10 @@ int main(int argc, char** argv) {
       *solve_cmd, [](const fictus::OptionSpec&) { return true; }, paper_note);
 
   std::string plot_dir;
+  bool plot_lambda = false;
   CLI::App* plot_cmd = app.add_subcommand("plot", "PNG plots of the results in a folder (matplotlib)");
-  plot_cmd->add_option("dir", plot_dir, "folder written by solve or reproduce")->required();
+  plot_cmd->add_option("dir", plot_dir, "folder written by solve, reproduce or sweep")->required();
+  plot_cmd->add_flag("--lambda", plot_lambda, "also draw the multipliers λ (not a contact pressure)");
 
   // reproduce: the paper's problem at each level, its m and δ; the other options as flags.
   std::string table = "both", levels = "7-12", reproduce_out;
@@ -483,11 +518,15 @@ int main(int argc, char** argv) {
   } catch (const CLI::Success& e) {
     return app.exit(e);  // --version
   } catch (const CLI::ParseError& e) {
-    return report(parse_error_line(e.what()) + " (see fictus --help)", exit_bad_input);
+    std::vector<std::string> flags;  // the long flags of the command given (or of fictus itself)
+    const std::vector<CLI::App*> given = app.get_subcommands();
+    for (const CLI::Option* option : (given.empty() ? &app : given.front())->get_options())
+      for (const std::string& name : option->get_lnames()) flags.push_back("--" + name);
+    return report(parse_error_line(e.what(), flags) + " (see fictus --help)", exit_bad_input);
   }
   try {
     if (*solve_cmd) return run_solve(solve);
-    if (*plot_cmd) return run_plot(plot_dir);
+    if (*plot_cmd) return run_plot(plot_dir, plot_lambda);
     if (*reproduce_cmd) return run_reproduce(reproduce_flags, reproduce_out, table, levels);
     if (*sweep_cmd) return fictus::cli::run_sweep(sweep_args, sweep_flags);
     if (*options_cmd) {

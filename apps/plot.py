@@ -1,12 +1,20 @@
 #!/usr/bin/env python3
-"""fictus plot DIR: PNG plots of a solve or a reproduction in DIR.
+"""fictus plot DIR [--lambda]: PNG plots of a solve, a reproduction or a sweep in DIR.
 
-- solution.png  û as a heat map (ω only), γ, Γ and the contact set (from solution.vti, points.csv)
-- profiles.png  u − g, ∂u/∂n and λ along γ against arc length (from points.csv)
-- convergence.png  relative errors against h with the paper's (from table1.csv / table2.csv)
+2-D solves:
+- solution.png     û as a heat map (ω only) with its colour bar, γ, Γ, the contact set and where the
+                   arc length s along γ starts (s = 0, with the direction in which it grows)
+- profiles.png     along γ against s: the gap u − g and ∂u/∂n, the contact pressure where u = g (with
+                   the independent check's ∂u/∂n, dashed, where the solve made one); with --lambda, λ
 3-D solves (results.json "dim": 3):
-- slices.png   û on three orthogonal planes through the centre of ω (from solution.vti)
-- surface.png  γ coloured by contact and by λ (from surface.vtp)
+- slices.png       û on three orthogonal planes through the centre of ω
+- surface.png      γ seen from two sides, coloured by ∂u/∂n (the contact pressure) and by the gap
+                   u − g, each with its colour bar; with --lambda, λ too
+Reproductions: convergence.png (relative errors against h with the paper's, from table<k>.csv).
+Sweeps: sweep.png (the contact force and the contact measure against the swept value, from sweep.csv).
+
+The surface is drawn by the painter's algorithm in the plane of the view: triangles facing away are
+dropped and the rest drawn from the farthest to the nearest, so hidden parts never show through.
 Needs numpy and matplotlib (Debian: python3-numpy, python3-matplotlib).
 """
 import csv
@@ -20,6 +28,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.collections import PolyCollection  # noqa: E402
 from matplotlib.ticker import NullFormatter, ScalarFormatter  # noqa: E402
 
 
@@ -30,21 +39,16 @@ def plain(axis):
     axis.set_major_formatter(formatter)
 
 
-def dim_of(folder):
+def results_of(folder):
     path = os.path.join(folder, "results.json")
     if not os.path.exists(path):
-        return 2
+        return {}
     with open(path) as handle:
-        return json.load(handle).get("dim", 2)
+        return json.load(handle)
 
 
-def variant_of(folder):
-    path = os.path.join(folder, "results.json")
-    if not os.path.exists(path):
-        return None
-    with open(path) as handle:
-        return json.load(handle).get("options", {}).get("variant")
-
+# ---------------------------------------------------------------------------------------------
+# Reading fictus's own VTK XML files (appended arrays, UInt64 headers, zlib or raw)
 
 def appended_array(raw, offset, compressed):
     """The bytes of one appended array: raw (a UInt64 size, then the bytes) or in VTK's zlib layout
@@ -61,36 +65,64 @@ def appended_array(raw, offset, compressed):
     return b"".join(parts)
 
 
-def read_vti(path):
-    """Reads fictus's own solution.vti: ImageData with appended arrays (UInt64 headers, zlib or raw)."""
+TYPES = {"Float64": "<f8", "Float32": "<f4", "UInt8": "u1", "Int32": "<i4", "Int64": "<i8"}
+
+
+def read_xml_arrays(path):
+    """The head of the file (text) and its appended arrays by (section, name): section is the
+    enclosing PointData, CellData, Points, Polys or Lines."""
     with open(path, "rb") as handle:
         data = handle.read()
     head, _, tail = data.partition(b"<AppendedData encoding=\"raw\">")
     text = head.decode()
     compressed = "vtkZLibDataCompressor" in text
+    raw = tail[tail.index(b"_") + 1:]
+    arrays, section = {}, None
+    for match in re.finditer(r"<(/?)(PointData|CellData|Points|Polys|Lines)\b|<DataArray ([^>]*)/>", text):
+        if match.group(2):
+            section = None if match.group(1) else match.group(2)
+            continue
+        attributes = dict(re.findall(r'(\w+)="([^"]*)"', match.group(3)))
+        values = np.frombuffer(appended_array(raw, int(attributes["offset"]), compressed),
+                               dtype=TYPES[attributes["type"]])
+        components = int(attributes.get("NumberOfComponents", "1"))
+        arrays[(section, attributes["Name"])] = values.reshape(-1, components) if components > 1 else values
+    return text, arrays
+
+
+def read_vti(path):
+    """fictus's solution.vti: the axes and the point arrays, shaped [j, i] or [k, j, i]."""
+    text, found = read_xml_arrays(path)
     extent = [int(v) for v in re.search(r'WholeExtent="([^"]+)"', text).group(1).split()]
     origin = [float(v) for v in re.search(r'Origin="([^"]+)"', text).group(1).split()]
     spacing = [float(v) for v in re.search(r'Spacing="([^"]+)"', text).group(1).split()]
-    raw = tail[tail.index(b"_") + 1:]
-    arrays = {}
-    for kind, name, offset in re.findall(r'type="(\w+)" Name="(\w+)" format="appended" offset="(\d+)"', text):
-        dtype = {"Float64": "<f8", "UInt8": "u1"}[kind]
-        values = np.frombuffer(appended_array(raw, int(offset), compressed), dtype=dtype)
-        shape = (extent[3] + 1, extent[1] + 1) if extent[5] == 0 else (extent[5] + 1, extent[3] + 1, extent[1] + 1)
-        arrays[name] = values.reshape(shape)
+    shape = (extent[3] + 1, extent[1] + 1) if extent[5] == 0 else (extent[5] + 1, extent[3] + 1, extent[1] + 1)
+    arrays = {name: values.reshape(shape) for (_, name), values in found.items()}
     axes = [origin[d] + spacing[d] * np.arange(extent[2 * d + 1] + 1) for d in range(3 if extent[5] else 2)]
     return (*axes, arrays)
+
+
+def read_vtp(path):
+    """fictus's surface.vtp or offset_surface.vtp: points, triangles (point indices), cell arrays."""
+    _, found = read_xml_arrays(path)
+    points = found[("Points", "points")]
+    triangles = found[("Polys", "connectivity")].reshape(-1, 3)
+    cells = {name: values for (section, name), values in found.items() if section == "CellData"}
+    return points, triangles, cells
 
 
 def read_csv(path):
     with open(path) as handle:
         rows = list(csv.DictReader(handle))
-    return {key: np.array([float(r[key]) for r in rows]) for key in rows[0]}
+    return {key: np.array([float(r[key]) if r[key] != "" else np.nan for r in rows]) for key in rows[0]}
 
 
 def closed(v):
     return np.append(v, v[0])
 
+
+# ---------------------------------------------------------------------------------------------
+# 2-D
 
 def plot_solution(folder):
     x, y, arrays = read_vti(os.path.join(folder, "solution.vti"))
@@ -107,11 +139,22 @@ def plot_solution(folder):
         ax.contour(x, y, u, levels=levels, colors="k", linewidths=0.6)
         ax.contour(x, y, exact, levels=levels, colors="w", linewidths=0.8, linestyles="--")
         title += "\ncontours: û (black), exact solution (white, dashed)"
-    ax.plot(closed(p["x"]), closed(p["y"]), "k-", lw=1, label="γ")
+    geometry = results_of(folder).get("problem", {}).get("geometry", {})
+    if isinstance(geometry, dict) and geometry.get("shape") == "polygon":  # γ itself, corners included
+        corners = np.array(geometry["vertices"], dtype=float)
+        ax.plot(closed(corners[:, 0]), closed(corners[:, 1]), "k-", lw=1, label="γ")
+    else:
+        ax.plot(closed(p["x"]), closed(p["y"]), "k-", lw=1, label="γ (through the points)")
     if np.any(np.hypot(p["Gamma_x"] - p["x"], p["Gamma_y"] - p["y"]) > 0):
         ax.plot(closed(p["Gamma_x"]), closed(p["Gamma_y"]), "--", color="tab:orange", lw=1, label="Γ")
     contact = p["contact"] > 0
     ax.plot(p["x"][contact], p["y"][contact], "r.", ms=4, label="contact")
+    # s = 0: the first point, and an arrow along γ in the direction of increasing s
+    ax.plot(p["x"][0], p["y"][0], "o", mfc="none", mec="k", ms=8, label="s = 0")
+    step = max(1, len(p["x"]) // 24)
+    ax.annotate("", xy=(p["x"][step], p["y"][step]), xytext=(p["x"][0], p["y"][0]),
+                arrowprops=dict(arrowstyle="->", color="k", lw=1.2))
+    ax.annotate("s = 0", (p["x"][0], p["y"][0]), textcoords="offset points", xytext=(8, -12), fontsize=8)
     ax.set_aspect("equal")
     ax.set_xlabel("x")
     ax.set_ylabel("y")
@@ -121,22 +164,37 @@ def plot_solution(folder):
     plt.close(fig)
 
 
-def plot_profiles(folder):
+def lambda_label(variant):
+    return {"smooth": "λ: control on Γ\n(not a pressure)",
+            "nonsmooth": "λ: jump of ∂û/∂n\nacross γ (not a force)"}.get(variant, "λ")
+
+
+PRESSURE = "∂u/∂n: contact\npressure where u = g"
+
+
+def plot_profiles(folder, with_lambda):
     p = read_csv(os.path.join(folder, "points.csv"))
-    fig, axes = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
+    variant = results_of(folder).get("options", {}).get("variant")
+    panels = [(p["u"] - p["g"], "gap u − g"), (p["dudn"], PRESSURE)]
+    if with_lambda:
+        panels.append((p["lambda"], lambda_label(variant)))
+    fig, axes = plt.subplots(len(panels), 1, figsize=(7, 2.4 * len(panels) + 0.6), sharex=True)
     contact = p["contact"] > 0
-    variant = variant_of(folder)
-    lam = {"smooth": "λ: control on Γ\n(not a pressure)", "nonsmooth": "λ: contact\npressure on γ"}.get(variant, "λ")
-    # Round-off is shown as 0: values below 1e-9 of the problem's scale (|u|, |g|, |∂u/∂n|, |λ|).
-    scale = max(np.max(np.abs(p[key])) for key in ("u", "g", "dudn", "lambda"))
-    for ax, values, label in zip(axes, (p["u"] - p["g"], p["dudn"], p["lambda"]), ("u − g", "∂u/∂n", lam)):
+    # Round-off is shown as 0: values below 1e-9 of the problem's scale (|u|, |g|, |∂u/∂n|).
+    scale = max(np.max(np.abs(p[key])) for key in ("u", "g", "dudn"))
+    for ax, (values, label) in zip(axes, panels):
         values = np.where(np.abs(values) < 1e-9 * scale, 0.0, values)
         plain(ax.yaxis)
-        ax.plot(p["s"], values, "k.-", ms=3)
+        ax.plot(p["s"], values, "k.-", ms=3, lw=0.8)
         ax.plot(p["s"][contact], values[contact], "r.", ms=4)
         ax.axhline(0.0, color="gray", lw=0.5, zorder=0)
-        ax.set_ylabel(label)
-    axes[-1].set_xlabel("arc length s along γ (red: contact)")
+        ax.set_ylabel(label, fontsize=9)
+    check = p.get("dudn_check")
+    if check is not None and np.all(np.isfinite(check)):
+        axes[1].plot(p["s"], check, "--", color="tab:blue", lw=0.8, label="independent estimate")
+        axes[1].plot([], [], "k.-", ms=3, lw=0.8, label="enforced (C_γ û)")
+        axes[1].legend(fontsize=7, loc="best")
+    axes[-1].set_xlabel("arc length s along γ from s = 0 (red: contact)")
     fig.suptitle("Signorini conditions along γ" + (f" ({variant} variant)" if variant else ""))
     fig.savefig(os.path.join(folder, "profiles.png"), dpi=120)
     plt.close(fig)
@@ -194,6 +252,9 @@ def plot_convergence(folder):
     plt.close(fig)
 
 
+# ---------------------------------------------------------------------------------------------
+# 3-D
+
 def plot_slices(folder):
     x, y, z, arrays = read_vti(os.path.join(folder, "solution.vti"))
     inside = arrays["inside"] > 0
@@ -216,63 +277,123 @@ def plot_slices(folder):
     plt.close(fig)
 
 
-def read_vtp(path):
-    """fictus's own surface.vtp (ASCII PolyData of triangles): the points and the cell arrays."""
-    with open(path) as handle:
-        text = handle.read()
-    def block(name):
-        match = re.search(r'Name="%s"[^>]*>([^<]*)<' % name, text)
-        return np.array(match.group(1).split(), dtype=float)
-    points = np.array(re.search(r"<Points>\s*<DataArray[^>]*>([^<]*)<", text).group(1).split(), dtype=float)
-    cells = {name: block(name) for name in ("surface", "contact", "lambda")}
-    return points.reshape(-1, 3, 3), cells
+def view_basis(elevation, azimuth):
+    """The unit vector towards the viewer and two in the picture plane (right, up), in degrees."""
+    e, a = np.radians(elevation), np.radians(azimuth)
+    toward = np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
+    right = np.array([-np.sin(a), np.cos(a), 0.0])
+    return toward, right, np.cross(toward, right)
 
 
-def plot_surface(folder):
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-    triangles, cells = read_vtp(os.path.join(folder, "surface.vtp"))
-    on_gamma = cells["surface"] == 0
-    triangles = triangles[on_gamma]
-    fig = plt.figure(figsize=(13, 6), constrained_layout=True)
-    lam = cells["lambda"][on_gamma]
-    colour_maps = [(np.where(cells["contact"][on_gamma] > 0, 1.0, 0.0), plt.get_cmap("coolwarm"), "contact (red)"),
-                   ((lam - lam.min()) / max(np.ptp(lam), 1e-300), plt.get_cmap("viridis"),
-                    f"λ per patch, {lam.min():.3g} … {lam.max():.3g}")]
-    low, high = triangles.reshape(-1, 3).min(axis=0), triangles.reshape(-1, 3).max(axis=0)
-    for k, (values, cmap, title) in enumerate(colour_maps):
-        ax = fig.add_subplot(1, 2, k + 1, projection="3d")
-        ax.add_collection3d(Poly3DCollection(triangles, facecolors=cmap(values), edgecolor="none"))
-        for setter, d in ((ax.set_xlim, 0), (ax.set_ylim, 1), (ax.set_zlim, 2)):
-            setter(low[d], high[d])
-        ax.set_box_aspect(high - low)
-        ax.set_xlabel("x")
-        ax.set_ylabel("y")
-        ax.set_zlabel("z")
-        ax.set_title(title, fontsize=10)
-    fig.suptitle("fictus: γ, its contact set and the multipliers")
+def visible_order(points, triangles, normals, toward):
+    """The triangles facing the viewer (outward normal towards `toward`), farthest first: the
+    painter's algorithm on a closed surface."""
+    depth = points[triangles].mean(axis=1) @ toward
+    facing = np.nonzero(normals @ toward > 0)[0]
+    return facing[np.argsort(depth[facing], kind="stable")]
+
+
+def draw_surface(ax, points, triangles, normals, values, toward, right, up, cmap, norm):
+    order = visible_order(points, triangles, normals, toward)
+    corners = points[triangles[order]]
+    flat = np.stack([corners @ right, corners @ up], axis=-1)
+    shade = 0.55 + 0.45 * np.clip(normals[order] @ toward, 0, 1)  # a little light from the viewer
+    colours = cmap(norm(values[order]))
+    colours[:, :3] *= shade[:, None]
+    ax.add_collection(PolyCollection(flat, facecolors=colours, edgecolors=colours, linewidths=0.3))  # no seams
+    ax.set_xlim(flat[..., 0].min(), flat[..., 0].max())
+    ax.set_ylim(flat[..., 1].min(), flat[..., 1].max())
+    ax.set_aspect("equal")
+    ax.set_xticks([])
+    ax.set_yticks([])
+
+
+def plot_surface(folder, with_lambda):
+    points, triangles, cells = read_vtp(os.path.join(folder, "surface.vtp"))
+    normals = cells["normal"]
+    variant = results_of(folder).get("options", {}).get("variant")
+    fields = [(cells["dudn"], "∂u/∂n: contact pressure where u = g", "viridis"),
+              (cells["gap"], "gap u − g", "magma")]
+    lam_surface = None
+    if with_lambda:
+        if "lambda" in cells:
+            fields.append((cells["lambda"], lambda_label(variant).replace("\n", " "), "coolwarm"))
+        elif os.path.exists(os.path.join(folder, "offset_surface.vtp")):
+            lam_surface = read_vtp(os.path.join(folder, "offset_surface.vtp"))
+            fields.append((lam_surface[2]["lambda"], lambda_label(variant).replace("\n", " "), "coolwarm"))
+    views = [(25, -60, "front"), (-25, 120, "back")]
+    fig, axes = plt.subplots(len(fields), 2, figsize=(11, 4.6 * len(fields)), squeeze=False,
+                             constrained_layout=True)
+    for row, (values, label, cmap_name) in enumerate(fields):
+        cmap = plt.get_cmap(cmap_name)
+        norm = plt.Normalize(np.min(values), np.max(values) if np.ptp(values) > 0 else np.min(values) + 1)
+        surface = (points, triangles, normals) if lam_surface is None or row < 2 else \
+            (lam_surface[0], lam_surface[1], lam_surface[2]["normal"])
+        for column, (elevation, azimuth, name) in enumerate(views):
+            toward, right, up = view_basis(elevation, azimuth)
+            ax = axes[row, column]
+            draw_surface(ax, *surface, values, toward, right, up, cmap, norm)
+            ax.set_title(f"{label}: {name} (elevation {elevation}°, azimuth {azimuth}°)", fontsize=9)
+        bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=axes[row, :], shrink=0.8, label=label)
+        plain(bar.ax.yaxis)
+        if values is cells["dudn"] or values is cells["gap"]:
+            bar.ax.axhline(0.0, color="w", lw=1.0)  # the contact/free divide: ∂u/∂n = 0 or u = g
+    fig.suptitle("fictus: γ coloured by the contact pressure and the gap" + (f" ({variant} variant)" if variant else ""))
     fig.savefig(os.path.join(folder, "surface.png"), dpi=110)
     plt.close(fig)
 
 
-def main(folder):
+# ---------------------------------------------------------------------------------------------
+# Sweeps
+
+def plot_sweep(folder):
+    with open(os.path.join(folder, "sweep.json")) as handle:
+        sweep = json.load(handle)
+    name = sweep["sweep"]["name"]
+    rows = sweep["rows"]
+    values = np.array([r[name] for r in rows])
+    converged = np.array([bool(r["converged"]) for r in rows])
+    fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    for ax, key, label in ((axes[0], "contact_force", "contact force ∫ ∂u/∂n over the contact set"),
+                           (axes[1], "contact_measure", "contact measure (length or area)")):
+        y = np.array([r[key] for r in rows])
+        ax.plot(values[converged], y[converged], "k.-", ms=5)
+        if not converged.all():
+            ax.plot(values[~converged], y[~converged], "rx", ms=7, label="Newton did not converge")
+            ax.legend(fontsize=8)
+        plain(ax.yaxis)
+        ax.set_ylabel(label, fontsize=9)
+        ax.grid(True, lw=0.3)
+    axes[-1].set_xlabel(name)
+    title = sweep.get("problem", {}).get("name") or "the paper's problem"
+    fig.suptitle(f"fictus sweep of {name}: {title}")
+    fig.savefig(os.path.join(folder, "sweep.png"), dpi=120)
+    plt.close(fig)
+
+
+def main(folder, with_lambda=False):
     made = []
-    if dim_of(folder) == 3:
+    exists = lambda name: os.path.exists(os.path.join(folder, name))  # noqa: E731
+    if exists("sweep.json"):
+        plot_sweep(folder)
+        made.append("sweep.png")
+    if results_of(folder).get("dim", 2) == 3:
         inputs = "solution.vti or surface.vtp"
-        if os.path.exists(os.path.join(folder, "solution.vti")):
+        if exists("solution.vti"):
             plot_slices(folder)
             made.append("slices.png")
-        if os.path.exists(os.path.join(folder, "surface.vtp")):
-            plot_surface(folder)
+        if exists("surface.vtp"):
+            plot_surface(folder, with_lambda)
             made.append("surface.png")
     else:
-        inputs = "solution.vti, points.csv or table<k>.csv"
-        if os.path.exists(os.path.join(folder, "solution.vti")) and os.path.exists(os.path.join(folder, "points.csv")):
+        inputs = "solution.vti, points.csv, table<k>.csv or sweep.json"
+        if exists("solution.vti") and exists("points.csv"):
             plot_solution(folder)
             made.append("solution.png")
-        if os.path.exists(os.path.join(folder, "points.csv")):
-            plot_profiles(folder)
+        if exists("points.csv"):
+            plot_profiles(folder, with_lambda)
             made.append("profiles.png")
-        if any(os.path.exists(os.path.join(folder, f"table{k}.csv")) for k in (1, 2)):
+        if exists("table1.csv") or exists("table2.csv"):
             plot_convergence(folder)
             made.append("convergence.png")
     if not made:
@@ -283,7 +404,8 @@ def main(folder):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 2:
-        print("usage: plot.py DIR", file=sys.stderr)
+    arguments = [a for a in sys.argv[1:] if a != "--lambda"]
+    if len(arguments) != 1:
+        print("usage: plot.py DIR [--lambda]", file=sys.stderr)
         sys.exit(1)
-    sys.exit(main(sys.argv[1]))
+    sys.exit(main(arguments[0], "--lambda" in sys.argv[1:]))

@@ -1,7 +1,9 @@
 #include "results_io.hpp"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -120,6 +122,7 @@ json solution_to_json(const Problem& problem, const Solution& s, const json& inp
                                {"max_difference", s.check->max_difference},
                                {"rms_difference", s.check->rms_difference}};
   if (s.errors) j["errors"] = errors_json(*s.errors, s.point_errors);
+  j["warnings"] = s.warnings;
   j["peak_memory_bytes"] = s.peak_memory_bytes;
   return j;
 }
@@ -157,55 +160,75 @@ std::string reason(const std::error_code& error) { return error ? error.message(
 }  // namespace
 
 void check_output_folder(const fs::path& dir, const std::vector<std::string>& names) {
+  for (std::size_t k = 0; k < names.size(); ++k)
+    if (std::find(names.begin(), names.begin() + k, names[k]) != names.begin() + k)
+      throw std::invalid_argument("output.files: " + names[k].substr(0, 60) + " is named twice");
   std::error_code error;
   const std::string shown = dir.string().substr(0, 120);
   if (fs::exists(dir, error) && !fs::is_directory(dir, error))
-    throw std::invalid_argument("output.dir: " + shown + " exists and is not a folder");
+    throw OutputError("output.dir: " + shown + " exists and is not a folder");
   const fs::path base = existing_ancestor(dir);
-  if (!fs::is_directory(base, error)) throw std::invalid_argument("output.dir: " + base.string() + " is not a folder");
-  if (::access(base.c_str(), W_OK | X_OK) != 0)
-    throw std::invalid_argument("output.dir: cannot write in " + base.string().substr(0, 120) + " (" +
-                                std::strerror(errno) + ")");
-  // The temporary folder goes beside `dir`: its parent must be writable too once `dir` exists.
-  const fs::path parent = existing_ancestor(dir.has_parent_path() ? dir.parent_path() : fs::path("."));
-  if (::access(parent.c_str(), W_OK | X_OK) != 0)
-    throw std::invalid_argument("output.dir: cannot write in " + parent.string().substr(0, 120) + " (" +
-                                std::strerror(errno) + ")");
+  if (!fs::is_directory(base, error))
+    throw OutputError("output.dir: " + base.string().substr(0, 120) + " is not a folder");
+  // Writable in fact, not only by its mode bits (a read-only mount, /proc): a folder made and removed.
+  const fs::path probe = base / (".fictus-probe-" + std::to_string(::getpid()));
+  if (::mkdir(probe.c_str(), 0700) != 0)
+    throw OutputError("output.dir: cannot write in " + base.string().substr(0, 120) + " (" + std::strerror(errno) +
+                      ")");
+  ::rmdir(probe.c_str());
   for (const std::string& name : names)
     if (fs::is_directory(dir / name, error))
-      throw std::invalid_argument("output.dir: " + (dir / name).string().substr(0, 120) + " is a folder, not a file");
+      throw OutputError("output.dir: " + (dir / name).string().substr(0, 120) + " is a folder, not a file");
 }
 
 void write_output_set(const fs::path& dir, const std::vector<OutputFile>& files) {
   std::vector<std::string> names;
   for (const OutputFile& f : files) names.push_back(f.name);
   check_output_folder(dir, names);
-  const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
-  std::string hidden = dir.filename().string();  // ".<dir>.tmp-<pid>", built up (GCC 12 warns on "." + s)
-  hidden.insert(hidden.begin(), '.');
-  hidden += ".tmp-";
-  hidden += std::to_string(::getpid());
-  const fs::path tmp = parent / hidden;
   std::error_code error;
+  // The folders made here (from the nearest existing one down to `dir`), removed again on failure.
+  std::vector<fs::path> made;
+  for (fs::path p = dir; !p.empty() && !fs::exists(p, error); p = p.parent_path()) made.push_back(p);
+  // The temporary folder lives inside `dir`, so that every move is a rename within one file system
+  // (`dir` may be a mount point).
+  const fs::path tmp = dir / (".fictus-tmp-" + std::to_string(::getpid()));
+  std::vector<std::string> placed, kept;  // new files moved into `dir`; earlier ones set aside in tmp
+  const auto undo = [&] {
+    std::error_code ignored;
+    for (const std::string& name : placed) fs::remove(dir / name, ignored);
+    for (const std::string& name : kept) fs::rename(tmp / (name + ".earlier"), dir / name, ignored);
+    fs::remove_all(tmp, ignored);
+    for (const fs::path& p : made) fs::remove(p, ignored);  // innermost first; only if empty
+  };
   try {
-    fs::create_directories(parent);
+    fs::create_directories(dir, error);
+    if (error) throw OutputError("output: cannot make " + dir.string().substr(0, 120) + ": " + reason(error));
     fs::remove_all(tmp, error);
     if (!fs::create_directory(tmp, error))
-      throw OutputError("output: cannot make a temporary folder: " + reason(error));
+      throw OutputError("output: cannot make a temporary folder in " + dir.string().substr(0, 120) + ": " +
+                        reason(error));
     for (const OutputFile& f : files) {  // 1. every file into the temporary folder
       std::ofstream out(tmp / f.name, std::ios::binary);
       if (out) f.write(out);
       if (out) out.flush();
       if (!out) throw OutputError("output: cannot write " + f.name + ": " + std::strerror(errno));
     }
-    fs::create_directories(dir);  // 2. all written: move them into place
-    for (const OutputFile& f : files) {
+    for (const OutputFile& f : files) {  // 2. all written: the earlier file aside, the new one in place
+      if (fs::exists(dir / f.name, error)) {
+        fs::rename(dir / f.name, tmp / (f.name + ".earlier"), error);
+        if (error) throw OutputError("output: cannot replace " + f.name + ": " + reason(error));
+        kept.push_back(f.name);
+      }
       fs::rename(tmp / f.name, dir / f.name, error);
       if (error) throw OutputError("output: cannot move " + f.name + " into place: " + reason(error));
+      placed.push_back(f.name);
     }
     fs::remove_all(tmp, error);
+  } catch (const fs::filesystem_error& e) {
+    undo();
+    throw OutputError(std::string("output: ") + e.code().message());
   } catch (...) {
-    fs::remove_all(tmp, error);
+    undo();
     throw;
   }
 }
@@ -213,13 +236,17 @@ void write_output_set(const fs::path& dir, const std::vector<OutputFile>& files)
 std::string points_csv(const Solution& s) {
   std::ostringstream out;
   out.precision(17);
-  out << "i,s,x,y,nx,ny,g,u,dudn,lambda,contact,Gamma_x,Gamma_y,arc\n";
+  // dudn_check: the independent check's ∂u/∂n (empty when there is none)
+  out << "i,s,x,y,nx,ny,g,u,dudn,lambda,contact,Gamma_x,Gamma_y,arc,dudn_check\n";
+  const bool check = s.check && int(s.check->normal_derivative.size()) == s.collocation.m;
   for (int i = 0; i < s.collocation.m; ++i) {
     const Point2 G = s.Gamma->position(s.collocation.t[i]);
     out << i << ',' << s.collocation.s[i] << ',' << s.collocation.point[i].x << ',' << s.collocation.point[i].y << ','
         << s.collocation.normal[i].x << ',' << s.collocation.normal[i].y << ',' << s.g[i] << ',' << s.trace[i] << ','
         << s.normal_derivative[i] << ',' << s.lambda[i] << ',' << int(s.newton.active[i]) << ',' << G.x << ',' << G.y
-        << ',' << s.collocation.arc[i] << '\n';
+        << ',' << s.collocation.arc[i] << ',';
+    if (check) out << s.check->normal_derivative[i];
+    out << '\n';
   }
   return out.str();
 }
@@ -307,6 +334,7 @@ json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& s) 
                   {"min_gap", min_gap}, {"max_gap", max_gap}};
   if (s.errors) j["errors"] = errors_json(*s.errors, s.point_errors);
   j["timings"] = timings_json(s.timings);
+  j["warnings"] = s.warnings;
   j["peak_memory_bytes"] = s.peak_memory_bytes;
   return j;
 }

@@ -41,13 +41,16 @@ struct OutputFile {
   std::function<void(std::ostream&)> write;
 };
 
-/// Throws "output.dir: …" unless `dir` is (or can be made as) a writable folder whose listed files
-/// can be replaced. Called before any work, so that a long solve does not end in a folder error.
+/// Throws OutputError "output.dir: …" unless `dir` is (or can be made as) a writable folder whose
+/// listed files can be replaced (tried by making and removing a folder in it or its nearest existing
+/// parent), and std::invalid_argument "output.files: … is named twice" for a repeated name. Called
+/// before any work, so that a long solve does not end in a folder error.
 void check_output_folder(const std::filesystem::path& dir, const std::vector<std::string>& names);
 
-/// Writes the files as one set: all into a temporary folder beside `dir`, then moved into `dir`
-/// only when every write succeeded; on any failure nothing in `dir` changes and the temporary
-/// folder is removed. Throws OutputError "output: cannot write <name>: <reason>".
+/// Writes the files as one set: all into a temporary folder inside `dir` (one file system, also when
+/// `dir` is a mount point), then each earlier file set aside and the new one renamed into place; on
+/// any failure the earlier files are put back, the new ones and the temporary folder removed, and
+/// folders this call made removed: `dir` is as it was. Throws OutputError "output: …".
 void write_output_set(const std::filesystem::path& dir, const std::vector<OutputFile>& files);
 
 std::string points_csv(const Solution& solution);

@@ -5,9 +5,14 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
-#include <limits>
+#include <cstring>
+#include <exception>
+#include <functional>
+#include <map>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "fictus/curve_grid_intersection.hpp"
@@ -15,6 +20,7 @@
 namespace fictus::cli {
 
 namespace {
+
 /// Deflates `size` bytes into `out` (a zlib stream, as VTK's reader inflates it). Run-length
 /// strategy at level 1: it takes the long runs of zeros outside ω at a fraction of the default's time.
 bool deflate_block(const unsigned char* data, std::uint64_t size, std::vector<unsigned char>& out) {
@@ -31,70 +37,166 @@ bool deflate_block(const unsigned char* data, std::uint64_t size, std::vector<un
   return done;
 }
 
-/// One array of the appended section in VTK's zlib layout: a UInt64 header (number of blocks, block
-/// size, size of the last block, compressed size of each block), then the compressed blocks.
-/// One array of the appended section in VTK's zlib layout: a UInt64 header (number of blocks, block
-/// size, size of the last block, compressed size of each block), then the compressed blocks.
-struct ZlibArray {
-  std::vector<std::uint64_t> header;
-  std::vector<std::vector<unsigned char>> blocks;
-  std::uint64_t bytes() const {
-    std::uint64_t total = header.size() * sizeof(std::uint64_t);
-    for (const auto& block : blocks) total += block.size();
-    return total;
-  }
-  void write(std::ostream& out) const {  // straight from the blocks: no joined copy of the array
-    out.write(reinterpret_cast<const char*>(header.data()), std::streamsize(header.size() * sizeof(std::uint64_t)));
-    for (const auto& block : blocks)
-      out.write(reinterpret_cast<const char*>(block.data()), std::streamsize(block.size()));
-  }
+/// One appended array: `count` values of `value_bytes` each (components flattened), made by `fill`
+/// for values [first, first + n) into `out`; fill is called from several threads at once.
+struct Appended {
+  std::size_t value_bytes;
+  std::size_t count;
+  std::function<void(std::size_t first, std::size_t n, unsigned char* out)> fill;
 };
 
 template <class T>
-ZlibArray zlib_array(const std::vector<T>& values) {
-  constexpr std::uint64_t block = 1 << 20;
-  const auto* data = reinterpret_cast<const unsigned char*>(values.data());
-  const std::uint64_t bytes = values.size() * sizeof(T);
-  const std::uint64_t blocks = bytes == 0 ? 0 : (bytes + block - 1) / block;
-  ZlibArray array{{blocks, block, bytes == 0 ? 0 : bytes - (blocks - 1) * block},
-                  std::vector<std::vector<unsigned char>>(blocks)};
-  // Blocks are independent: compressed in parallel, kept in order.
-  bool failed = false;
-#pragma omp parallel for schedule(dynamic) reduction(|| : failed)
-  for (std::int64_t b = 0; b < std::int64_t(blocks); ++b)
-    failed = failed || !deflate_block(data + b * block, std::min(block, bytes - b * block), array.blocks[b]);
-  if (failed) throw std::runtime_error("output: zlib could not compress solution.vti");
-  for (const auto& part : array.blocks) array.header.push_back(part.size());
-  return array;
+Appended values_of(const std::vector<T>& v) {
+  return {sizeof(T), v.size(), [&v](std::size_t first, std::size_t n, unsigned char* out) {
+            std::memcpy(out, v.data() + first, n * sizeof(T));
+          }};
 }
-struct ImageArray {
-  const char* type;
-  const char* name;
-  ZlibArray data;
+
+/// A value per index, made by `value(k)`.
+template <class T, class F>
+Appended computed(std::size_t count, F value) {
+  return {sizeof(T), count, [value](std::size_t first, std::size_t n, unsigned char* out) {
+            T* values = reinterpret_cast<T*>(out);
+            for (std::size_t k = 0; k < n; ++k) values[k] = value(first + k);
+          }};
+}
+
+constexpr std::uint64_t block_bytes = 1 << 20;
+constexpr char offset_mark[] = "@offset@";
+constexpr int offset_digits = 20;
+
+/// Writes one array in VTK's zlib layout (UInt64 block count, block size, size of the last block,
+/// compressed size of each block, then the blocks): made and compressed `chunk` blocks at a time on
+/// `threads` threads, written in order; the header is written last.
+void write_array(std::ostream& out, const Appended& a, int threads) {
+  const std::uint64_t bytes = a.count * a.value_bytes, per_block = block_bytes / a.value_bytes;
+  const std::uint64_t blocks = bytes == 0 ? 0 : (bytes + block_bytes - 1) / block_bytes;
+  std::vector<std::uint64_t> header{blocks, block_bytes, bytes == 0 ? 0 : bytes - (blocks - 1) * block_bytes};
+  header.resize(3 + blocks, 0);
+  const auto at = out.tellp();
+  out.write(reinterpret_cast<const char*>(header.data()), std::streamsize(header.size() * sizeof(std::uint64_t)));
+  const std::int64_t chunk = 8 * std::max(1, threads);
+  std::vector<std::vector<unsigned char>> compressed(static_cast<std::size_t>(chunk));
+  for (std::int64_t first = 0; first < std::int64_t(blocks); first += chunk) {
+    const std::int64_t n = std::min<std::int64_t>(chunk, std::int64_t(blocks) - first);
+    bool failed = false;
+    std::exception_ptr error;  // a fill that throws (an exact solution's expression): rethrown here
+#pragma omp parallel num_threads(threads) reduction(|| : failed)
+    {
+      std::vector<unsigned char> raw(block_bytes);
+#pragma omp for schedule(dynamic)
+      for (std::int64_t b = 0; b < n; ++b) {
+        const std::uint64_t value = std::uint64_t(first + b) * per_block;
+        const std::uint64_t values = std::min<std::uint64_t>(per_block, a.count - value);
+        try {
+          a.fill(value, values, raw.data());
+          failed = failed || !deflate_block(raw.data(), values * a.value_bytes, compressed[std::size_t(b)]);
+        } catch (...) {
+#pragma omp critical(fictus_vtk_fill)
+          if (!error) error = std::current_exception();
+          failed = true;
+        }
+      }
+    }
+    if (error) std::rethrow_exception(error);
+    if (failed) throw std::runtime_error("output: zlib could not compress an array");
+    for (std::int64_t b = 0; b < n; ++b) {
+      const auto& block = compressed[std::size_t(b)];
+      header[3 + std::size_t(first + b)] = block.size();
+      out.write(reinterpret_cast<const char*>(block.data()), std::streamsize(block.size()));
+    }
+  }
+  const auto end = out.tellp();
+  out.seekp(at);
+  out.write(reinterpret_cast<const char*>(header.data()), std::streamsize(header.size() * sizeof(std::uint64_t)));
+  out.seekp(end);
+}
+
+/// A VTK XML file: `xml` is its text up to the appended data, with offset_mark where each array's
+/// offset goes (in the order of `arrays`); the arrays follow, then the offsets are filled in.
+void write_appended(std::ostream& out, std::string xml, const std::vector<Appended>& arrays, int threads) {
+  const auto start = out.tellp();
+  if (start == std::ostream::pos_type(-1)) throw std::runtime_error("output: VTK files are written to seekable files");
+  std::vector<std::size_t> marks;
+  for (std::size_t at = xml.find(offset_mark); at != std::string::npos; at = xml.find(offset_mark, at)) {
+    xml.replace(at, sizeof offset_mark - 1, std::string(offset_digits, '0'));
+    marks.push_back(at);
+  }
+  if (marks.size() != arrays.size()) throw std::logic_error("write_appended: one offset mark per array");
+  out << xml << "  <AppendedData encoding=\"raw\">\n   _";
+  const auto base = out.tellp();
+  std::vector<std::uint64_t> offsets;
+  for (const Appended& a : arrays) {
+    offsets.push_back(std::uint64_t(out.tellp() - base));
+    write_array(out, a, threads);
+  }
+  out << "\n  </AppendedData>\n</VTKFile>\n";
+  const auto end = out.tellp();
+  for (std::size_t k = 0; k < marks.size(); ++k) {
+    std::string digits = std::to_string(offsets[k]);
+    digits.insert(0, offset_digits - digits.size(), '0');  // leading zeros: the same width, the same number
+    out.seekp(start + std::streamoff(marks[k]));
+    out.write(digits.data(), std::streamsize(digits.size()));
+  }
+  out.seekp(end);
+}
+
+std::string header(const char* type) {
+  return std::string("<?xml version=\"1.0\"?>\n<VTKFile type=\"") + type +
+         "\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\" "
+         "compressor=\"vtkZLibDataCompressor\">\n";
+}
+
+/// The XML of one appended data array.
+std::string array_xml(const char* type, const std::string& name, int components = 1) {
+  return "        <DataArray type=\"" + std::string(type) + "\" Name=\"" + name + "\"" +
+         (components > 1 ? " NumberOfComponents=\"" + std::to_string(components) + "\"" : std::string()) +
+         " format=\"appended\" offset=\"" + offset_mark + "\"/>\n";
+}
+
+/// Named arrays of one kind of data (point or cell data), their XML and their values.
+struct DataArrays {
+  std::string xml;
+  std::vector<Appended> arrays;
+  void add(const char* type, const std::string& name, Appended values, int components = 1) {
+    xml += array_xml(type, name, components);
+    arrays.push_back(std::move(values));
+  }
 };
 
-/// VTK XML ImageData with appended zlib arrays at the nodes of extent [0, n_d].
-void write_image(std::ostream& out, std::array<int, 3> n, Point3 origin, Point3 spacing,
-                 const std::vector<ImageArray>& arrays) {
-  out.precision(17);
+/// ImageData of the nodes of extent [0, n_d] with the point data `data`.
+void write_image(std::ostream& out, std::array<int, 3> n, Point3 origin, Point3 spacing, const DataArrays& data,
+                 int threads) {
+  std::ostringstream xml;
+  xml.precision(17);
   const std::string extent = "0 " + std::to_string(n[0]) + " 0 " + std::to_string(n[1]) + " 0 " + std::to_string(n[2]);
-  out << "<?xml version=\"1.0\"?>\n"
-      << "<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\" "
-         "compressor=\"vtkZLibDataCompressor\">\n"
-      << "  <ImageData WholeExtent=\"" << extent << "\" Origin=\"" << origin.x << ' ' << origin.y << ' ' << origin.z
-      << "\" Spacing=\"" << spacing.x << ' ' << spacing.y << ' ' << spacing.z << "\">\n"
-      << "    <Piece Extent=\"" << extent << "\">\n"
-      << "      <PointData Scalars=\"u\">\n";
-  std::uint64_t offset = 0;
-  for (const ImageArray& a : arrays) {
-    out << "        <DataArray type=\"" << a.type << "\" Name=\"" << a.name << "\" format=\"appended\" offset=\""
-        << offset << "\"/>\n";
-    offset += a.data.bytes();
-  }
-  out << "      </PointData>\n    </Piece>\n  </ImageData>\n  <AppendedData encoding=\"raw\">\n   _";
-  for (const ImageArray& a : arrays) a.data.write(out);
-  out << "\n  </AppendedData>\n</VTKFile>\n";
+  xml << header("ImageData") << "  <ImageData WholeExtent=\"" << extent << "\" Origin=\"" << origin.x << ' ' << origin.y
+      << ' ' << origin.z << "\" Spacing=\"" << spacing.x << ' ' << spacing.y << ' ' << spacing.z
+      << "\">\n    <Piece Extent=\"" << extent << "\">\n      <PointData Scalars=\"u\">\n"
+      << data.xml << "      </PointData>\n    </Piece>\n  </ImageData>\n";
+  write_appended(out, xml.str(), data.arrays, threads);
 }
+
+/// PolyData of `points` (3 coordinates each) with lines or triangles (`cells` of `corners` points
+/// each, by point index), and point and cell data.
+void write_poly(std::ostream& out, const std::vector<double>& points, const std::vector<std::int64_t>& connectivity,
+                const std::vector<std::int64_t>& offsets, bool lines, const DataArrays& point_data,
+                const DataArrays& cell_data, int threads) {
+  const char* kind = lines ? "Lines" : "Polys";
+  std::string xml = header("PolyData") + "  <PolyData>\n    <Piece NumberOfPoints=\"" +
+                    std::to_string(points.size() / 3) + "\" NumberOf" + kind + "=\"" + std::to_string(offsets.size()) +
+                    "\">\n      <PointData>\n" + point_data.xml + "      </PointData>\n      <CellData>\n" +
+                    cell_data.xml + "      </CellData>\n      <Points>\n" + array_xml("Float64", "points", 3) +
+                    "      </Points>\n      <" + kind + ">\n" + array_xml("Int64", "connectivity") +
+                    array_xml("Int64", "offsets") + "      </" + kind + ">\n    </Piece>\n  </PolyData>\n";
+  std::vector<Appended> arrays = point_data.arrays;
+  arrays.insert(arrays.end(), cell_data.arrays.begin(), cell_data.arrays.end());
+  arrays.push_back(values_of(points));
+  arrays.push_back(values_of(connectivity));
+  arrays.push_back(values_of(offsets));
+  write_appended(out, xml, arrays, threads);
+}
+
 }  // namespace
 
 void write_vti(std::ostream& out, const Problem& problem, const Solution& s) {
@@ -102,143 +204,180 @@ void write_vti(std::ostream& out, const Problem& problem, const Solution& s) {
   const int nx = grid.nx(), ny = grid.ny();
   const std::size_t n = std::size_t(nx + 1) * std::size_t(ny + 1);
   const CurveGridIntersection geometry(*problem.gamma, grid);
-  std::vector<double> u(n, 0.0), exact, error;
-  std::vector<std::uint8_t> inside(n, 0);
-  for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i) {
-      const std::size_t k = std::size_t(j) * (nx + 1) + i;
-      if (grid.has_unknown(i, j) && !s.u.empty()) u[k] = s.u[grid.index(i, j)];
-      inside[k] = geometry.node_inside(i, j);
-    }
-  const bool with_exact = bool(problem.exact) && !s.u.empty();
-  if (with_exact) {
-    exact.assign(n, 0.0);
-    error.assign(n, 0.0);
-    for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i) {
-        const std::size_t k = std::size_t(j) * (nx + 1) + i;
-        if (!inside[k]) continue;
-        exact[k] = problem.exact(grid.x(i), grid.y(j));
-        error[k] = u[k] - exact[k];
-      }
+  const auto node = [nx](std::size_t k) { return std::pair<int, int>{int(k % (nx + 1)), int(k / (nx + 1))}; };
+  const auto u = [&](std::size_t k) {
+    const auto [i, j] = node(k);
+    return grid.has_unknown(i, j) && !s.u.empty() ? s.u[grid.index(i, j)] : 0.0;
+  };
+  const auto exact = [&](std::size_t k) {
+    const auto [i, j] = node(k);
+    return geometry.node_inside(i, j) ? problem.exact(grid.x(i), grid.y(j)) : 0.0;
+  };
+  DataArrays data;
+  data.add("Float64", "u", computed<double>(n, u));
+  data.add("UInt8", "inside", computed<std::uint8_t>(n, [&](std::size_t k) {
+             const auto [i, j] = node(k);
+             return std::uint8_t(geometry.node_inside(i, j));
+           }));
+  if (problem.exact && !s.u.empty()) {
+    data.add("Float64", "u_exact", computed<double>(n, exact));
+    data.add("Float64", "error", computed<double>(n, [&](std::size_t k) {
+               const auto [i, j] = node(k);
+               return geometry.node_inside(i, j) ? u(k) - exact(k) : 0.0;
+             }));
   }
-  std::vector<ImageArray> arrays = {{"Float64", "u", zlib_array(u)}, {"UInt8", "inside", zlib_array(inside)}};
-  if (with_exact) {
-    arrays.push_back({"Float64", "u_exact", zlib_array(exact)});
-    arrays.push_back({"Float64", "error", zlib_array(error)});
-  }
-  write_image(out, {nx, ny, 0}, Point3{grid.box().lower.x, grid.box().lower.y, 0.0}, {grid.h(), grid.h(), 1.0}, arrays);
+  write_image(out, {nx, ny, 0}, Point3{grid.box().lower.x, grid.box().lower.y, 0.0}, {grid.h(), grid.h(), 1.0}, data,
+              s.options.threads);
 }
 
-void write_vtp(std::ostream& out, const Solution& s) {
-  const int m = s.collocation.m;
-  const bool two_curves = s.delta > 0;
-  const int n_points = two_curves ? 2 * m : m;
-  out.precision(17);
-  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\">\n"
-      << "  <PolyData>\n    <Piece NumberOfPoints=\"" << n_points << "\" NumberOfLines=\"" << (two_curves ? 2 : 1)
-      << "\">\n"
-      << "      <Points>\n        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (int i = 0; i < m; ++i) out << s.collocation.point[i].x << ' ' << s.collocation.point[i].y << " 0\n";
-  if (two_curves)
-    for (int i = 0; i < m; ++i) {
-      const Point2 p = s.Gamma->position(s.collocation.t[i]);
-      out << p.x << ' ' << p.y << " 0\n";
-    }
-  out << "        </DataArray>\n      </Points>\n      <Lines>\n"
-      << "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (int c = 0; c < (two_curves ? 2 : 1); ++c) {
-    for (int i = 0; i < m; ++i) out << c * m + i << ' ';
-    out << c * m << '\n';
+namespace {
+
+/// A closed polyline through m points.
+void write_closed_line(std::ostream& out, const std::vector<Point2>& p, const DataArrays& point_data, int threads) {
+  const std::size_t m = p.size();
+  std::vector<double> points;
+  std::vector<std::int64_t> connectivity;
+  for (std::size_t i = 0; i < m; ++i) {
+    points.insert(points.end(), {p[i].x, p[i].y, 0.0});
+    connectivity.push_back(std::int64_t(i));
   }
-  out << "        </DataArray>\n        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n"
-      << m + 1 << (two_curves ? " " + std::to_string(2 * (m + 1)) : std::string()) << "\n        </DataArray>\n"
-      << "      </Lines>\n      <PointData Scalars=\"lambda\">\n";
-  auto scalars = [&](const char* name, auto value) {
-    out << "        <DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
-    for (int c = 0; c < (two_curves ? 2 : 1); ++c)
-      for (int i = 0; i < m; ++i) out << value(i) << '\n';
-    out << "        </DataArray>\n";
-  };
-  scalars("g", [&](int i) { return s.g[i]; });
-  scalars("u", [&](int i) { return s.trace[i]; });
-  scalars("dudn", [&](int i) { return s.normal_derivative[i]; });
-  scalars("lambda", [&](int i) { return s.lambda[i]; });
-  scalars("contact", [&](int i) { return double(s.newton.active[i]); });
-  scalars("s", [&](int i) { return s.collocation.s[i]; });
-  out << "        <DataArray type=\"Int32\" Name=\"curve\" format=\"ascii\">\n";
-  for (int c = 0; c < (two_curves ? 2 : 1); ++c)
-    for (int i = 0; i < m; ++i) out << c << '\n';
-  out << "        </DataArray>\n        <DataArray type=\"Float64\" Name=\"normal\" NumberOfComponents=\"3\" "
-         "format=\"ascii\">\n";
-  for (int c = 0; c < (two_curves ? 2 : 1); ++c)
-    for (int i = 0; i < m; ++i) out << s.collocation.normal[i].x << ' ' << s.collocation.normal[i].y << " 0\n";
-  out << "        </DataArray>\n      </PointData>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
+  connectivity.push_back(0);
+  write_poly(out, points, connectivity, {std::int64_t(m + 1)}, true, point_data, {}, threads);
+}
+
+}  // namespace
+
+void write_curve_vtp(std::ostream& out, const Solution& s) {
+  const std::size_t m = std::size_t(s.collocation.m);
+  std::vector<double> normal, gap(m), contact(m);
+  for (std::size_t i = 0; i < m; ++i) {
+    normal.insert(normal.end(), {s.collocation.normal[i].x, s.collocation.normal[i].y, 0.0});
+    gap[i] = s.trace[i] - s.g[i];
+    contact[i] = double(s.newton.active[i]);
+  }
+  DataArrays data;
+  data.add("Float64", "s", values_of(s.collocation.s));
+  data.add("Float64", "g", values_of(s.g));
+  data.add("Float64", "u", values_of(s.trace));
+  data.add("Float64", "dudn", values_of(s.normal_derivative));
+  if (s.check && s.check->normal_derivative.size() == m)
+    data.add("Float64", "dudn_check", values_of(s.check->normal_derivative));
+  data.add("Float64", "gap", values_of(gap));
+  data.add("Float64", "contact", values_of(contact));
+  if (s.options.variant == Variant::nonsmooth) data.add("Float64", "lambda", values_of(s.lambda));
+  data.add("Float64", "normal", values_of(normal), 3);
+  write_closed_line(out, s.collocation.point, data, s.options.threads);
+}
+
+void write_offset_curve_vtp(std::ostream& out, const Solution& s) {
+  std::vector<Point2> points;
+  for (int i = 0; i < s.collocation.m; ++i) points.push_back(s.Gamma->position(s.collocation.t[i]));
+  DataArrays data;
+  data.add("Float64", "lambda", values_of(s.lambda));
+  write_closed_line(out, points, data, s.options.threads);
 }
 
 void write_vti(std::ostream& out, const SurfaceProblem& problem, const SurfaceSolution& s) {
   const Grid3& grid = s.grid;
   const int nx = grid.nx(), ny = grid.ny(), nz = grid.nz();
   const std::size_t n = std::size_t(nx + 1) * std::size_t(ny + 1) * std::size_t(nz + 1);
-  std::vector<double> u(n, 0.0), exact, error;
-  std::vector<std::uint8_t> inside(n, 0);
-  const bool with_exact = bool(problem.exact);
-  if (with_exact) exact.assign(n, 0.0), error.assign(n, 0.0);
-#pragma omp parallel for schedule(static)
-  for (int k = 0; k <= nz; ++k)
-    for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i) {
-        const std::size_t at = (std::size_t(k) * (ny + 1) + j) * (nx + 1) + i;
-        const Grid3::Index node{i, j, k};
-        if (grid.has_unknown(node)) u[at] = s.u[grid.index(node)];
-        const Point3 x{grid.x(i), grid.y(j), grid.z(k)};
-        inside[at] = problem.gamma->level(x) < 0;
-        if (with_exact && inside[at]) {
-          exact[at] = problem.exact(x.x, x.y, x.z);
-          error[at] = u[at] - exact[at];
-        }
-      }
-  std::vector<ImageArray> arrays = {{"Float64", "u", zlib_array(u)}, {"UInt8", "inside", zlib_array(inside)}};
-  if (with_exact) {
-    arrays.push_back({"Float64", "u_exact", zlib_array(exact)});
-    arrays.push_back({"Float64", "error", zlib_array(error)});
+  const auto node = [nx, ny](std::size_t k) {
+    return Grid3::Index{int(k % (nx + 1)), int(k / (nx + 1) % (ny + 1)), int(k / (std::size_t(nx + 1) * (ny + 1)))};
+  };
+  const auto x = [&](const Grid3::Index& i) { return Point3{grid.x(i[0]), grid.y(i[1]), grid.z(i[2])}; };
+  std::vector<std::uint8_t> inside(n);  // a byte a node: the level function once per node
+#pragma omp parallel for num_threads(s.options.threads) schedule(static)
+  for (std::int64_t k = 0; k < std::int64_t(n); ++k) inside[std::size_t(k)] = problem.gamma->level(x(node(k))) < 0;
+  const auto u = [&](std::size_t k) {
+    const Grid3::Index i = node(k);
+    return grid.has_unknown(i) ? s.u[grid.index(i)] : 0.0;
+  };
+  const auto exact = [&](std::size_t k) {
+    const Point3 p = x(node(k));
+    return inside[k] ? problem.exact(p.x, p.y, p.z) : 0.0;
+  };
+  DataArrays data;
+  data.add("Float64", "u", computed<double>(n, u));
+  data.add("UInt8", "inside", values_of(inside));
+  if (problem.exact) {
+    data.add("Float64", "u_exact", computed<double>(n, exact));
+    data.add("Float64", "error", computed<double>(n, [&](std::size_t k) { return inside[k] ? u(k) - exact(k) : 0.0; }));
   }
-  write_image(out, {nx, ny, nz}, grid.box().lower, {grid.h(), grid.h(), grid.h()}, arrays);
+  write_image(out, {nx, ny, nz}, grid.box().lower, {grid.h(), grid.h(), grid.h()}, data, s.options.threads);
 }
 
-void write_vtp(std::ostream& out, const SurfaceSolution& s) {
-  const bool two = s.delta > 0;
-  const std::vector<const PatchedSurface*> surfaces =
-      two ? std::vector<const PatchedSurface*>{&s.gamma, &s.Gamma} : std::vector<const PatchedSurface*>{&s.gamma};
-  std::size_t triangles = 0;
-  for (const PatchedSurface* surface : surfaces) triangles += surface->triangles.size();
-  out.precision(17);
-  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\">\n"
-      << "  <PolyData>\n    <Piece NumberOfPoints=\"" << 3 * triangles << "\" NumberOfPolys=\"" << triangles << "\">\n"
-      << "      <Points>\n        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const PatchedSurface* surface : surfaces)
-    for (const Triangle3& t : surface->triangles)
-      for (const Point3& p : {t.a, t.b, t.c}) out << p.x << ' ' << p.y << ' ' << p.z << '\n';
-  out << "        </DataArray>\n      </Points>\n      <Polys>\n"
-      << "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (std::size_t t = 0; t < triangles; ++t) out << 3 * t << ' ' << 3 * t + 1 << ' ' << 3 * t + 2 << '\n';
-  out << "        </DataArray>\n        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  for (std::size_t t = 0; t < triangles; ++t) out << 3 * (t + 1) << '\n';
-  out << "        </DataArray>\n      </Polys>\n      <CellData Scalars=\"lambda\">\n";
-  auto cells = [&](const char* type, const char* name, auto value) {
-    out << "        <DataArray type=\"" << type << "\" Name=\"" << name << "\" format=\"ascii\">\n";
-    for (std::size_t c = 0; c < surfaces.size(); ++c)
-      for (int patch : surfaces[c]->patch_of) out << value(int(c), patch) << '\n';
-    out << "        </DataArray>\n";
-  };
-  cells("Int32", "surface", [](int c, int) { return c; });
-  cells("Int32", "patch", [](int, int p) { return p; });
-  cells("Float64", "g", [&](int, int p) { return s.g[p]; });
-  cells("Float64", "u", [&](int, int p) { return s.trace[p]; });
-  cells("Float64", "dudn", [&](int, int p) { return s.normal_derivative[p]; });
-  cells("Float64", "lambda", [&](int, int p) { return s.lambda[p]; });
-  cells("Int32", "contact", [&](int, int p) { return int(s.newton.active[p]); });
-  out << "      </CellData>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
+namespace {
+
+/// The triangles of a patched surface with shared points (bitwise equal corners are one point),
+/// cell data per patch (its outward normal among them) and, at the points, the area-weighted means of
+/// the same over their triangles.
+void write_patched(std::ostream& out, const PatchedSurface& surface,
+                   const std::vector<std::pair<std::string, const std::vector<double>*>>& per_patch, int threads) {
+  std::map<std::tuple<double, double, double>, std::int64_t> index;
+  std::vector<double> points;
+  std::vector<std::int64_t> connectivity, offsets;
+  std::vector<double> weight;                               // Σ area of a point's triangles
+  std::vector<std::vector<double>> sums(per_patch.size());  // Σ area·value
+  const std::size_t T = surface.triangles.size();
+  std::vector<std::int32_t> patch(T);
+  for (std::size_t t = 0; t < T; ++t) {
+    const Triangle3& tri = surface.triangles[t];
+    const double a = area(tri);
+    patch[t] = surface.patch_of[t];
+    for (const Point3& p : {tri.a, tri.b, tri.c}) {
+      const auto [it, added] = index.try_emplace({p.x, p.y, p.z}, std::int64_t(points.size() / 3));
+      if (added) {
+        points.insert(points.end(), {p.x, p.y, p.z});
+        weight.push_back(0.0);
+        for (auto& s : sums) s.push_back(0.0);
+      }
+      connectivity.push_back(it->second);
+      weight[std::size_t(it->second)] += a;
+      for (std::size_t k = 0; k < per_patch.size(); ++k)
+        sums[k][std::size_t(it->second)] += a * (*per_patch[k].second)[std::size_t(patch[t])];
+    }
+    offsets.push_back(std::int64_t(connectivity.size()));
+  }
+  for (auto& s : sums)
+    for (std::size_t p = 0; p < s.size(); ++p) s[p] = weight[p] > 0 ? s[p] / weight[p] : 0.0;
+  DataArrays point_data, cell_data;
+  cell_data.add("Int32", "patch", values_of(patch));
+  cell_data.add(
+      "Float64", "normal",
+      computed<double>(
+          3 * T, [&surface, &patch](std::size_t k) { return surface.normal[std::size_t(patch[k / 3])][int(k % 3)]; }),
+      3);
+  for (std::size_t k = 0; k < per_patch.size(); ++k) {
+    const std::vector<double>& v = *per_patch[k].second;
+    point_data.add("Float64", per_patch[k].first, values_of(sums[k]));
+    cell_data.add("Float64", per_patch[k].first,
+                  computed<double>(T, [&v, &patch](std::size_t t) { return v[std::size_t(patch[t])]; }));
+  }
+  write_poly(out, points, connectivity, offsets, false, point_data, cell_data, threads);
+}
+
+}  // namespace
+
+void write_surface_vtp(std::ostream& out, const SurfaceSolution& s) {
+  std::vector<double> gap(s.trace.size()), contact(s.trace.size());
+  for (std::size_t p = 0; p < gap.size(); ++p) gap[p] = s.trace[p] - s.g[p], contact[p] = double(s.newton.active[p]);
+  std::vector<std::pair<std::string, const std::vector<double>*>> values = {
+      {"g", &s.g}, {"u", &s.trace}, {"dudn", &s.normal_derivative}, {"gap", &gap}, {"contact", &contact}};
+  if (s.options.variant == Variant::nonsmooth) values.push_back({"lambda", &s.lambda});
+  write_patched(out, s.gamma, values, s.options.threads);
+}
+
+void write_offset_surface_vtp(std::ostream& out, const SurfaceSolution& s) {
+  write_patched(out, s.Gamma, {{"lambda", &s.lambda}}, s.options.threads);
+}
+
+void write_vtm(std::ostream& out, const std::vector<std::pair<std::string, std::string>>& blocks) {
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"vtkMultiBlockDataSet\" version=\"1.0\" "
+         "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <vtkMultiBlockDataSet>\n";
+  for (std::size_t k = 0; k < blocks.size(); ++k)
+    out << "    <DataSet index=\"" << k << "\" name=\"" << blocks[k].first << "\" file=\"" << blocks[k].second
+        << "\"/>\n";
+  out << "  </vtkMultiBlockDataSet>\n</VTKFile>\n";
 }
 
 }  // namespace fictus::cli

@@ -1,8 +1,19 @@
 #pragma once
-// ParaView files: solution.vti (VTK XML ImageData, appended Float64/UInt8 arrays compressed with zlib in
-// 1 MiB blocks, as VTK's vtkZLibDataCompressor writes them) and
-// curves.vtp (VTK XML PolyData, γ and Γ as closed polylines with the point data of points.csv).
+// ParaView files, VTK XML with appended binary arrays compressed by zlib in 1 MiB blocks (as VTK's
+// vtkZLibDataCompressor writes them), streamed: each array is made and compressed block by block, in
+// parallel, and written as it comes, so that no array is ever held whole (the stream must be seekable:
+// the offsets are written last).
+//   solution.vti         the grid field (ImageData);
+//   curves.vtp           2-D: γ as a closed polyline through the points, their values as point data;
+//   offset_curve.vtp     2-D, smooth variant: Γ behind the points, with λ;
+//   surface.vtp          3-D: γ's triangles with shared points, the values of each patch as cell data
+//                        and their area-weighted means at the points as point data;
+//   offset_surface.vtp   3-D, smooth variant: Γ's triangles with λ;
+//   solution.vtm         a multiblock file naming the others: opens a whole run in ParaView.
 #include <ostream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/surface_solver.hpp"
@@ -12,13 +23,23 @@ namespace fictus::cli {
 /// û at all (nx+1)(ny+1) nodes (x fastest; 0 on a Dirichlet boundary), "inside" (1 in ω), and,
 /// with an exact solution, "u_exact" and "error" (û − u, 0 outside ω).
 void write_vti(std::ostream& out, const Problem& problem, const Solution& solution);
-void write_vtp(std::ostream& out, const Solution& solution);
+/// γ through the collocation points with point data s, g, u, dudn, gap (u − g), contact, normal, the
+/// independent check's dudn_check when there is one, and lambda in the non-smooth variant.
+void write_curve_vtp(std::ostream& out, const Solution& solution);
+/// Γ (smooth variant) through the points of Γ behind the collocation points, with lambda.
+void write_offset_curve_vtp(std::ostream& out, const Solution& solution);
 
 /// 3-D: û at all (N+1)³ nodes, "inside" (1 in ω) and, with an exact solution, "u_exact" and "error"
-/// (0 outside ω), zlib-compressed as above.
+/// (0 outside ω).
 void write_vti(std::ostream& out, const SurfaceProblem& problem, const SurfaceSolution& solution);
-/// 3-D: γ's triangles (and Γ's, in the smooth variant: "surface" 0 and 1) with the values of their patch as
-/// cell data (patch, g, u, dudn, lambda, contact).
-void write_vtp(std::ostream& out, const SurfaceSolution& solution);
+/// 3-D: γ's triangles (points shared), cell data patch, normal (the patch's outward normal), g, u,
+/// dudn, gap, contact (and lambda in the non-smooth variant), point data the area-weighted means of
+/// the same over the triangles at a point.
+void write_surface_vtp(std::ostream& out, const SurfaceSolution& solution);
+/// 3-D, smooth variant: Γ's triangles, cell data patch, normal and lambda, point data lambda.
+void write_offset_surface_vtp(std::ostream& out, const SurfaceSolution& solution);
+
+/// A vtkMultiBlockDataSet file naming (block name, file name) pairs, the files beside it.
+void write_vtm(std::ostream& out, const std::vector<std::pair<std::string, std::string>>& blocks);
 
 }  // namespace fictus::cli

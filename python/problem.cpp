@@ -215,7 +215,10 @@ PyProblem PyProblem::from_config(py::dict config) {
     } else if (const char* name = section_of(key)) {
       section(name)[py::str(key)] = v;
     } else {
-      throw std::invalid_argument(key + ": unknown keyword");
+      std::vector<std::string> known = {"f",           "g",    "exact",  "domain", "geometry",
+                                        "formulation", "data", "solver", "output", "parameters"};
+      for (const OptionSpec& spec : option_specs()) known.push_back(spec.key);
+      throw std::invalid_argument(key + ": unknown keyword" + did_you_mean(key, known));
     }
   }
   // Callables in [data] are attached after parsing; the TOML gets placeholders.

@@ -15,6 +15,7 @@
 #include "fictus/io/problem_file.hpp"
 #include "fictus/io/process.hpp"
 #include "fictus/mesh_surface.hpp"
+#include "fictus/options.hpp"
 #include "fictus/surface_solver.hpp"
 #include "python_problem.hpp"
 
@@ -75,7 +76,9 @@ struct PySurfaceProblem {
       const std::string key = py::str(k);
       if (key != "domain" && key != "geometry" && key != "formulation" && key != "data" && key != "solver" &&
           key != "output")
-        throw std::invalid_argument(key + ": unknown section (domain, geometry, formulation, data, solver, output)");
+        throw std::invalid_argument(
+            key + ": unknown section (domain, geometry, formulation, data, solver, output)" +
+            did_you_mean(key, {"domain", "geometry", "formulation", "data", "solver", "output"}));
       if (!py::isinstance<py::dict>(v)) throw std::invalid_argument(key + ": expected a dict");
       py::dict copy;  // the caller's dict stays as it was (callables are replaced by placeholders below)
       for (auto [kk, vv] : v.cast<py::dict>()) copy[kk] = vv;

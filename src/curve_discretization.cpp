@@ -1,6 +1,10 @@
 #include "fictus/curve_discretization.hpp"
 
+#include <cmath>
 #include <cstdio>
+#include <limits>
+#include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -12,63 +16,117 @@ CurveDiscretization::CurveDiscretization(std::shared_ptr<const Curve> gamma, con
                                          const SolverOptions& options, double c, const Execution& execution)
     : gamma_(std::move(gamma)) {
   if (!gamma_) throw std::invalid_argument("geometry: no curve given");
-  make_geometry(grid, options);
-  make_trace_rows(grid, options, c, execution);
+  SolverOptions resolved = options;
+  resolved.variant = resolved_variant(options.variant, gamma_->smooth());
+  make_geometry(grid, resolved);
+  make_trace_rows(grid, resolved, c, execution);
 }
+
+namespace {
+
+/// The room of Γ = γ + δn (spacing_rule.hpp) at grid spacing h: on every side of the box, from
+/// the samples of γ whose normal points towards it, δ <= (distance − 2h)/(n toward the side); and
+/// the δ beyond which Γ stops being simple, found once by bisection when Γ at the box's limit folds.
+OffsetRoom curve_offset_room(std::shared_ptr<const Curve> gamma, const Box2& box) {
+  struct Sample {
+    double distance, toward;  // to one side of the box, and n's component toward it
+  };
+  auto samples = std::make_shared<std::vector<Sample>>();
+  constexpr int count = 4096;  // as check_inside_box and check_simple
+  std::vector<double> t = gamma->corners();
+  for (int k = 0; k < count; ++k) t.push_back(2 * std::numbers::pi * k / count);
+  for (double s : t) {
+    const Point2 p = gamma->position(s), n = gamma->outward_normal(s);
+    const Sample sides[4] = {
+        {p.x - box.lower.x, -n.x}, {box.upper.x - p.x, n.x}, {p.y - box.lower.y, -n.y}, {box.upper.y - p.y, n.y}};
+    for (const Sample& side : sides)
+      if (side.toward > 0) samples->push_back(side);
+  }
+  const auto box_room = [samples](double h) {
+    double room = std::numeric_limits<double>::infinity();
+    for (const Sample& s : *samples) room = std::min(room, (s.distance - 2 * h) / s.toward);
+    return room;
+  };
+  auto fold = std::make_shared<std::optional<double>>();  // the δ where Γ stops being simple (+∞: never)
+  return [gamma, box_room, fold](double h) {
+    const double room = box_room(h);
+    if (!fold->has_value()) {
+      const auto simple = [&gamma](double delta) {
+        try {
+          check_simple(OffsetCurve(gamma, delta), "formulation.offset");
+          return true;
+        } catch (const std::invalid_argument&) {
+          return false;
+        }
+      };
+      const double widest = box_room(0);
+      if (!(widest > 0) || simple(widest)) {
+        *fold = std::numeric_limits<double>::infinity();
+      } else {
+        double low = 0, high = widest;
+        for (int k = 0; k < 40 && high - low > 1e-9 * widest; ++k)
+          ((simple((low + high) / 2)) ? low : high) = (low + high) / 2;
+        *fold = low;
+      }
+    }
+    return std::min(room, **fold);
+  };
+}
+
+}  // namespace
 
 void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options) {
   const Curve& gamma = *gamma_;
-  const double h = grid.h();
+  const double h = grid.h(), width = grid.box().width(0);
   check_simple(gamma, "geometry");
   if (signed_area(gamma) <= 0)
     throw std::invalid_argument("geometry: the curve must be counter-clockwise (ω on its left)");
-  check_inside_box(gamma, grid.box(), 2 * h, "geometry");
+  if (const BoxClearance c = box_clearance(gamma, grid.box(), "geometry"); c.distance < 2 * h) {
+    char text[240];
+    if (c.distance > 0)
+      std::snprintf(text, sizeof text,
+                    "geometry: the curve comes within %.3g of the box at (%.6g, %.6g); the grid needs 2h = %.3g "
+                    "there: N >= %.0f (or a larger box)",
+                    c.distance, c.at.x, c.at.y, 2 * h, std::ceil(2 * width / c.distance - 1e-9));
+    else
+      std::snprintf(
+          text, sizeof text,
+          "geometry: the curve comes within %.3g of the box boundary (or leaves it) at (%.6g, %.6g): a larger box",
+          c.distance, c.at.x, c.at.y);
+    throw std::invalid_argument(text);
+  }
   gamma_geometry_ = std::make_unique<CurveGridIntersection>(gamma, grid, "geometry");
 
   const ArcLengthTable arc_length(gamma);
   const double L = arc_length.length();
+  if (options.variant == Variant::smooth && !gamma.smooth())
+    throw std::invalid_argument(
+        "formulation.variant: the smooth variant needs a curve with a continuous normal "
+        "(use \"nonsmooth\" for polygons)");
   const double spacing_cells =
       options.variant == Variant::smooth ? default_spacing_cells_smooth : default_spacing_cells_nonsmooth;
-  const int m = options.multipliers == 0 ? default_multipliers(L, h, spacing_cells) : options.multipliers;
-  if (m < minimum_multipliers)
-    throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) +
-                                " is too small (need m >= " + std::to_string(minimum_multipliers) + ")");
-  if (L / m < 2 * h)
-    throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) +
-                                " is too large for the grid (spacing L/m = " + std::to_string(L / m) +
-                                " < 2h; use m <= " + std::to_string(int(L / (2 * h))) + ")");
+  SpacingInput input{2,
+                     L,
+                     h,
+                     width,
+                     [L, spacing_cells](double k) { return default_multipliers(L, k, spacing_cells); },
+                     options.variant == Variant::smooth ? curve_offset_room(gamma_, grid.box()) : OffsetRoom()};
+  spacing_ = plan_spacing(input, options);
+  const int m = spacing_.m;
   if (options.variant == Variant::nonsmooth) {
     collocation_ = make_collocation(gamma, arc_length, m, phase_off_corners(gamma, arc_length, m));
     Gamma_ = gamma_;
     return;
   }
-  if (!gamma.smooth())
-    throw std::invalid_argument(
-        "formulation.variant: the smooth variant needs a curve with a continuous normal "
-        "(use \"nonsmooth\" for polygons)");
-  delta_ = options.offset * L / m;
+  delta_ = spacing_.delta;
   // Points placed so that the arcs of Γ behind them are equal where γ is convex (there Γ's arcs are
   // stretched by 1 + δκ): the longest arc of Γ, which sets the ripple of the controls, is as short as m
   // allows (docs/math.md, "Placement of the points").
   const ArcLengthTable placement = offset_placement(gamma, delta_);
   collocation_ = make_collocation(gamma, arc_length, m, 0.5, &placement);
-  // The biquadratic stencil of C_γ reaches 1.5·√2·h ≈ 2.1h from x_i; its nodes must stay out of the
-  // cells cut by Γ (which reach 1.4h from Γ), where the kink of û pollutes the nodal values.
-  if (options.normal_derivative == NormalDerivative::reconstructed && delta_ < 4 * h)
-    throw std::invalid_argument("formulation.offset: Γ at δ = offset·L/m = " + std::to_string(delta_ / h) +
-                                " h is within reach of the C_γ stencil (need δ >= 4h: a larger offset or a smaller m)");
   Gamma_ = std::make_shared<OffsetCurve>(gamma_, delta_);
-  try {
-    check_simple(*Gamma_, "formulation.offset");
-    check_inside_box(*Gamma_, grid.box(), 2 * h, "formulation.offset");
-  } catch (const std::invalid_argument& e) {  // say what moves Γ closer to γ
-    char hint[160];
-    std::snprintf(hint, sizeof hint,
-                  "; Γ lies δ = offset·L/m = %.3g from γ (%.1f h): a larger N or a smaller formulation.offset "
-                  "brings it closer",
-                  delta_, delta_ / h);
-    throw std::invalid_argument(e.what() + std::string(hint));
-  }
+  check_simple(*Gamma_, "formulation.offset");  // the plan's room says so; checked again on Γ itself
+  check_inside_box(*Gamma_, grid.box(), 2 * h, "formulation.offset");
   Gamma_geometry_ = std::make_unique<CurveGridIntersection>(*Gamma_, grid, "formulation.offset");
 }
 

@@ -203,20 +203,18 @@ void load_terms(const State& st, CurveSetup& setup) {
   setup.load_version = st.load_version;
 }
 
-/// Steps 1–3 for data.gamma, or the previous ones when the curve and its options are unchanged.
-const CurveSetup& curve_setup(State& st, const ContactData& data, const SolverOptions& options, PhaseClock& clock,
-                              bool& reused) {
+/// Steps 1–3 for data.gamma, or the previous ones when the curve and its options are unchanged
+/// (B_γu₀ and C_γu₀ come after step 0: load_terms).
+CurveSetup& curve_setup(State& st, const ContactData& data, const SolverOptions& options, PhaseClock& clock,
+                        bool& reused) {
   reused = st.setup && st.setup->gamma == data.gamma && same_curve_options(st.setup->options, options);
-  if (reused) {
-    if (st.setup->load_version != st.load_version) load_terms(st, *st.setup);  // a new f, the same rows
-    return *st.setup;
-  }
+  if (reused) return *st.setup;
   st.setup.reset();
   auto setup = std::make_unique<CurveSetup>();
   setup->gamma = data.gamma;
   setup->options = options;
   setup->boundary = std::make_unique<CurveDiscretization>(data.gamma, st.grid, options, st.c, st.execution);
-  load_terms(st, *setup);
+  setup->load_version = -1;  // B_γu₀ and C_γu₀ once u₀ is there (load_terms)
   clock.mark("geometry");
   setup->schur = schur_blocks(st, *setup->boundary, options, clock);
   st.setup = std::move(setup);
@@ -300,7 +298,8 @@ void signorini_checks(const BoundaryDiscretization& boundary, Solution& sol) {
     sum += difference * difference;
   }
   check.rms_difference = std::sqrt(sum / m);
-  sol.check = check;
+  check.normal_derivative = std::move(*d);
+  sol.check = std::move(check);
 }
 
 /// Step 8a: the errors of the traces at the points. ∂u/∂n of the exact solution: its gradient when
@@ -341,21 +340,25 @@ PointErrors point_errors(const ContactData& data, const BoundaryDiscretization& 
 Solution FictitiousDomainSolver::solve(const ContactData& data, SolverOptions options, bool compute_field) {
   State& st = *state_;
   options.validate();
-  if (options.threads != st.execution.threads() || options.load_quadrature != st.load_quadrature)
+  if (Execution(options.threads).threads() != st.execution.threads() || options.load_quadrature != st.load_quadrature)
     throw std::invalid_argument("solver.threads: threads and load_quadrature are the solver's (" +
                                 std::to_string(st.execution.threads()) + ", " + std::to_string(st.load_quadrature) +
                                 "); make a new FictitiousDomainSolver to change them");
   if (!data.gamma) throw std::invalid_argument("geometry: no curve given");
   if (!data.g && !data.g_along_curve && !data.g_vectorized) throw std::invalid_argument("data.g: not given");
-  Eigen::setNbThreads(options.threads);  // the dense LU of the Newton steps follows the threads option
+  const bool chosen = options.variant == Variant::automatic;
+  options.variant = resolved_variant(options.variant, data.gamma->smooth());
+  Eigen::setNbThreads(st.execution.threads());  // the dense LU of the Newton steps follows the threads option
   Solution sol(st.grid);
   const Execution& execution = st.execution;
   PhaseClock clock(sol.timings, execution);
   std::size_t fast_solves = 0;
 
-  load_and_u0(st, clock, fast_solves);  // 0
+  // 1–3 before 0: the curve and the options that shape it are checked before any grid-sized work.
+  CurveSetup& setup = curve_setup(st, data, options, clock, sol.reused_curve);  // 1–3
   execution.throw_if_interrupted();
-  const CurveSetup& setup = curve_setup(st, data, options, clock, sol.reused_curve);  // 1–3
+  load_and_u0(st, clock, fast_solves);  // 0
+  if (setup.load_version != st.load_version) load_terms(st, setup);
   execution.throw_if_interrupted();
   const CurveDiscretization& boundary = *setup.boundary;
   sol.collocation = boundary.collocation();
@@ -387,7 +390,14 @@ Solution FictitiousDomainSolver::solve(const ContactData& data, SolverOptions op
     clock.mark("errors");
   }
   sol.options = options;
-  sol.options.multipliers = boundary.collocation().m;
+  sol.options.threads = st.execution.threads();
+  sol.options.multipliers = boundary.spacing().m;
+  sol.options.offset = boundary.spacing().offset;
+  if (chosen && options.variant == Variant::nonsmooth)
+    sol.warnings.push_back(
+        "formulation.variant: γ has corners: solved with the non-smooth variant (the smooth one needs a continuous "
+        "normal)");
+  if (!boundary.spacing().warning.empty()) sol.warnings.push_back(boundary.spacing().warning);
   return sol;
 }
 
@@ -402,8 +412,8 @@ std::pair<double, double> nodes_and_multipliers(const Problem& problem, const So
   if (m == 0) {
     const double L = problem.gamma ? ArcLengthTable(*problem.gamma, 256).length()
                                    : 2 * (problem.box.width(0) + problem.box.width(1));
-    const double cells =
-        options.variant == Variant::smooth ? default_spacing_cells_smooth : default_spacing_cells_nonsmooth;
+    const Variant variant = resolved_variant(options.variant, !problem.gamma || problem.gamma->smooth());
+    const double cells = variant == Variant::smooth ? default_spacing_cells_smooth : default_spacing_cells_nonsmooth;
     m = std::max(double(minimum_multipliers), L / (cells * h));
   } else if (problem.gamma) {
     m = std::min(m, ArcLengthTable(*problem.gamma, 256).length() / (2 * h));  // the most a solve accepts
@@ -428,8 +438,8 @@ double estimated_seconds(const Problem& problem, const SolverOptions& options) {
   // one dense LU of 1e-10·m³ s (8 steps assumed; the cap allows more); GMRES about 2.5 m
   // iterations of 2.5 fast solves of 4.6e-10 s per node·log2(nodes). Threads divide it, up to the
   // cores there are.
-  const double threads =
-      std::clamp(double(options.threads), 1.0, double(std::max(1u, std::thread::hardware_concurrency())));
+  const double threads = std::clamp(double(Execution(options.threads).threads()), 1.0,
+                                    double(std::max(1u, std::thread::hardware_concurrency())));
   const double grid = 4.5e-9 * n_log_n, pairs = 1.15e-6 * m * m, dense = 8 * 0.5e-10 * m * m * m;
   const double seconds =
       options.inner == InnerSolver::green ? grid + pairs + dense : grid + 2.5 * m * 2.5 * 2.3e-10 * n_log_n;

@@ -1,6 +1,9 @@
 #include "fictus/options.hpp"
 
+#include "fictus/execution.hpp"
+
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -152,7 +155,11 @@ std::vector<OptionSpec> make_specs() {
       const auto& b = std::get<std::vector<double>>(v);
       for (double x : b)
         if (!std::isfinite(x) || std::abs(x) > 1e12) return std::string("must be finite numbers of magnitude <= 1e12");
-      return b[0] < b[1] && b[2] < b[3] ? std::string() : std::string("need x0 < x1 and y0 < y1");
+      if (b[0] < b[1] && b[2] < b[3]) return std::string();
+      return "the box is [x0, x1, y0, y1] (bounds order, as VTK and matplotlib's extent) with x0 < x1 and y0 < y1, "
+             "got [" +
+             format_number(b[0]) + ", " + format_number(b[1]) + ", " + format_number(b[2]) + ", " +
+             format_number(b[3]) + "]";
     };
     specs.push_back(box);
   }
@@ -171,10 +178,12 @@ std::vector<OptionSpec> make_specs() {
                          {Boundary::dirichlet, Boundary::periodic},
                          "conditions on ∂Ω: u = 0, or periodic (even cell counts; c = 0 allowed)"));
   // [formulation]
-  specs.push_back(choice(std::string("formulation"), std::string("variant"), &SolverOptions::variant,
-                         {to_string(Variant::smooth), to_string(Variant::nonsmooth), "non-smooth"},
-                         {Variant::smooth, Variant::nonsmooth, Variant::nonsmooth},
-                         "smooth: controls λ on the offset curve Γ outside ω; nonsmooth: multipliers on γ"));
+  specs.push_back(
+      choice(std::string("formulation"), std::string("variant"), &SolverOptions::variant,
+             {to_string(Variant::automatic), to_string(Variant::smooth), to_string(Variant::nonsmooth), "non-smooth"},
+             {Variant::automatic, Variant::smooth, Variant::nonsmooth, Variant::nonsmooth},
+             "smooth: controls λ on the offset curve Γ outside ω; nonsmooth: multipliers on γ; "
+             "automatic: smooth where γ has a continuous normal, nonsmooth where it has corners"));
   {
     OptionSpec m = integer("formulation", "multipliers", &SolverOptions::multipliers, 0, 1000000,
                            "m; 0 = the default rule m = max(8, round(L/(c·h))), c = 8 (smooth) or 12 (non-smooth); "
@@ -182,9 +191,10 @@ std::vector<OptionSpec> make_specs() {
     m.aliases = {"m"};
     specs.push_back(m);
   }
-  specs.push_back(number("formulation", "offset", &SolverOptions::offset, 0.0, true, 100.0, false,
-                         "smooth variant: δ/s, the distance of Γ from γ in units of the point spacing s = L/m; "
-                         "Γ must stay >= 4h from γ"));
+  specs.push_back(number("formulation", "offset", &SolverOptions::offset, 0.0, false, 100.0, false,
+                         "smooth variant: δ/s, the distance of Γ from γ in units of the point spacing s; 0 = the "
+                         "default rule δ = 1.5·s, made to fit (with a warning) where the box or γ leave Γ less room; "
+                         "Γ needs δ >= 4h"));
   specs.push_back(number("formulation", "rho", &SolverOptions::rho, 0.0, true, 1e12, false,
                          "ρ of the projection max{0, ∂u/∂n − ρ(u − g)}"));
   specs.push_back(choice(std::string("formulation"), std::string("normal_derivative"),
@@ -243,11 +253,12 @@ std::vector<OptionSpec> make_specs() {
   }
   {
     OptionSpec t = member(std::string("solver"), std::string("threads"), OptionType::integer, &SolverOptions::threads,
-                          "threads for the transforms, loops and dense algebra");
-    t.rule = "in 1 … 4 × the hardware threads";
+                          "threads for the transforms, loops and dense algebra; 0 = the machine's "
+                          "(OMP_NUM_THREADS when set, else the hardware threads)");
+    t.rule = "in 0 … 4 × the hardware threads";
     t.violation = [](const OptionValue& v) {
       const std::int64_t n = std::get<std::int64_t>(v);
-      return n < 1 || n > max_threads() ? "must be in 1 … " + std::to_string(max_threads()) +
+      return n < 0 || n > max_threads() ? "must be in 0 … " + std::to_string(max_threads()) +
                                               " (4 × the hardware threads), got " + std::to_string(n)
                                         : std::string();
     };
@@ -307,9 +318,53 @@ const char* type_words(OptionType t) {
 
 }  // namespace
 
-const char* to_string(Variant v) { return v == Variant::smooth ? "smooth" : "nonsmooth"; }
+const char* to_string(Variant v) {
+  return v == Variant::smooth ? "smooth" : v == Variant::nonsmooth ? "nonsmooth" : "automatic";
+}
 const char* to_string(InnerSolver s) { return s == InnerSolver::green ? "green" : "krylov"; }
 const char* to_string(NormalDerivative d) { return d == NormalDerivative::shifted ? "shifted" : "reconstructed"; }
+
+std::string did_you_mean(std::string_view name, const std::vector<std::string>& candidates) {
+  const auto lower = [](std::string_view text) {
+    std::string out(text);
+    for (char& ch : out) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    return out;
+  };
+  const std::string a = lower(name);
+  // Optimal string alignment distance: insertions, deletions, substitutions, adjacent transpositions.
+  const auto distance = [&a](const std::string& b) {
+    const std::size_t n = a.size(), m = b.size();
+    std::vector<std::vector<std::size_t>> d(n + 1, std::vector<std::size_t>(m + 1));
+    for (std::size_t i = 0; i <= n; ++i) d[i][0] = i;
+    for (std::size_t j = 0; j <= m; ++j) d[0][j] = j;
+    for (std::size_t i = 1; i <= n; ++i)
+      for (std::size_t j = 1; j <= m; ++j) {
+        d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+        if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+          d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+      }
+    return d[n][m];
+  };
+  if (a.empty() || a.size() > 64) return "";
+  const std::size_t allowed = std::max<std::size_t>(1, a.size() / 3);
+  std::size_t best = allowed + 1;
+  std::string nearest;
+  for (const std::string& candidate : candidates) {
+    if (candidate.empty() || candidate.size() > a.size() + allowed + 1 || candidate == name) continue;
+    const std::size_t d = distance(lower(candidate));
+    if (d < best) best = d, nearest = candidate;
+  }
+  return nearest.empty() ? "" : " (did you mean \"" + nearest + "\"?)";
+}
+
+int default_threads() {
+  if (const char* text = std::getenv("OMP_NUM_THREADS")) {
+    char* end = nullptr;
+    const long n = std::strtol(text, &end, 10);  // "4" or "4,2" (nested levels): the first entry
+    if (end != text && n > 0 && n <= max_threads()) return int(n);
+  }
+  return std::max(1, int(std::thread::hardware_concurrency()));
+}
 
 int max_threads() {
   static const int n = std::max(4, 4 * int(std::thread::hardware_concurrency()));
@@ -343,7 +398,8 @@ OptionValue checked(const OptionSpec& spec, OptionValue value) {
   if (spec.type == OptionType::choice) {
     const std::string& text = std::get<std::string>(value);
     if (std::find(spec.choices.begin(), spec.choices.end(), text) == spec.choices.end())
-      fail(spec, "expected " + spec.rule + ", got \"" + text.substr(0, 40) + (text.size() > 40 ? "…" : "") + "\"");
+      fail(spec, "expected " + spec.rule + ", got \"" + text.substr(0, 40) + (text.size() > 40 ? "…" : "") + "\"" +
+                     did_you_mean(text, spec.choices));
   }
   if (spec.type == OptionType::numbers) {
     const auto& list = std::get<std::vector<double>>(value);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
@@ -338,9 +339,10 @@ void check_simple(const Curve& curve, const std::string& what, int samples) {
   check_simple_polyline(p, 1e-12 * size, what);
 }
 
-void check_inside_box(const Curve& curve, const Box2& box, double margin, const std::string& what, int samples) {
+BoxClearance box_clearance(const Curve& curve, const Box2& box, const std::string& what, int samples) {
   std::vector<double> t = curve.corners();
   for (int k = 0; k < samples; ++k) t.push_back(two_pi * k / samples);
+  BoxClearance least{std::numeric_limits<double>::infinity(), {}};
   for (double s : t) {
     const Point2 p = curve.position(s);
     if (!std::isfinite(p.x) || !std::isfinite(p.y)) {
@@ -348,13 +350,19 @@ void check_inside_box(const Curve& curve, const Box2& box, double margin, const 
       msg << what << ": the curve is not finite at t = " << s;
       throw std::invalid_argument(msg.str());
     }
-    if (p.x - box.lower.x < margin || box.upper.x - p.x < margin || p.y - box.lower.y < margin ||
-        box.upper.y - p.y < margin) {
-      std::ostringstream msg;
-      msg << what << ": the curve comes within " << margin << " of the box boundary (or leaves it) at (" << p.x << ", "
-          << p.y << ")";
-      throw std::invalid_argument(msg.str());
-    }
+    const double d = std::min({p.x - box.lower.x, box.upper.x - p.x, p.y - box.lower.y, box.upper.y - p.y});
+    if (d < least.distance) least = {d, p};
+  }
+  return least;
+}
+
+void check_inside_box(const Curve& curve, const Box2& box, double margin, const std::string& what, int samples) {
+  const BoxClearance c = box_clearance(curve, box, what, samples);
+  if (c.distance < margin) {
+    std::ostringstream msg;
+    msg << what << ": the curve comes within " << c.distance << " of the box boundary (or leaves it) at (" << c.at.x
+        << ", " << c.at.y << ")";
+    throw std::invalid_argument(msg.str());
   }
 }
 

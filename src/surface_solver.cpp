@@ -17,6 +17,7 @@
 #include "fictus/q1_element.hpp"
 #include "fictus/quadrature.hpp"
 #include "fictus/schur_complement.hpp"
+#include "fictus/spacing_rule.hpp"
 #include "fictus/surface_kink.hpp"
 #include "fictus/trace_operators.hpp"
 #include "solve_steps.hpp"
@@ -495,14 +496,17 @@ std::string format(const char* pattern, double a, double b = 0, double c = 0) {
 void check_inside_box(const Surface& gamma, const Grid3& grid, double grow, const std::string& field) {
   const Box3 bounds = gamma.bounds();
   const double margin = 2 * grid.h();
-  for (int d = 0; d < 3; ++d)
-    if (!(bounds.lower[d] - grow - grid.box().lower[d] >= margin &&
-          grid.box().upper[d] - bounds.upper[d] - grow >= margin))
-      throw std::invalid_argument(
-          field + ": " + (grow > 0 ? "the offset surface" : "the surface") +
-          format(" comes within %.3g of the box along axis %.0f (need 2h = %.3g)",
-                 std::min(bounds.lower[d] - grow - grid.box().lower[d], grid.box().upper[d] - bounds.upper[d] - grow),
-                 double(d), margin));
+  for (int d = 0; d < 3; ++d) {
+    const double room =
+        std::min(bounds.lower[d] - grow - grid.box().lower[d], grid.box().upper[d] - bounds.upper[d] - grow);
+    if (room >= margin) continue;
+    std::string text = field + ": " + (grow > 0 ? "the offset surface" : "the surface") +
+                       format(" comes within %.3g of the box along axis %.0f; the grid needs 2h = %.3g there", room,
+                              double(d), margin);
+    if (room > 0 && grow == 0)
+      text += format(": N >= %.0f (or a larger box)", std::ceil(2 * grid.box().width(0) / room - 1e-9));
+    throw std::invalid_argument(text);
+  }
 }
 
 /// The triangles of `surface` moved by δ along the surface's unit normal at each vertex.
@@ -518,13 +522,13 @@ std::vector<Triangle3> offset_triangles(const std::vector<Triangle3>& triangles,
 }
 
 /// The nested start's coarse solve: `problem` on the grid of N/2 (m/4 points when m is given; Γ at the
-/// same distance δ from γ; no error integrals), its points and active set in `points` and `active`, or
-/// `skipped` set to why not: the coarse grid checks the box's margin (2h), the surface's reach and
-/// δ ≥ 4h with its own h, and may refuse what this grid takes. Its steps are reported through
-/// `execution` as "N/2 <step>"; an interrupt asked there ends this solve too.
-void solve_coarse(const SurfaceProblem& problem, const SolverOptions& options, const Execution& execution,
-                  const std::function<bool()>& interrupt, SurfaceSolution::NestedStart& report,
-                  std::vector<Point3>& points, ActiveSet& active) {
+/// same distance δ from γ, `offset` being this grid's δ/s; no error integrals), its points and active set in `points`
+/// and `active`, or `skipped` set to why not: the coarse grid checks the box's margin (2h), the surface's reach and δ ≥
+/// 4h with its own h, and may refuse what this grid takes. Its steps are reported through `execution` as "N/2 <step>";
+/// an interrupt asked there ends this solve too.
+void solve_coarse(const SurfaceProblem& problem, const SolverOptions& options, double offset,
+                  const Execution& execution, const std::function<bool()>& interrupt,
+                  SurfaceSolution::NestedStart& report, std::vector<Point3>& points, ActiveSet& active) {
   if (problem.N % 2 != 0) {
     report.skipped = "N is odd";
     return;
@@ -541,8 +545,8 @@ void solve_coarse(const SurfaceProblem& problem, const SolverOptions& options, c
   SolverOptions coarse_options = options;
   if (options.multipliers > 0)
     coarse_options.multipliers = std::max(minimum_multipliers, int(std::lround(options.multipliers / 4.0)));
-  coarse_options.offset = options.offset / 2;  // δ = offset·s, and s doubles
-  bool stop_asked = false;  // a data callback may turn an interrupt into invalid_argument (Python's Ctrl-C)
+  coarse_options.offset = offset / 2;  // δ = offset·s, and s doubles
+  bool stop_asked = false;             // a data callback may turn an interrupt into invalid_argument (Python's Ctrl-C)
   const auto check = [&interrupt, &stop_asked] { return stop_asked = stop_asked || (interrupt && interrupt()); };
   try {
     const auto progress = [&execution](const std::string& phase, double seconds) {
@@ -594,6 +598,7 @@ ActiveSet nearest_flags(const std::vector<Point3>& from, const ActiveSet& flags,
 SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
                       std::function<void(const std::string&, double)> progress, std::function<bool()> interrupt) {
   options.validate();
+  options.variant = resolved_variant(options.variant, true);  // surfaces have a continuous normal
   Execution execution(options.threads);
   execution.set_progress(std::move(progress));
   execution.set_interrupt_check(interrupt);  // a copy: the nested start's coarse solve asks it too
@@ -606,16 +611,32 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   const double h = grid.h();
   SurfaceSolution sol(grid);
   detail::PhaseClock clock(sol.timings, execution);
-  Eigen::setNbThreads(options.threads);
+  Eigen::setNbThreads(execution.threads());
 
   check_inside_box(gamma, grid, 0, "geometry");  // before any work
+  const double area = gamma.area();
+  const Box3 bounds = gamma.bounds();
+  const Box3& box = grid.box();
+  const OffsetRoom room = [&gamma, bounds, box](double k) {  // Γ keeps 2h from the box and does not fold
+    double room = gamma.reach() - 2 * k;
+    for (int d = 0; d < 3; ++d)
+      room = std::min({room, bounds.lower[d] - box.lower[d] - 2 * k, box.upper[d] - bounds.upper[d] - 2 * k});
+    return room;
+  };
+  const SpacingPlan plan =
+      plan_spacing({3, area, h, box.width(0),
+                    [area, &options](double k) { return default_patches(area, k, options.variant); }, room},
+                   options);
+  const int m = plan.m;
+  if (!plan.warning.empty()) sol.warnings.push_back(plan.warning);
+  execution.throw_if_interrupted();
 
   // Nested start: the same problem on the grid of N/2 first (before this grid's arrays exist).
   std::vector<Point3> coarse_points;
   ActiveSet coarse_active;
   if (options.nested_start > 0 && problem.N >= options.nested_start) {
     sol.nested_start.emplace();
-    solve_coarse(problem, options, execution, interrupt, *sol.nested_start, coarse_points, coarse_active);
+    solve_coarse(problem, options, plan.offset, execution, interrupt, *sol.nested_start, coarse_points, coarse_active);
     clock.mark("nested_start");
     sol.nested_start->seconds = sol.timings.phases.back().second;
     execution.throw_if_interrupted();
@@ -643,33 +664,12 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
   clock.mark("u0");
   execution.throw_if_interrupted();
 
-  // 1. Geometry: the patches of γ, δ and Γ.
-  const double area = gamma.area();
-  const int m = options.multipliers > 0 ? options.multipliers : default_patches(area, h, options.variant);
-  if (m < minimum_multipliers)
-    throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) +
-                                " is too small (need m >= " + std::to_string(minimum_multipliers) + ")");
-  const double spacing = std::sqrt(area / m);
-  if (spacing < 2 * h)
-    throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) +
-                                format(" gives patches of side %.3g < 2h = %.3g (use m <= %.0f)", spacing, 2 * h,
-                                       std::floor(area / (4 * h * h))));
+  // 1. Geometry: the patches of γ, δ and Γ (m and δ planned above).
   sol.gamma = gamma.patches(m, h);
   execution.throw_if_interrupted();
   sol.Gamma = sol.gamma;
   if (options.variant == Variant::smooth) {
-    sol.delta = options.offset * spacing;
-    if (options.normal_derivative == NormalDerivative::reconstructed && sol.delta < 4 * h)
-      throw std::invalid_argument(
-          format("formulation.offset: Γ at δ = offset·s = %.2f h is within reach of the C_γ "
-                 "stencil (need δ >= 4h: a larger offset or a smaller m)",
-                 sol.delta / h));
-    if (sol.delta > gamma.reach() - 2 * h)
-      throw std::invalid_argument(
-          format("formulation.offset: the offset surface at δ = %.3g would come within 2h of "
-                 "touching itself (the surface allows offsets up to %.3g): a larger N or a "
-                 "smaller formulation.offset",
-                 sol.delta, gamma.reach()));
+    sol.delta = plan.delta;
     check_inside_box(gamma, grid, sol.delta, "formulation.offset");
     sol.Gamma.triangles = offset_triangles(sol.gamma.triangles, gamma, sol.delta);
     for (int p = 0; p < m; ++p) sol.Gamma.point[p] = sol.gamma.point[p] + sol.delta * sol.gamma.normal[p];
@@ -875,7 +875,9 @@ SurfaceSolution solve(const SurfaceProblem& problem, SolverOptions options,
     clock.mark("errors");
   }
   sol.options = options;
+  sol.options.threads = execution.threads();
   sol.options.multipliers = m;
+  sol.options.offset = plan.offset;
   return sol;
 }
 

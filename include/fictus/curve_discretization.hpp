@@ -8,15 +8,15 @@
 #include "fictus/collocation.hpp"
 #include "fictus/curve_grid_intersection.hpp"
 #include "fictus/kink_correction.hpp"
+#include "fictus/spacing_rule.hpp"
 
 namespace fictus {
 
 class CurveDiscretization final : public BoundaryDiscretization {
  public:
   /// Steps 1–2 of the solve for curve γ on `grid` (c: the reaction coefficient the kink rows use):
-  ///   1. geometry: γ checked (counter-clockwise, simple, 2h inside the box), m from the default rule
-  ///      when options.multipliers = 0 and checked (8 ≤ m ≤ L/(2h)), the collocation points, δ and Γ
-  ///      (smooth variant: simple, inside the box, ≥ 4h from γ with reconstructed traces);
+  ///   1. geometry: γ checked (counter-clockwise, simple, 2h inside the box), m and δ by the rules of
+  ///      spacing_rule.hpp, the collocation points and Γ (smooth variant: simple, 2h inside the box);
   ///   2. trace rows: B_γ, C_γ, B_Γ, and the kink correction's rows and direct terms.
   /// Throws std::invalid_argument naming the option or "geometry" on bad input.
   CurveDiscretization(std::shared_ptr<const Curve> gamma, const Grid2& grid, const SolverOptions& options, double c,
@@ -40,6 +40,8 @@ class CurveDiscretization final : public BoundaryDiscretization {
   const std::shared_ptr<const Curve>& gamma() const { return gamma_; }
   const std::shared_ptr<const Curve>& Gamma() const { return Gamma_; }
   double delta() const { return delta_; }
+  /// m, s and δ as planned (spacing_rule.hpp), with the warning when the default rule was changed.
+  const SpacingPlan& spacing() const { return spacing_; }
 
  private:
   void make_geometry(const Grid2& grid, SolverOptions options);
@@ -48,6 +50,7 @@ class CurveDiscretization final : public BoundaryDiscretization {
   std::shared_ptr<const Curve> gamma_, Gamma_;
   Collocation collocation_;
   double delta_ = 0;
+  SpacingPlan spacing_;
   std::unique_ptr<CurveGridIntersection> gamma_geometry_, Gamma_geometry_;
   SparseRows B_gamma_, C_gamma_, B_Gamma_, loads_;
   DirectTerms direct_;

@@ -12,11 +12,15 @@ struct Interrupted : std::runtime_error {
   Interrupted() : std::runtime_error("interrupted") {}
 };
 
+/// The threads a solve uses when solver.threads is 0: OMP_NUM_THREADS when it is set to a positive
+/// number (its first entry), else the hardware threads (at least 1).
+int default_threads();
+
 class Execution {
  public:
-  /// threads ≥ 1 (the options' rule, options.hpp, caps it further).
-  explicit Execution(int threads = 1) : threads_(threads) {
-    if (threads < 1) throw std::invalid_argument("solver.threads: must be >= 1, got " + std::to_string(threads));
+  /// threads ≥ 1, or 0 for default_threads() (the options' rule, options.hpp, caps it further).
+  explicit Execution(int threads = 1) : threads_(threads == 0 ? default_threads() : threads) {
+    if (threads < 0) throw std::invalid_argument("solver.threads: must be >= 0, got " + std::to_string(threads));
   }
   int threads() const { return threads_; }
 

@@ -1,11 +1,13 @@
 #pragma once
 // The whole method, as the steps of FictitiousDomainSolver::solve (docs/math.md):
-//   once per solver (grid, boundary conditions, c, f):
-//     0. load and u₀ = A⁻¹f; the Green's table T on the first explicit Schur complement;
-//   once per curve and the options that shape its rows (reused while they stay):
-//     1. geometry: γ checked, m, collocation points, δ and Γ;
+//   once per curve and the options that shape its rows (reused while they stay), first, so that bad
+//   input is refused before any grid-sized work:
+//     1. geometry: γ checked, m and δ (spacing_rule.hpp), collocation points and Γ;
 //     2. trace rows: B_γ, C_γ, B_Γ (and the kink correction);
-//     3. Schur blocks: S_B, S_C (explicit from T, or implicit with GMRES);
+//     3. Schur blocks: S_B, S_C (explicit from the Green's table T, made on the first of them, or
+//        implicit with GMRES);
+//   once per solver (grid, boundary conditions, c, f):
+//     0. load and u₀ = A⁻¹f (then B_γu₀, C_γu₀);
 //   every solve:
 //     4. obstacle g at the points;
 //     5. semismooth Newton on λ;
@@ -39,11 +41,12 @@ struct SignoriniCheck {
 /// The Signorini conditions once more with a normal derivative D_γ û from another stencil than the
 /// solve's C_γ (docs/math.md, "Checks"): where C_γ is wrong, D_γ û − C_γ û shows it.
 struct IndependentCheck {
-  std::string rule;                  // the stencil of D_γ
-  double min_normal_derivative = 0;  // min_i (D_γ û)_i
-  double max_complementarity = 0;    // max_i |(D_γ û)_i (B_γ û − g)_i|
-  double max_difference = 0;         // max_i |D_γ û − C_γ û|_i
-  double rms_difference = 0;         // root mean square of the same
+  std::string rule;                       // the stencil of D_γ
+  double min_normal_derivative = 0;       // min_i (D_γ û)_i
+  double max_complementarity = 0;         // max_i |(D_γ û)_i (B_γ û − g)_i|
+  double max_difference = 0;              // max_i |D_γ û − C_γ û|_i
+  double rms_difference = 0;              // root mean square of the same
+  std::vector<double> normal_derivative;  // (D_γ û)_i at every point
 };
 
 /// Errors at the collocation points against an exact solution.
@@ -61,7 +64,8 @@ struct Timings {
 struct Solution {
   explicit Solution(const Grid2& g) : grid(g) {}
   Grid2 grid;
-  SolverOptions options;               // in effect (m resolved)
+  SolverOptions options;               // in effect (m and the offset resolved)
+  std::vector<std::string> warnings;   // what the solve changed to fit (one line each), for the user
   GridVector u;                        // û at the unknowns (empty when the field was not asked for)
   Collocation collocation;             // points on γ
   std::shared_ptr<const Curve> Gamma;  // the curve carrying λ (γ itself in the non-smooth variant)

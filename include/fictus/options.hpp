@@ -61,6 +61,11 @@ void validate_options(const Problem& problem, const SolverOptions& options);
 /// The largest `threads` accepted: 4 × the hardware threads (at least 4).
 int max_threads();
 
+/// " (did you mean \"radius\"?)" for the candidate nearest to `name` (edit distance with
+/// transpositions, letter case ignored) when it is at most max(1, |name|/3) edits away; else "".
+/// Every message about an unknown name (key, section, flag, choice, variable) ends with it.
+std::string did_you_mean(std::string_view name, const std::vector<std::string>& candidates);
+
 /// The options table in Markdown (section, key, default, rule, meaning), as in docs/problem_files.md.
 std::string options_markdown();
 

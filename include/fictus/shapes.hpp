@@ -105,6 +105,14 @@ void check_simple(const Curve& curve, const std::string& what, int samples = 409
 /// check_simple() of the closed polygon through `vertices` (the closing edge implied).
 void check_simple_polygon(const std::vector<Point2>& vertices, const std::string& what);
 
+/// The least distance from the curve (samples equally spaced in t, and its corners) to ∂box,
+/// negative where it leaves the box, and where; throws "<what>: the curve is not finite …".
+struct BoxClearance {
+  double distance;
+  Point2 at;
+};
+BoxClearance box_clearance(const Curve& curve, const Box2& box, const std::string& what, int samples = 4096);
+
 /// Throws std::invalid_argument("<what>: …") if the curve comes closer than `margin` to ∂box.
 void check_inside_box(const Curve& curve, const Box2& box, double margin, const std::string& what, int samples = 4096);
 

@@ -3,7 +3,8 @@
 // their values obey, their meaning and their names in files, flags and results: options.hpp).
 namespace fictus {
 
-enum class Variant { nonsmooth, smooth };
+/// automatic: smooth where γ has a continuous normal, nonsmooth where it has corners (a polygon).
+enum class Variant { nonsmooth, smooth, automatic };
 enum class InnerSolver { green, krylov };
 /// How the traces B_γ u and C_γ u are taken (docs/math.md, "Trace matrices"):
 ///   reconstructed  consistent at x_i: smooth variant, the gradient of the biquadratic interpolant
@@ -12,13 +13,17 @@ enum class InnerSolver { green, krylov };
 enum class NormalDerivative { reconstructed, shifted };
 
 const char* to_string(Variant v);
+/// The variant a solve uses: `v`, or for automatic the one the boundary allows.
+inline Variant resolved_variant(Variant v, bool smooth_boundary) {
+  return v != Variant::automatic ? v : smooth_boundary ? Variant::smooth : Variant::nonsmooth;
+}
 const char* to_string(InnerSolver s);
 const char* to_string(NormalDerivative d);
 
 struct SolverOptions {
-  Variant variant = Variant::smooth;
+  Variant variant = Variant::automatic;
   int multipliers = 0;  // m; 0: default_multipliers()
-  double offset = 1.5;  // smooth variant: δ = offset · s, s = L/m (spacing of the points)
+  double offset = 0;    // smooth variant: δ = offset · s (s: the spacing of the points); 0: the default rule
   double rho = 1.0;     // ρ > 0
   NormalDerivative normal_derivative = NormalDerivative::reconstructed;
   double normal_shift = 1.0;     // shifted rule only: C_γ taken at x_i − normal_shift·h·n_i
@@ -34,8 +39,8 @@ struct SolverOptions {
   bool far_field = true;         // 3-D green: interpolate the far pairs of S, then Newton on the exact S from there
   int nested_start = 160;        // 3-D: from this N on, Newton starts from the active set of a solve on the N/2 grid
   bool condition_number = true;  // of the final Newton matrix (2-D green path only)
-  int threads = 1;
-  double max_memory = 0;  // GiB a solve may use; 0: the memory available when it starts
+  int threads = 0;               // 0: the machine's (default_threads(), execution.hpp)
+  double max_memory = 0;         // GiB a solve may use; 0: the memory available when it starts
 
   /// Throws std::invalid_argument naming the option when a value breaks its rule (options.hpp).
   void validate() const;

@@ -151,11 +151,12 @@ int default_patches(double area, double h, Variant variant);
 struct SurfaceSolution {
   explicit SurfaceSolution(const Grid3& g) : grid(g) {}
   Grid3 grid;
-  SolverOptions options;  // in effect (m resolved)
-  GridVector u;           // û at the unknowns
-  PatchedSurface gamma;   // γ's patches: points, normals, areas
-  PatchedSurface Gamma;   // the surface carrying λ (γ itself in the non-smooth variant)
-  double delta = 0;       // distance of Γ from γ
+  SolverOptions options;              // in effect (m and the offset resolved)
+  std::vector<std::string> warnings;  // what the solve changed to fit (one line each), for the user
+  GridVector u;                       // û at the unknowns
+  PatchedSurface gamma;               // γ's patches: points, normals, areas
+  PatchedSurface Gamma;               // the surface carrying λ (γ itself in the non-smooth variant)
+  double delta = 0;                   // distance of Γ from γ
   std::vector<double> lambda, g, trace, normal_derivative;  // per patch
   double lambda_total = 0;
   double alpha = 0;

@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "fictus/options.hpp"
+
 namespace fictus {
 
 struct Expression::Shared {
@@ -103,9 +105,16 @@ Expression::Expression(std::string text, std::vector<std::string> variables, std
     auto c = compile(shared->text, shared->variables, shared->constants);
     c->parser.Eval();  // reports syntax errors
     const std::string unknown = unassigned_local(shared->text, c->local_names).substr(0, 40);
-    if (!unknown.empty())
+    if (!unknown.empty()) {
+      std::vector<std::string> known = shared->variables;  // the variables, parameters, constants and functions
+      for (const auto& [name, value] : shared->constants) known.push_back(name);
+      for (const auto& [name, value] : c->parser.GetConst()) known.push_back(name);
+      for (const auto& [name, value] : c->parser.GetFunDef()) known.push_back(name);
+      std::string hint = did_you_mean(unknown, known);
+      if (hint.empty()) hint = " (a local name must be assigned first: \"" + unknown + " = …, …\")";
       throw std::invalid_argument(shared->key + ": cannot parse \"" + shown(shared->text) + "\": unknown variable \"" +
-                                  unknown + "\" (a local name must be assigned first: \"" + unknown + " = …, …\")");
+                                  unknown + "\"" + hint);
+    }
   } catch (const mu::Parser::exception_type& e) {
     for (const auto& [name, value] : shared->constants) {  // "a = …" where a is a parameter
       const std::size_t at = find_word(shared->text, name);

@@ -34,6 +34,18 @@ class TableReader {
   TableReader(const toml::table* table, std::string name) : table_(table), name_(std::move(name)) {}
 
   bool has(const std::string& key) const { return table_ && table_->contains(key); }
+  /// Throws unless the table has `k`: "<table>.<k>: missing", or, when a key not read yet is a
+  /// near spelling of it, "<table>.<that key>: unknown key (did you mean "<k>"?)".
+  void require(const std::string& k) const {
+    if (has(k)) return;
+    if (table_)
+      for (const auto& [name, value] : *table_) {
+        const std::string given(name.str());
+        if (used_.count(given)) continue;
+        if (const std::string hint = did_you_mean(given, {k}); !hint.empty()) fail(key(given), "unknown key" + hint);
+      }
+    fail(key(k), "missing");
+  }
   std::string key(const std::string& k) const { return name_ + "." + k; }
 
   double number(const std::string& k, double fallback) {
@@ -52,7 +64,7 @@ class TableReader {
     return *n->value<std::string>();
   }
   std::string required_string(const std::string& k) {
-    if (!has(k)) fail(key(k), "missing");
+    require(k);
     return string(k, "");
   }
   std::vector<double> numbers(const std::string& k, std::size_t size, std::vector<double> fallback) {
@@ -70,7 +82,7 @@ class TableReader {
     return out;
   }
   std::vector<double> required_numbers(const std::string& k, std::size_t size) {
-    if (!has(k)) fail(key(k), "missing");
+    require(k);
     return numbers(k, size, {});
   }
   const toml::array* array(const std::string& k) {
@@ -89,7 +101,9 @@ class TableReader {
   void finish() const {
     if (!table_) return;
     for (const auto& [k, v] : *table_)
-      if (!used_.count(std::string(k.str()))) fail(key(std::string(k.str())), "unknown key");
+      if (!used_.count(std::string(k.str())))
+        fail(key(std::string(k.str())),
+             "unknown key" + did_you_mean(k.str(), std::vector<std::string>(used_.begin(), used_.end())));
   }
 
  private:
@@ -201,13 +215,13 @@ std::shared_ptr<const Curve> read_geometry(TableReader& g, const ExpressionMaker
     curve = std::make_shared<Ellipse>(Point2{c[0], c[1]}, ab[0], ab[1], g.number("angle", 0.0));
   } else if (shape == "circle") {
     const auto c = g.required_numbers("center", 2);
-    if (!g.has("radius")) fail("geometry.radius", "missing");
+    g.require("radius");
     const double r = g.number("radius", 0.0);
     if (!(r > 0)) fail("geometry.radius", "must be positive");
     curve = std::make_shared<Ellipse>(Point2{c[0], c[1]}, r, r, 0.0);
   } else if (shape == "polygon") {
     const toml::array* list = g.array("vertices");
-    if (!list) fail("geometry.vertices", "missing");
+    if (!list) g.require("vertices");
     std::vector<Point2> vertices;
     for (const toml::node& v : *list) {
       const toml::array* xy = v.as_array();
@@ -284,7 +298,8 @@ SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std
     const std::string name(k.str());
     if (name != "domain" && name != "geometry" && name != "formulation" && name != "data" && name != "solver" &&
         name != "output")
-      fail(name, "unknown section of a 3-D problem (domain, geometry, formulation, data, solver, output)");
+      fail(name, "unknown section of a 3-D problem (domain, geometry, formulation, data, solver, output)" +
+                     did_you_mean(name, {"domain", "geometry", "formulation", "data", "solver", "output"}));
   }
   SurfaceProblemSpec spec;
   SurfaceProblem& p = spec.problem;
@@ -347,13 +362,13 @@ SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std
   Point3 axes;
   if (!centered) {
   } else if (shape == "torus") {
-    if (!geometry.has("major_radius")) fail("geometry.major_radius", "missing");
-    if (!geometry.has("minor_radius")) fail("geometry.minor_radius", "missing");
+    geometry.require("major_radius");
+    geometry.require("minor_radius");
     const double R = geometry.number("major_radius", 0.0), r = geometry.number("minor_radius", 0.0);
     if (!(r > 0 && R > r)) fail("geometry.minor_radius", "need 0 < minor_radius < major_radius");
     p.gamma = std::make_shared<Torus>(Point3{center[0], center[1], center[2]}, R, r);
   } else if (shape == "sphere") {
-    if (!geometry.has("radius")) fail("geometry.radius", "missing");
+    geometry.require("radius");
     const double r = geometry.number("radius", 0.0);
     if (!(r > 0)) fail("geometry.radius", "must be positive");
     axes = {r, r, r};
@@ -427,7 +442,9 @@ ProblemSpec parse_problem_text(const std::string& text, const std::string& sourc
     const std::string name(k.str());
     if (name != "domain" && name != "geometry" && name != "formulation" && name != "data" && name != "solver" &&
         name != "output" && name != "parameters")
-      fail(name, "unknown section (domain, geometry, formulation, data, solver, output, parameters)");
+      fail(name,
+           "unknown section (domain, geometry, formulation, data, solver, output, parameters)" +
+               did_you_mean(name, {"domain", "geometry", "formulation", "data", "solver", "output", "parameters"}));
   }
   ProblemSpec spec;
   spec.parameters = read_parameters(subtable(root, "parameters"), parameters);

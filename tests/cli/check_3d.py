@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """A 3-D solve's output folder: results.json (dim 3, converged, errors under the bounds, the Signorini
 conditions at round-off), points.csv (one row per patch, its columns), and the ParaView files read back
-by VTK's own readers (solution.vti: (N+1)³ nodes with u, inside, u_exact, error; surface.vtp: the
-triangles of γ and Γ with per-patch cell data).
+by VTK's own readers (solution.vti: (N+1)³ nodes with u, inside, u_exact, error; surface.vtp: γ's
+triangles with shared points, per-patch cell data and point data; offset_surface.vtp: Γ with λ in the
+smooth variant; solution.vtm naming them).
 
 usage: check_3d.py FOLDER MAX_REL_L2_OMEGA MAX_REL_L2_GAMMA
 """
@@ -11,7 +12,8 @@ import json
 import os
 import sys
 
-from vtkmodules.vtkIOXML import vtkXMLImageDataReader, vtkXMLPolyDataReader
+from vtkmodules.vtkFiltersCore import vtkCleanPolyData
+from vtkmodules.vtkIOXML import vtkXMLImageDataReader, vtkXMLMultiBlockDataReader, vtkXMLPolyDataReader
 from vtkmodules.util.numpy_support import vtk_to_numpy
 
 
@@ -54,6 +56,38 @@ def main():
     patch, contact = vtk_to_numpy(cells.GetArray("patch")), vtk_to_numpy(cells.GetArray("contact"))
     assert surface.GetNumberOfCells() == len(patch) > m, surface.GetNumberOfCells()
     assert patch.max() == m - 1 and set(contact.tolist()) <= {0, 1}
+    # points shared: VTK's own cleaning (exact duplicates) finds none left
+    clean = vtkCleanPolyData()
+    clean.SetInputData(surface)
+    clean.SetTolerance(0.0)
+    clean.PointMergingOn()
+    clean.Update()
+    assert clean.GetOutput().GetNumberOfPoints() == surface.GetNumberOfPoints() < surface.GetNumberOfCells(), (
+        clean.GetOutput().GetNumberOfPoints(), surface.GetNumberOfPoints())
+    # point data beside the cell data: the means at the points lie within the patches' range
+    points = surface.GetPointData()
+    for name in ("u", "g", "dudn", "gap", "contact"):
+        at_points, per_cell = vtk_to_numpy(points.GetArray(name)), vtk_to_numpy(cells.GetArray(name))
+        assert len(at_points) == surface.GetNumberOfPoints(), name
+        assert per_cell.min() - 1e-12 <= at_points.min() and at_points.max() <= per_cell.max() + 1e-12, name
+    gap = vtk_to_numpy(cells.GetArray("gap"))
+    assert abs(gap - (vtk_to_numpy(cells.GetArray("u")) - vtk_to_numpy(cells.GetArray("g")))).max() < 1e-15
+    smooth = r["surface"]["delta"] > 0
+    assert (cells.GetArray("lambda") is None) == smooth  # λ lives on Γ in the smooth variant
+    if smooth:
+        offset = vtkXMLPolyDataReader()
+        offset.SetFileName(os.path.join(folder, "offset_surface.vtp"))
+        offset.Update()
+        assert offset.GetOutput().GetCellData().GetArray("lambda") is not None
+    multi = vtkXMLMultiBlockDataReader()
+    multi.SetFileName(os.path.join(folder, "solution.vtm"))
+    multi.Update()
+    blocks = multi.GetOutput()
+    names = [blocks.GetMetaData(k).Get(blocks.NAME()) for k in range(blocks.GetNumberOfBlocks())]
+    assert names == ["field", "gamma"] + (["Gamma"] if smooth else []), names
+    with open(os.path.join(folder, "surface.vtp"), "rb") as handle:
+        head = handle.read(4096)
+    assert b'compressor="vtkZLibDataCompressor"' in head and b'format="ascii"' not in head
     print(f"3-D output checked: N = {N}, m = {m}, L2(omega) {e['rel_l2_omega']:.3e}, "
           f"{surface.GetNumberOfCells()} triangles")
 

@@ -1,13 +1,14 @@
 #!/usr/bin/env python3
-"""Reads solution.vti and curves.vtp with VTK's own XML readers (python3-vtk9) and checks sizes and
-values against results.json and points.csv. Usage: check_vtk.py DIR"""
+"""Reads solution.vti, curves.vtp, offset_curve.vtp (smooth variant) and solution.vtm with VTK's own
+XML readers (python3-vtk9) and checks sizes and values against results.json and points.csv, and that
+the files are binary and zlib-compressed. Usage: check_vtk.py DIR"""
 import csv
 import json
 import sys
 
 import numpy as np
 from vtkmodules.util.numpy_support import vtk_to_numpy
-from vtkmodules.vtkIOXML import vtkXMLImageDataReader, vtkXMLPolyDataReader
+from vtkmodules.vtkIOXML import vtkXMLImageDataReader, vtkXMLMultiBlockDataReader, vtkXMLPolyDataReader
 
 
 def main(folder):
@@ -48,12 +49,39 @@ def main(folder):
     reader.Update()
     poly = reader.GetOutput()
     m = results["multipliers"]
-    curves = 2 if results["curve"]["delta"] > 0 else 1
-    assert poly.GetNumberOfPoints() == curves * m and poly.GetNumberOfLines() == curves
-    lam = vtk_to_numpy(poly.GetPointData().GetArray("lambda"))
-    contact = vtk_to_numpy(poly.GetPointData().GetArray("contact"))
-    assert np.allclose(lam[:m], [float(q["lambda"]) for q in points], rtol=1e-14, atol=1e-300)
-    assert int(contact[:m].sum()) == results["newton"]["n_active"]
+    smooth = results["curve"]["delta"] > 0
+    assert poly.GetNumberOfPoints() == m and poly.GetNumberOfLines() == 1  # γ alone
+    data = poly.GetPointData()
+    contact = vtk_to_numpy(data.GetArray("contact"))
+    assert int(contact.sum()) == results["newton"]["n_active"]
+    gap = vtk_to_numpy(data.GetArray("gap"))
+    assert np.allclose(gap, [float(q["u"]) - float(q["g"]) for q in points], rtol=0, atol=1e-15)
+    assert np.allclose(vtk_to_numpy(data.GetArray("dudn")), [float(q["dudn"]) for q in points], rtol=1e-15)
+    lam = [float(q["lambda"]) for q in points]
+    if smooth:  # λ lives on Γ: offset_curve.vtp
+        assert data.GetArray("lambda") is None
+        reader = vtkXMLPolyDataReader()
+        reader.SetFileName(f"{folder}/offset_curve.vtp")
+        reader.Update()
+        offset = reader.GetOutput()
+        assert offset.GetNumberOfPoints() == m and offset.GetNumberOfLines() == 1
+        gx = vtk_to_numpy(offset.GetPoints().GetData())[:, 0]
+        assert np.allclose(gx, [float(q["Gamma_x"]) for q in points], rtol=1e-15)
+        assert np.allclose(vtk_to_numpy(offset.GetPointData().GetArray("lambda")), lam, rtol=1e-14, atol=1e-300)
+    else:
+        assert np.allclose(vtk_to_numpy(data.GetArray("lambda")), lam, rtol=1e-14, atol=1e-300)
+    for name in ("solution.vti", "curves.vtp") + (("offset_curve.vtp",) if smooth else ()):
+        with open(f"{folder}/{name}", "rb") as handle:
+            head = handle.read(2048)
+        assert b'compressor="vtkZLibDataCompressor"' in head and b'format="ascii"' not in head, name
+    # solution.vtm opens the run: the field, γ and (smooth) Γ as blocks
+    multi = vtkXMLMultiBlockDataReader()
+    multi.SetFileName(f"{folder}/solution.vtm")
+    multi.Update()
+    blocks = multi.GetOutput()
+    names = [blocks.GetMetaData(k).Get(blocks.NAME()) for k in range(blocks.GetNumberOfBlocks())]
+    assert names == ["field", "gamma"] + (["Gamma"] if smooth else []), names
+    assert blocks.GetBlock(1).GetNumberOfPoints() == m
     print(f"{folder}: VTK files OK")
 
 

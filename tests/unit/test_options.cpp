@@ -50,12 +50,24 @@ TEST(Options, BadValuesAreRejectedNamingTheKey) {
             std::string::npos);
   EXPECT_NE(text_error("N", "4").find("domain.N: need 8 <= N"), std::string::npos);
   EXPECT_NE(text_error("N", "12x").find("domain.N: expected an integer"), std::string::npos);
-  EXPECT_NE(text_error("threads", "1000000").find("solver.threads: must be in 1"), std::string::npos);
+  EXPECT_NE(text_error("threads", "1000000").find("solver.threads: must be in 0"), std::string::npos);
   EXPECT_NE(text_error("normal_shift", "1e300").find("formulation.normal_shift: must be in [0.0, 8.0]"),
             std::string::npos);
   EXPECT_NE(text_error("rho", "nan").find("formulation.rho"), std::string::npos);
   EXPECT_NE(text_error("c", "-1").find("data.c"), std::string::npos);
-  EXPECT_NE(text_error("box", "0,1,1,0").find("domain.box: need x0 < x1 and y0 < y1"), std::string::npos);
+  // The expected order is said, and what was given.
+  EXPECT_NE(text_error("box", "0,1,1,0").find("domain.box: the box is [x0, x1, y0, y1] (bounds order"),
+            std::string::npos);
+  EXPECT_NE(text_error("box", "0,0,1,1").find("with x0 < x1 and y0 < y1, got [0.0, 0.0, 1.0, 1.0]"), std::string::npos);
+  // Unknown choices and names are answered with the nearest known one.
+  EXPECT_EQ(text_error("variant", "smoth"),
+            "formulation.variant: expected \"automatic\", \"smooth\" or \"nonsmooth\", got \"smoth\" (did you mean "
+            "\"smooth\"?)");
+  EXPECT_EQ(fictus::did_you_mean("raduis", {"center", "radius"}), " (did you mean \"radius\"?)");
+  EXPECT_EQ(fictus::did_you_mean("--n", {"--N", "--m", "--out"}), " (did you mean \"--N\"?)");
+  EXPECT_EQ(fictus::did_you_mean("pi", {"x", "y", "_pi", "_e"}), " (did you mean \"_pi\"?)");
+  EXPECT_EQ(fictus::did_you_mean("threds", {"threads", "rho"}), " (did you mean \"threads\"?)");
+  EXPECT_EQ(fictus::did_you_mean("banana", {"threads", "rho"}), "");
   EXPECT_NE(text_error("box", "0,1,0").find("domain.box: expected an array of 4 numbers"), std::string::npos);
   EXPECT_NE(text_error("condition_number", "maybe").find("solver.condition_number"), std::string::npos);
   // A periodic box needs an even N: a rule across two options.

@@ -112,13 +112,17 @@ TEST(Torus, PatchesQuadratureAndOffsetLimit) {
     const Point3 g = torus.level_gradient(patches.point[p]);
     EXPECT_NEAR(fictus::dot(g, patches.normal[p]) / fictus::norm(g), 1.0, 1e-12);  // outward
   }
-  // Γ may not go round the tube past the axis: the offset is limited by R − r.
+  // Γ may not go round the tube past the axis: the offset is limited by R − r (a given offset
+  // beyond it is refused; the default rule fits itself below it: spacing_rule.hpp).
   fictus::SurfaceProblem p;
   p.N = 64;
   p.gamma = std::make_shared<fictus::Torus>(Point3{0.5, 0.5, 0.5}, 0.25, 0.1);
   p.f = [](double, double, double) { return 1.0; };
   p.g = [](double, double, double) { return 0.0; };
-  EXPECT_EQ(error_of(p, fictus::SolverOptions{}).rfind("formulation.offset: the offset surface at", 0), 0u);
+  fictus::SolverOptions o;
+  o.offset = 1.5;
+  EXPECT_EQ(error_of(p, o).rfind("formulation.offset: Γ at δ = offset·s", 0), 0u) << error_of(p, o);
+  EXPECT_NE(error_of(p, o).find("has no room"), std::string::npos) << error_of(p, o);
   EXPECT_THROW(fictus::Torus({0.5, 0.5, 0.5}, 0.1, 0.2), std::invalid_argument);
 }
 

@@ -1,0 +1,139 @@
+// The rules for m and δ (spacing_rule.hpp): the default rule where it fits, the nearest fitting δ
+// with a warning where it does not, and refusals that name what would fit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <regex>
+#include <stdexcept>
+#include <string>
+
+#include "fictus/collocation.hpp"
+#include "fictus/spacing_rule.hpp"
+
+namespace {
+
+using fictus::SolverOptions;
+using fictus::SpacingInput;
+using fictus::SpacingPlan;
+
+/// A circle of radius r in the unit box: Γ at δ keeps 2h from the box while r + δ <= 0.5 − 2h.
+SpacingInput circle(double r, int N) {
+  const double L = 2 * std::acos(-1.0) * r, h = 1.0 / N;
+  return {2,
+          L,
+          h,
+          1.0,
+          [L](double k) { return fictus::default_multipliers(L, k, 8.0); },
+          [r](double k) { return 0.5 - r - 2 * k; }};
+}
+
+/// A sphere of radius r in the unit box, as a surface.
+SpacingInput sphere(double r, int N) {
+  const double A = 4 * std::acos(-1.0) * r * r, h = 1.0 / N;
+  return {3,
+          A,
+          h,
+          1.0,
+          [A](double k) { return std::max(8, int(std::lround(A / (64 * k * k)))); },
+          [r](double k) { return 0.5 - r - 2 * k; }};
+}
+
+int number_after(const std::string& text, const std::string& words) {
+  std::smatch match;
+  if (!std::regex_search(text, match, std::regex(words + " (\\d+)"))) return -1;
+  return std::stoi(match[1]);
+}
+
+TEST(SpacingRule, TheDefaultRuleWhereItFits) {
+  const SpacingInput in = circle(0.3, 256);
+  const SpacingPlan plan = fictus::plan_spacing(in, SolverOptions{});
+  EXPECT_EQ(plan.m, in.default_m(in.h));
+  EXPECT_DOUBLE_EQ(plan.offset, 1.5);
+  EXPECT_DOUBLE_EQ(plan.delta, 1.5 * in.measure / plan.m);
+  EXPECT_EQ(plan.warning, "");
+}
+
+// A circle of radius 0.3 at N = 64 (the default δ of 12h leaves the box's margin) and a sphere
+// of radius 0.3 at N = 32 … 56: the default rule shrinks to fit, with a warning naming the N from
+// which it fits unchanged; at that N it does, one below it does not.
+TEST(SpacingRule, CoarseGridsRunWithTheNearestFittingOffset) {
+  for (const auto& [make, N] :
+       {std::pair{&circle, 64}, std::pair{&sphere, 32}, std::pair{&sphere, 40}, std::pair{&sphere, 56}}) {
+    const SpacingInput in = make(0.3, N);
+    const SpacingPlan plan = fictus::plan_spacing(in, SolverOptions{});
+    ASSERT_NE(plan.warning, "") << "N = " << N;
+    EXPECT_NE(plan.warning.find("formulation.offset: the default Γ"), std::string::npos) << plan.warning;
+    EXPECT_LE(plan.delta, in.room(in.h) * (1 + 1e-12));
+    EXPECT_GE(plan.delta, 4 * in.h);
+    EXPECT_GE(plan.spacing, 2 * in.h * (1 - 1e-12));
+    EXPECT_GT(plan.m, in.default_m(in.h));     // the points move closer
+    EXPECT_NEAR(plan.offset, 1.5, 1.5 * 0.1);  // δ/s stays near the default's
+    EXPECT_DOUBLE_EQ(plan.offset * plan.spacing, plan.delta);
+    const int keeps = number_after(plan.warning, "N >=");
+    ASSERT_GT(keeps, N) << plan.warning;
+    EXPECT_EQ(fictus::plan_spacing(make(0.3, keeps), SolverOptions{}).warning, "") << "N = " << keeps;
+    EXPECT_NE(fictus::plan_spacing(make(0.3, keeps - 1), SolverOptions{}).warning, "") << "N = " << keeps - 1;
+  }
+}
+
+TEST(SpacingRule, AGivenOffsetThatDoesNotFitNamesTheOffsetsThatDo) {
+  const SpacingInput in = circle(0.3, 64);
+  SolverOptions o;
+  for (double offset : {0.3, 1.5, 3.0}) {  // too near (δ < 4h), too far (beyond the box margin)
+    o.offset = offset;
+    std::string what;
+    try {
+      fictus::plan_spacing(in, o);
+    } catch (const std::invalid_argument& e) {
+      what = e.what();
+    }
+    std::smatch match;
+    ASSERT_TRUE(std::regex_search(what, match, std::regex(R"(offsets in \[([0-9.e+-]+), ([0-9.e+-]+)\] fit)")))
+        << offset << ": " << what;
+    EXPECT_EQ(what.rfind("formulation.offset: ", 0), 0u) << what;
+    const double low = std::stod(match[1]), high = std::stod(match[2]);
+    EXPECT_TRUE(offset < low || offset > high) << what;
+    o.offset = (low + high) / 2;  // the range it names fits
+    EXPECT_NO_THROW(fictus::plan_spacing(in, o)) << what;
+  }
+}
+
+// Nothing fits: the refusal names an N that runs, and N − 1 does not.
+TEST(SpacingRule, NoRoomNamesTheNThatRuns) {
+  for (const auto& make : {&circle, &sphere}) {
+    const SpacingInput in = make(0.3, 16);
+    std::string what;
+    try {
+      fictus::plan_spacing(in, SolverOptions{});
+    } catch (const std::invalid_argument& e) {
+      what = e.what();
+    }
+    EXPECT_EQ(what.rfind("formulation.offset: no room for Γ at N = 16", 0), 0u) << what;
+    const int runs = number_after(what, "N >=");
+    ASSERT_GT(runs, 16) << what;
+    EXPECT_NO_THROW(fictus::plan_spacing(make(0.3, runs), SolverOptions{}));
+    EXPECT_THROW(fictus::plan_spacing(make(0.3, runs - 1), SolverOptions{}), std::invalid_argument);
+  }
+}
+
+TEST(SpacingRule, MultipliersOutsideTheirRangeAreRefused) {
+  const SpacingInput in = circle(0.3, 64);
+  SolverOptions o;
+  o.multipliers = 5;
+  EXPECT_THROW(fictus::plan_spacing(in, o), std::invalid_argument);
+  o.multipliers = 400;
+  try {
+    fictus::plan_spacing(in, o);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("formulation.multipliers: m = 400 is too large", 0), 0u) << what;
+    o.multipliers = number_after(what, "m <=");  // the largest it names fits
+    o.variant = fictus::Variant::nonsmooth;
+    EXPECT_NO_THROW(fictus::plan_spacing(in, o)) << what;
+    ++o.multipliers;
+    EXPECT_THROW(fictus::plan_spacing(in, o), std::invalid_argument) << what;
+  }
+}
+
+}  // namespace
