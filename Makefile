@@ -56,6 +56,7 @@ fuzz: build
 bench: build
 	$(BUILD_DIR)/bench/fictus_bench --out bench/results $(BENCH_ARGS)
 	$(BUILD_DIR)/bench/fictus_bench_3d --out bench/results $(BENCH3D_ARGS)
+	/usr/bin/python3 bench/output_memory.py $(BUILD_DIR)/apps/fictus --out bench/results
 
 # Regenerate the fitted-mesh references (FreeFEM, about an hour on one core) and the manufactured
 # solutions (sympy); both outputs are committed, so neither is needed to build or test.

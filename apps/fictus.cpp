@@ -68,7 +68,9 @@ std::string parse_error_line(const std::string& message, const std::vector<std::
     while (words >> word)
       if (first.empty() && word.size() > 1 && word[0] == '-') first = word;
     if (!first.empty()) return first.substr(0, 60) + ": not expected" + fictus::did_you_mean(first, flags);
-    return "arguments: not expected: " + match[1].str().substr(0, 60);
+    const std::string what = match[1].str();
+    return what.find(' ') == std::string::npos && !what.empty() ? what.substr(0, 60) + ": not expected"
+                                                                : "arguments: not expected: " + what.substr(0, 60);
   }
   if (std::regex_match(message, match, at_most))
     return match[1].str() + ": given " + match[2].str() + " times; it takes one value";

@@ -1,4 +1,4 @@
-// The spacing study behind the default m and δ (docs/math.md, "Number of multipliers and offset"):
+// The spacing study behind the default m and δ (docs/math.md, "Rules for m and δ"):
 // relative L²(ω) errors, least-squares rates over N = 256 … 2048, cond(S) at the finest level and the
 // contact-end error (fitted-mesh references) for s/h = 4, 6, 8, 12, the paper's m ∝ N^0.85, and
 // offsets δ/s = 1, 1.5, 2 (smooth variant), on the manufactured problems and the references.

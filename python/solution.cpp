@@ -147,6 +147,7 @@ void bind_solution(py::module_& m) {
       .def_property_readonly("delta", [](const PySolution& p) { return p.s().delta; })
       .def_property_readonly("condition_number", [](const PySolution& p) { return p.s().condition_number; })
       .def_property_readonly("peak_memory_bytes", [](const PySolution& p) { return p.s().peak_memory_bytes; })
+      .def_property_readonly("warnings", [](const PySolution& p) { return p.s().warnings; })
       .def_property_readonly("timings",
                              [](const PySolution& p) {
                                py::dict d;

@@ -267,6 +267,7 @@ void bind_surface(py::module_& m) {
       .def_property_readonly("multipliers", [](py::object self) { return of(self).gamma.m; })
       .def_property_readonly("delta", [](py::object self) { return of(self).delta; })
       .def_property_readonly("peak_memory_bytes", [](py::object self) { return of(self).peak_memory_bytes; })
+      .def_property_readonly("warnings", [](py::object self) { return of(self).warnings; })
       .def_property_readonly("timings",
                              [](py::object self) {
                                py::dict d;

@@ -352,7 +352,8 @@ std::string did_you_mean(std::string_view name, const std::vector<std::string>& 
   for (const std::string& candidate : candidates) {
     if (candidate.empty() || candidate.size() > a.size() + allowed + 1 || candidate == name) continue;
     const std::size_t d = distance(lower(candidate));
-    if (d < best) best = d, nearest = candidate;
+    // Not one that changes every letter ("g" for "f"): a near spelling keeps some of the name.
+    if (d < best && d < std::min(a.size(), candidate.size())) best = d, nearest = candidate;
   }
   return nearest.empty() ? "" : " (did you mean \"" + nearest + "\"?)";
 }

@@ -72,7 +72,7 @@ SolverOptions paper_options(int N, Variant variant) {
   SolverOptions o;
   o.variant = variant;
   o.multipliers = paper_multipliers(N);
-  o.offset = 1.0;
+  o.offset = paper_row(variant, N) ? 1.0 : 0.0;  // the paper's δ = L/m at its grids, else the default rule
   return o;
 }
 

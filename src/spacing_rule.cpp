@@ -73,7 +73,10 @@ SpacingPlan plan_spacing(const SpacingInput& in, const SolverOptions& options) {
     throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(plan.m) +
                                 format(" is too large for the grid (spacing s = %.3g < 2h = %.3g; use m <= %.0f)",
                                        plan.spacing, 2 * h, double(most)));
-  if (options.variant == Variant::nonsmooth) return plan;
+  if (options.variant == Variant::nonsmooth) {
+    plan.offset = options.offset;  // as given: no Γ to place
+    return plan;
+  }
 
   const auto delta_of = [&](double offset) { return delta_for(in.dim, in.measure, plan.m, offset); };
   const double lower = lowest_delta(options, h), upper = in.room(h);
@@ -121,8 +124,8 @@ SpacingPlan plan_spacing(const SpacingInput& in, const SolverOptions& options) {
       format("formulation.offset: the default Γ (δ = 1.5 s = %.3g h, s = %.3g h) does not fit at N = %.0f; using ",
              wanted / h, wanted_cells, double(N)) +
       format(
-          "δ = %.3g h and m = %.0f (s = %.3g h): nearer and finer than the default rule, less accurate (up to 3x "
-          "larger errors at s = 4h in the spacing study)",
+          "δ = %.3g h and m = %.0f (s = %.3g h): nearer and finer than the default rule, less accurate "
+          "(docs/math.md, \"Rules for m and δ\")",
           plan.delta / h, plan.m, plan.spacing / h) +
       (keeps > 0 ? "; N >= " + std::to_string(keeps) + " keeps the default" : std::string());
   return plan;

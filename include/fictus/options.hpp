@@ -62,7 +62,8 @@ void validate_options(const Problem& problem, const SolverOptions& options);
 int max_threads();
 
 /// " (did you mean \"radius\"?)" for the candidate nearest to `name` (edit distance with
-/// transpositions, letter case ignored) when it is at most max(1, |name|/3) edits away; else "".
+/// transpositions, letter case ignored) when it is at most max(1, |name|/3) edits away and fewer
+/// than the shorter name's letters (so "g" never suggests "f"); else "".
 /// Every message about an unknown name (key, section, flag, choice, variable) ends with it.
 std::string did_you_mean(std::string_view name, const std::vector<std::string>& candidates);
 

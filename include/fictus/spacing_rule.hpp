@@ -32,7 +32,7 @@ double multiplier_spacing(int dim, double measure, int m);
 struct SpacingPlan {
   int m = 0;
   double spacing = 0;   // s
-  double offset = 0;    // δ/s in effect (smooth variant; 0 in the non-smooth one)
+  double offset = 0;    // δ/s in effect (smooth variant; the option as given in the non-smooth one)
   double delta = 0;     // δ (smooth variant; 0 in the non-smooth one)
   std::string warning;  // one line when the default rule was changed to fit, else empty
 };

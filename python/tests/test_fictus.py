@@ -99,6 +99,25 @@ def test_bad_input_raises_with_the_cli_message(config, message):
         fictus.Problem.from_dict(config).solve()
 
 
+def test_new_user_first_tries():
+    # a square: simple, solved with the non-smooth variant without asking, and said so
+    square = {"geometry": {"shape": "polygon", "vertices": [[0.3, 0.3], [0.7, 0.3], [0.7, 0.7], [0.3, 0.7]]},
+              "domain": {"N": 64}, "data": {"f": "10 * (x - 0.5)", "g": "0"}}
+    s = fictus.Problem.from_dict(square).solve()
+    assert s.converged and s.options["variant"] == "nonsmooth"
+    assert any("formulation.variant: γ has corners" in w for w in s.warnings)
+    # a coarse grid: the default offset fits itself, with a warning naming the N that keeps it
+    s = fictus.Problem.from_dict(dict(CIRCLE, domain={"N": 64}, data={"f": "1", "g": "0"})).solve()
+    assert s.converged and any("does not fit at N = 64" in w for w in s.warnings), s.warnings
+    assert s.multipliers > 15  # the default rule gives 15 points; the fitted one brings them closer
+    # a misspelt key names the nearest one
+    with pytest.raises(ValueError, match='geometry.raduis: unknown key \\(did you mean "radius"\\?\\)'):
+        fictus.Problem.from_dict({"geometry": {"shape": "circle", "center": [0.5, 0.5], "raduis": 0.3},
+                                  "data": {"f": "1", "g": "0"}})
+    with pytest.raises(ValueError, match='did you mean "threads"'):
+        fictus.Problem(geometry=CIRCLE["geometry"], f="1", g="0", threds=2)
+
+
 def test_callable_errors_are_reported():
     def broken(x, y):
         raise ZeroDivisionError("boom")
@@ -145,7 +164,7 @@ SMALL = dict(N=64, geometry=dict(shape="circle", center=[0.5, 0.5], radius=0.25)
 
 
 def test_absurd_thread_counts_are_rejected():
-    with pytest.raises(ValueError, match="solver.threads: must be in 1"):
+    with pytest.raises(ValueError, match="solver.threads: must be in 0"):
         fictus.Problem(**SMALL, f="1", g="0", threads=10**6).solve()
 
 

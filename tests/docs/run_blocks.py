@@ -70,9 +70,9 @@ def blocks(path):
     return found, problems
 
 
+# No C++ standard set here: the exported targets must carry it (as a user's project would not set it).
 CONSUMER = """cmake_minimum_required(VERSION 3.20)
 project(doc_block LANGUAGES CXX)
-set(CMAKE_CXX_STANDARD 20)
 find_package(fictus 0.1 REQUIRED)
 add_executable(block main.cpp)
 target_link_libraries(block PRIVATE fictus::fictus fictus::fictus_io)

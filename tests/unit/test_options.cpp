@@ -68,6 +68,7 @@ TEST(Options, BadValuesAreRejectedNamingTheKey) {
   EXPECT_EQ(fictus::did_you_mean("pi", {"x", "y", "_pi", "_e"}), " (did you mean \"_pi\"?)");
   EXPECT_EQ(fictus::did_you_mean("threds", {"threads", "rho"}), " (did you mean \"threads\"?)");
   EXPECT_EQ(fictus::did_you_mean("banana", {"threads", "rho"}), "");
+  EXPECT_EQ(fictus::did_you_mean("g", {"f", "c"}), "");  // one letter for another is no spelling
   EXPECT_NE(text_error("box", "0,1,0").find("domain.box: expected an array of 4 numbers"), std::string::npos);
   EXPECT_NE(text_error("condition_number", "maybe").find("solver.condition_number"), std::string::npos);
   // A periodic box needs an even N: a rule across two options.
