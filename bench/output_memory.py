@@ -3,7 +3,9 @@
 with results.json only and once with every file (solution.vti streamed block by block), the wall time
 and the peak resident memory of each process (wait4's ru_maxrss), in one run.
 
-usage: output_memory.py FICTUS [--N 16384] [--threads 2] [--out bench/results] [--repeats 1]
+usage: output_memory.py FICTUS [--before OLD_FICTUS] [--N 16384] [--threads 2] [--out bench/results]
+                        [--repeats 1]
+With --before, an older build's program runs the same two solves in the same run (its rows first).
 Writes <out>/<date>-output-memory.md with the machine, compiler, threads and commit.
 """
 import argparse
@@ -47,22 +49,27 @@ def machine():
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("fictus")
+    parser.add_argument("--before", help="an older build's fictus, measured in the same run")
     parser.add_argument("--N", type=int, default=16384)
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--repeats", type=int, default=1)
     parser.add_argument("--out", default="bench/results")
     args = parser.parse_args()
     scratch = tempfile.mkdtemp(prefix="fictus-output-memory-")
-    base = [args.fictus, "solve", "--N", str(args.N), "--variant", "smooth", "--threads", str(args.threads),
-            "--quiet", "--out", scratch]
+    programs = ([("before", args.before)] if args.before else []) + [("this build", args.fictus)]
     rows = []
     try:
-        for label, extra in (("results.json only", ["--files", "results.json"]), ("every file", [])):
-            runs = [run(base + extra) for _ in range(args.repeats)]
-            seconds = sorted(r[0] for r in runs)[len(runs) // 2]
-            peak = max(r[1] for r in runs)
-            sizes = sum(os.path.getsize(os.path.join(scratch, f)) for f in os.listdir(scratch))
-            rows.append((label, seconds, peak, sizes))
+        for name, program in programs:
+            base = [program, "solve", "--N", str(args.N), "--variant", "smooth", "--threads", str(args.threads),
+                    "--quiet", "--out", scratch]
+            for label, extra in (("results.json only", ["--files", "results.json"]), ("every file", [])):
+                for f in os.listdir(scratch):
+                    os.remove(os.path.join(scratch, f))
+                runs = [run(base + extra) for _ in range(args.repeats)]
+                seconds = sorted(r[0] for r in runs)[len(runs) // 2]
+                peak = max(r[1] for r in runs)
+                sizes = sum(os.path.getsize(os.path.join(scratch, f)) for f in os.listdir(scratch))
+                rows.append((name, label, seconds, peak, sizes))
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
@@ -73,11 +80,13 @@ def main():
              f"{datetime.date.today().isoformat()}",
              f"- `fictus solve --N {args.N} --variant smooth --threads {args.threads}` (the paper's problem), "
              f"median of {args.repeats} run(s); peak = the process's maximum resident set", "",
-             "| files | time [s] | peak memory [GiB] | written [MiB] |", "|---|---|---|---|"]
-    for label, seconds, peak, size in rows:
-        lines.append(f"| {label} | {seconds:.1f} | {peak / 2**30:.2f} | {size / 2**20:.0f} |")
-    lines += ["", f"The files add {(rows[1][2] - rows[0][2]) / 2**30:.2f} GiB to the peak and "
-              f"{rows[1][1] - rows[0][1]:.1f} s."]
+             "| program | files | time [s] | peak memory [GiB] | written [MiB] |", "|---|---|---|---|---|"]
+    for name, label, seconds, peak, size in rows:
+        lines.append(f"| {name} | {label} | {seconds:.1f} | {peak / 2**30:.2f} | {size / 2**20:.0f} |")
+    lines.append("")
+    for k in range(0, len(rows), 2):
+        lines.append(f"{rows[k][0]}: the files add {(rows[k + 1][3] - rows[k][3]) / 2**30:.2f} GiB to the peak "
+                     f"and {rows[k + 1][2] - rows[k][2]:.1f} s.")
     text = "\n".join(lines) + "\n"
     print(text)
     os.makedirs(args.out, exist_ok=True)
