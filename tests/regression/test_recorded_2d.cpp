@@ -18,6 +18,7 @@
 #include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/io/problem_file.hpp"
 #include "fictus/paper_problem.hpp"
+#include "recorded.hpp"
 
 namespace {
 
@@ -25,18 +26,7 @@ using nlohmann::json;
 const std::string source_dir = FICTUS_SOURCE_DIR;
 const std::string recorded_path = source_dir + "/tests/regression/recorded_2d.json";
 
-/// Σ|v|, Σv², Σ(k+1)|v_k|/n: positive digests that also see a permutation.
-template <class Vector>
-json digest(const Vector& v) {
-  double a = 0, s = 0, w = 0;
-  const double n = double(v.size());
-  for (std::size_t k = 0; k < std::size_t(v.size()); ++k) {
-    a += std::abs(v[k]);
-    s += v[k] * v[k];
-    w += double(k + 1) * std::abs(v[k]) / n;
-  }
-  return json::array({a, s, w});
-}
+using fictus::regression::digest;
 
 json summarize(const fictus::Solution& s) {
   json j;
@@ -109,28 +99,6 @@ std::vector<Case> cases() {
   return list;
 }
 
-/// Every number of `expected` against `actual`, to `tolerance` relative, or 1e-14 absolute: the
-/// round-off of quantities of order one or smaller that are formed by cancellation (the relative error
-/// norms, u_h − u over |u| ≈ 1e-4 … 1e-7, move by ~1e-15 when u_h does; gaps at round-off).
-void compare(const json& expected, const json& actual, const std::string& where, double tolerance) {
-  if (expected.is_number()) {
-    ASSERT_TRUE(actual.is_number()) << where;
-    const double a = expected.get<double>(), b = actual.get<double>();
-    EXPECT_LE(std::abs(a - b), tolerance * std::max(std::abs(a), std::abs(b)) + 1e-14)
-        << where << ": recorded " << a << ", now " << b;
-  } else if (expected.is_array() || expected.is_object()) {
-    ASSERT_EQ(expected.size(), actual.size()) << where;
-    if (expected.is_array())
-      for (std::size_t k = 0; k < expected.size(); ++k)
-        compare(expected[k], actual[k], where + "[" + std::to_string(k) + "]", tolerance);
-    else
-      for (const auto& [key, value] : expected.items()) {
-        ASSERT_TRUE(actual.contains(key)) << where << "." << key;
-        compare(value, actual[key], where + "." + key, tolerance);
-      }
-  }
-}
-
 TEST(Recorded2d, AnswersEqualTheRecordedValues) {
   json now;
   for (const Case& c : cases()) now[c.name] = summarize(c.run());
@@ -142,29 +110,9 @@ TEST(Recorded2d, AnswersEqualTheRecordedValues) {
   ASSERT_TRUE(in) << "cannot read " << recorded_path;
   const json recorded = json::parse(in);
   EXPECT_EQ(recorded.size(), now.size());
-  // Every value to 1e-12 relative, with two refinements that keep the criterion at round-off:
-  //  - the digests' second entry is a sum of squares (twice the relative change of its terms);
-  //  - the independent check's entries are differences of two ∂u/∂n stencils whose operands are
-  //    nodal values over h: compared to 1e-12·max|û|/h, the round-off of such a stencil.
-  constexpr double tolerance = 1e-12;
   for (const auto& [name, values] : recorded.items()) {
     ASSERT_TRUE(now.contains(name)) << name << " is no longer computed";
-    for (const auto& [key, value] : values.items()) {
-      ASSERT_TRUE(now[name].contains(key)) << name << "." << key;
-      const json& actual = now[name][key];
-      if (key == "check") {
-        const double scale = now[name]["stencil_scale"].get<double>();
-        for (std::size_t k = 0; k < value.size(); ++k)
-          EXPECT_LE(std::abs(value[k].get<double>() - actual[k].get<double>()), tolerance * scale)
-              << name << ".check[" << k << "]: recorded " << value[k] << ", now " << actual[k];
-      } else if (value.is_array() && value.size() == 3) {
-        for (std::size_t k = 0; k < 3; ++k)
-          compare(value[k], actual[k], name + "." + key + "[" + std::to_string(k) + "]",
-                  k == 1 ? 2 * tolerance : tolerance);
-      } else {
-        compare(value, actual, name + "." + key, tolerance);
-      }
-    }
+    fictus::regression::compare_recorded(values, now[name], name);
   }
 }
 
