@@ -142,7 +142,7 @@ struct SolveCommand {
 
 /// Progress on stderr, flushed (also when redirected): each step of a long solve as it ends, with
 /// the time since the start and the peak memory so far.
-void print_progress_lines(fictus::FictitiousDomainSolver& solver) {
+void print_progress_lines(fictus::FictitiousDomainSolver<2>& solver) {
   const auto start = std::chrono::steady_clock::now();
   solver.set_progress([start](const std::string& phase, double seconds) {
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -181,19 +181,11 @@ int run_solve_surface(const std::string& text, const SolveCommand& command) {
     spec.output.files = command.files;
   }
   if (!spec.output.dir.empty()) fictus::cli::check_output_folder(spec.output.dir, spec.output.files);
-  // Memory before anything is allocated: u₀, the field, the Green's table and the load (8 bytes a node).
-  const double nodes = std::pow(double(spec.problem.N) + 1, 3);
-  const double needed = 4 * 8 * nodes + (64 << 20);
-  if (spec.options.max_memory > 0 && needed > spec.options.max_memory * double(1 << 30))
-    throw std::invalid_argument("solver.max_memory: N = " + std::to_string(spec.problem.N) + " needs about " +
-                                std::to_string(needed / double(1 << 30)).substr(0, 5) + " GiB, more than the " +
-                                std::to_string(spec.options.max_memory).substr(0, 5) + " GiB allowed");
-  if (needed > 0.9 * double(fictus::available_memory_bytes()))
-    throw std::invalid_argument("domain.N: N = " + std::to_string(spec.problem.N) + " needs about " +
-                                std::to_string(int(needed / (1 << 30) + 1)) + " GiB; less is available");
+  fictus::check_memory(spec.problem, spec.options);  // before anything is allocated
+  const double seconds = fictus::estimated_seconds(spec.problem, spec.options);
   const auto start = std::chrono::steady_clock::now();
   std::function<void(const std::string&, double)> progress;
-  const bool long_run = !command.quiet && nodes > 2e5;  // long runs say what is coming and how it goes
+  const bool long_run = !command.quiet && seconds >= 2;  // long runs say what is coming and how it goes
   if (long_run)
     progress = [start](const std::string& phase, double seconds) {
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -202,7 +194,8 @@ int run_solve_surface(const std::string& text, const SolveCommand& command) {
       std::fflush(stderr);
     };
   if (long_run) {
-    std::fprintf(stderr, "fictus: solving a 3-D problem, N = %d (%.3g M unknowns)\n", spec.problem.N, nodes / 1e6);
+    std::fprintf(stderr, "fictus: solving a 3-D problem, N = %d: estimated %.2g GiB and %.2g s\n", spec.problem.N,
+                 fictus::estimated_peak_bytes(spec.problem, spec.options) / double(1 << 30), seconds);
     std::fflush(stderr);
   }
   fictus::SurfaceSolution s = fictus::solve(spec.problem, spec.options, progress);

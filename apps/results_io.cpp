@@ -322,16 +322,9 @@ json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& s) 
                                {"exact_steps", s.far_field->exact_steps}};
   }
   j["signorini"] = signorini_json(s.signorini);
-  long points = 0;
-  double contact_area = 0, force = 0, min_gap = std::numeric_limits<double>::infinity(), max_gap = -min_gap;
-  for (int p = 0; p < s.gamma.m; ++p) {  // as contact_summary in 2-D, with patch areas for arcs
-    const double gap = s.trace[p] - s.g[p];
-    min_gap = std::min(min_gap, gap), max_gap = std::max(max_gap, gap);
-    if (s.newton.active[p] == 1)
-      ++points, contact_area += s.gamma.area[p], force += s.normal_derivative[p] * s.gamma.area[p];
-  }
-  j["contact"] = {{"points", points},   {"area", contact_area}, {"force", force}, {"lambda_integral", s.lambda_total},
-                  {"min_gap", min_gap}, {"max_gap", max_gap}};
+  const ContactSummary contact = contact_summary(s);
+  j["contact"] = {{"points", contact.points},          {"area", contact.measure},    {"force", contact.force},
+                  {"lambda_integral", contact.lambda}, {"min_gap", contact.min_gap}, {"max_gap", contact.max_gap}};
   if (s.errors) j["errors"] = errors_json(*s.errors, s.point_errors);
   j["timings"] = timings_json(s.timings);
   j["warnings"] = s.warnings;

@@ -16,7 +16,9 @@
 #include <vector>
 
 #include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/surface_solver.hpp"
+#include "fictus/omega_quadrature.hpp"
+#include "fictus/surface.hpp"
+#include "fictus/surface_discretization.hpp"
 
 namespace fictus::cli {
 

@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
 
   // The non-smooth variant stops at N = 256: with patches of 4h its m is 18 530 at N = 512, where the
   // dense Newton matrices (2.7 GB each) and their LUs (about 160 s each) make a 20-minute run
-  // (docs/math.md, the measured table of "The far field of the 3-D Schur complement").
+  // (docs/notes/3d-far-field-and-newton.md, "End to end").
   for (const fictus::Variant variant : {fictus::Variant::smooth, fictus::Variant::nonsmooth}) {
     const bool smooth = variant == fictus::Variant::smooth;
     md << (smooth ? "## End to end, smooth variant, green inner solver\n\n"

@@ -12,11 +12,14 @@
 #include <stdexcept>
 
 #include "bindings.hpp"
+#include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/io/problem_file.hpp"
 #include "fictus/io/process.hpp"
 #include "fictus/mesh_surface.hpp"
+#include "fictus/omega_quadrature.hpp"
 #include "fictus/options.hpp"
-#include "fictus/surface_solver.hpp"
+#include "fictus/surface.hpp"
+#include "fictus/surface_discretization.hpp"
 #include "python_problem.hpp"
 
 namespace py = pybind11;
@@ -132,6 +135,7 @@ struct PySurfaceSolution {
 PySurfaceSolution solve(const PySurfaceProblem& p) {
   const auto errors = std::make_shared<CallbackErrors>();  // this solve's own slot
   const SurfaceProblem problem = p.bound(errors);
+  check_memory(problem, p.spec.options);  // before anything is allocated, as the CLI does
   std::shared_ptr<const SurfaceSolution> solution;
   try {
     // Ctrl-C: Python's handler runs in PyErr_CheckSignals (this thread, under the GIL) and leaves

@@ -1,5 +1,6 @@
 #include "fictus/curve_discretization.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -9,17 +10,18 @@
 #include <string>
 
 #include "fictus/shapes.hpp"
+#include "solve_steps.hpp"
 
 namespace fictus {
 
 CurveDiscretization::CurveDiscretization(std::shared_ptr<const Curve> gamma, const Grid2& grid,
                                          const SolverOptions& options, double c, const Execution& execution)
-    : gamma_(std::move(gamma)) {
+    : execution_(execution), gamma_(std::move(gamma)) {
   if (!gamma_) throw std::invalid_argument("geometry: no curve given");
   SolverOptions resolved = options;
   resolved.variant = resolved_variant(options.variant, gamma_->smooth());
   make_geometry(grid, resolved);
-  make_trace_rows(grid, resolved, c, execution);
+  make_trace_rows(grid, resolved, c);
 }
 
 namespace {
@@ -130,8 +132,7 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
   Gamma_geometry_ = std::make_unique<CurveGridIntersection>(*Gamma_, grid, "formulation.offset");
 }
 
-void CurveDiscretization::make_trace_rows(const Grid2& grid, const SolverOptions& options, double c,
-                                          const Execution& execution) {
+void CurveDiscretization::make_trace_rows(const Grid2& grid, const SolverOptions& options, double c) {
   const Collocation& points = collocation_;
   B_gamma_ = point_value_rows(grid, points.point);
   B_Gamma_ = arc_integral_rows(Gamma_geometry_ ? *Gamma_geometry_ : *gamma_geometry_, points.arc_begin, points.arc_end);
@@ -142,7 +143,7 @@ void CurveDiscretization::make_trace_rows(const Grid2& grid, const SolverOptions
   }
   C_gamma_ = normal_derivative_rows_centered(grid, points.point, points.normal, 2);
   if (options.variant == Variant::nonsmooth) {
-    kink_ = std::make_unique<KinkCorrection>(*gamma_geometry_, collocation_, c, execution);
+    kink_ = std::make_unique<KinkCorrection>(*gamma_geometry_, collocation_, c, execution_);
     loads_ = add_rows(B_Gamma_, kink_->galerkin());
     direct_.trace = kink_->direct(B_gamma_);
     direct_.normal_derivative = kink_->direct(C_gamma_);
@@ -170,11 +171,87 @@ std::optional<std::vector<double>> CurveDiscretization::independent_normal_deriv
   return d;
 }
 
-ErrorNorms CurveDiscretization::errors(const GridVector& u, const ContactData& data, int quadrature,
-                                       const Execution& execution) const {
+namespace {
+
+std::string format_number(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3g", v);
+  return buffer;
+}
+
+std::string format_point(Point2 p) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "(%.6g, %.6g)", p.x, p.y);
+  return buffer;
+}
+
+}  // namespace
+
+std::vector<double> CurveDiscretization::obstacle(const Data& data) const {
+  const int m = n_points();
+  const std::vector<Point2>& p = points();
+  std::vector<double> g(m);
+  if (data.g_vectorized && !data.g_along_curve) {
+    std::vector<double> x(m), y(m);
+    for (int i = 0; i < m; ++i) x[i] = p[i].x, y[i] = p[i].y;
+    data.g_vectorized(m, x.data(), y.data(), g.data());
+  }
+  for (int i = 0; i < m; ++i) {
+    if (data.g_along_curve)
+      g[i] = data.g_along_curve(p[i].x, p[i].y, arc_positions()[i]);
+    else if (!data.g_vectorized)
+      g[i] = data.g(p[i].x, p[i].y);
+    if (!std::isfinite(g[i]))
+      throw std::invalid_argument("data.g: not finite at the collocation point " + format_point(p[i]));
+    if (std::abs(g[i]) > detail::largest_scale)
+      throw std::invalid_argument("data.g: " + format_number(g[i]) + " at " + format_point(p[i]) + " is beyond " +
+                                  format_number(detail::largest_scale) +
+                                  ": rescale the problem (u, f and g by one factor)");
+  }
+  return g;
+}
+
+ErrorNorms CurveDiscretization::errors(const GridVector& u, const std::vector<double>&, const Data& data,
+                                       int quadrature) const {
   if (data.exact_vectorized)
-    return compute_errors(u, *gamma_geometry_, data.exact_vectorized, {}, quadrature, execution);
-  return compute_errors(u, *gamma_geometry_, data.exact, data.exact_gradient, quadrature, execution);
+    return compute_errors(u, *gamma_geometry_, data.exact_vectorized, {}, quadrature, execution_);
+  return compute_errors(u, *gamma_geometry_, data.exact, data.exact_gradient, quadrature, execution_);
+}
+
+PointErrors CurveDiscretization::point_errors(const std::vector<double>& trace,
+                                              const std::vector<double>& normal_derivative, const Data& data) const {
+  const VectorizedField exact = data.exact_vectorized ? data.exact_vectorized : vectorize(data.exact);
+  const std::vector<Point2>& p = points();
+  const std::vector<Point2>& n = normals();
+  const std::size_t m = p.size();
+  std::vector<double> x(m), y(m), values(m);
+  for (std::size_t i = 0; i < m; ++i) x[i] = p[i].x, y[i] = p[i].y;
+  exact(m, x.data(), y.data(), values.data());
+  const Grid2& grid = gamma_geometry_->grid();
+  const double step = 1e-5 * (grid.box().upper.x - grid.box().lower.x);
+  std::vector<double> xs(2 * m), ys(2 * m), inner(2 * m);
+  for (std::size_t i = 0; i < m; ++i)
+    for (int k = 0; k < 2; ++k) {
+      const Point2 q = p[i] - (k + 1) * step * n[i];
+      xs[2 * i + k] = q.x, ys[2 * i + k] = q.y;
+    }
+  if (!data.exact_gradient) exact(2 * m, xs.data(), ys.data(), inner.data());
+  PointErrors pe;
+  for (std::size_t i = 0; i < m; ++i) {
+    if (!std::isfinite(values[i])) throw std::invalid_argument("data.exact: not finite at " + format_point(p[i]));
+    const double dudn = data.exact_gradient ? dot(n[i], data.exact_gradient(x[i], y[i]))
+                                            : (3 * values[i] - 4 * inner[2 * i] + inner[2 * i + 1]) / (2 * step);
+    if (!std::isfinite(dudn))
+      throw std::invalid_argument("data.exact: its normal derivative is not finite near " + format_point(p[i]));
+    pe.max_trace = std::max(pe.max_trace, std::abs(trace[i] - values[i]));
+    pe.max_normal_derivative = std::max(pe.max_normal_derivative, std::abs(normal_derivative[i] - dudn));
+  }
+  return pe;
+}
+
+void CurveDiscretization::describe(SolutionBoundary<2>& out) const {
+  out.collocation = collocation_;
+  out.Gamma = Gamma_;
 }
 
 }  // namespace fictus

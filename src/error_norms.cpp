@@ -4,6 +4,8 @@
 #include <cmath>
 #include <vector>
 
+#include "fictus/curve_grid_intersection.hpp"
+#include "fictus/omega_quadrature.hpp"
 #include "fictus/q1_element.hpp"
 
 namespace fictus {
@@ -133,6 +135,124 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
   n.rel_h1_omega = rel(n.h1_omega, std::sqrt(omega[2] + omega[3]));
   n.rel_l2_gamma = rel(n.l2_gamma, std::sqrt(boundary_norm));
   return n;
+}
+
+namespace {
+
+/// û at the eight nodes of `cell` (local node k as in Q1Element; 0 where a node has no unknown).
+std::array<double, 8> nodal_values(const Grid3& grid, const GridVector& u, const Grid3::Index& cell) {
+  std::array<double, 8> v;
+  for (int k = 0; k < 8; ++k) {
+    const Grid3::Index node{cell[0] + Q1Element<3>::offset(k, 0), cell[1] + Q1Element<3>::offset(k, 1),
+                            cell[2] + Q1Element<3>::offset(k, 2)};
+    v[std::size_t(k)] = grid.has_unknown(node) ? u[grid.index(node)] : 0.0;
+  }
+  return v;
+}
+
+}  // namespace
+
+void gradient_at(const VectorizedField3& u, const GradientField3& gradient, double e,
+                 const std::array<std::vector<double>, 3>& x, std::array<std::vector<double>, 3>& du) {
+  const std::size_t n = x[0].size();
+  for (auto& d : du) d.resize(n);
+  if (gradient) {
+    for (std::size_t k = 0; k < n; ++k) {
+      const Point3 g = gradient(x[0][k], x[1][k], x[2][k]);
+      for (int d = 0; d < 3; ++d) du[d][k] = g[d];
+    }
+    return;
+  }
+  std::vector<double> shifted(n), plus(n), minus(n);
+  for (int axis = 0; axis < 3; ++axis) {
+    const auto at = [&](std::vector<double>& out) {
+      const double* c[3] = {x[0].data(), x[1].data(), x[2].data()};
+      c[axis] = shifted.data();
+      u(n, c[0], c[1], c[2], out.data());
+    };
+    for (std::size_t k = 0; k < n; ++k) shifted[k] = x[axis][k] + e;
+    at(plus);
+    for (std::size_t k = 0; k < n; ++k) shifted[k] = x[axis][k] - e;
+    at(minus);
+    for (std::size_t k = 0; k < n; ++k) du[axis][k] = (plus[k] - minus[k]) / (2 * e);
+  }
+}
+
+std::array<std::vector<double>, 3> coordinates(const std::vector<Point3>& points) {
+  std::array<std::vector<double>, 3> x;
+  for (auto& c : x) c.reserve(points.size());
+  for (const Point3& p : points)
+    for (int d = 0; d < 3; ++d) x[d].push_back(p[d]);
+  return x;
+}
+
+ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,
+                          const std::vector<double>& trace, const ScalarField3& exact,
+                          const GradientField3& exact_gradient, int q, const Execution& execution) {
+  return compute_errors(u_h, grid, gamma, patches, trace, vectorize(exact), exact_gradient, q, execution);
+}
+
+ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,
+                          const std::vector<double>& trace, const VectorizedField3& exact,
+                          const GradientField3& exact_gradient, int q, const Execution& execution) {
+  const double e = 1e-6 * grid.box().width(0);
+  struct Sums {
+    double e2 = 0, de2 = 0, u2 = 0, du2 = 0;
+  };
+  struct Buffers {
+    std::array<std::vector<double>, 3> x, du;
+    std::vector<double> u;
+  };
+  std::vector<Sums> sums(execution.threads());
+  std::vector<Buffers> buffers(execution.threads());
+  for_each_omega_row(grid, gamma, q, execution, [&](int thread, const std::vector<OmegaPoint>& row) {
+    Buffers& b = buffers[thread];
+    const std::size_t n = row.size();
+    for (int d = 0; d < 3; ++d) {
+      b.x[d].resize(n);
+      for (std::size_t k = 0; k < n; ++k) b.x[d][k] = row[k].x[d];
+    }
+    b.u.resize(n);
+    exact(n, b.x[0].data(), b.x[1].data(), b.x[2].data(), b.u.data());
+    gradient_at(exact, exact_gradient, e, b.x, b.du);
+    Sums& s = sums[thread];
+    std::array<double, 8> nodal{};
+    for (std::size_t k = 0; k < n; ++k) {
+      if (k == 0 || row[k].cell != row[k - 1].cell) nodal = nodal_values(grid, u_h, row[k].cell);
+      Point3 xi;
+      for (int d = 0; d < 3; ++d) xi[d] = (row[k].x[d] - grid.coordinate(d, row[k].cell[d])) / grid.h();
+      const auto [value, slope] = Q1Element<3>::interpolate(nodal, xi, grid.h());
+      const double u = b.u[k];
+      const Point3 du{b.du[0][k], b.du[1][k], b.du[2][k]};
+      const Point3 de = slope - du;
+      const double w = row[k].weight;
+      s.e2 += w * (value - u) * (value - u);
+      s.de2 += w * dot(de, de);
+      s.u2 += w * u * u;
+      s.du2 += w * dot(du, du);
+    }
+  });
+  Sums total;
+  for (const Sums& s : sums) total.e2 += s.e2, total.de2 += s.de2, total.u2 += s.u2, total.du2 += s.du2;
+  const std::array<std::vector<double>, 3> x = coordinates(patches.point);
+  std::vector<double> u(x[0].size());
+  exact(u.size(), x[0].data(), x[1].data(), x[2].data(), u.data());
+  double g2 = 0, gu2 = 0;
+  for (int p = 0; p < patches.m; ++p) {
+    g2 += patches.area[p] * (trace[p] - u[p]) * (trace[p] - u[p]);
+    gu2 += patches.area[p] * u[p] * u[p];
+  }
+  ErrorNorms out;
+  out.l2_omega = std::sqrt(total.e2);
+  out.h1semi_omega = std::sqrt(total.de2);
+  out.h1_omega = std::sqrt(total.e2 + total.de2);
+  out.l2_gamma = std::sqrt(g2);
+  const auto relative = [](double error, double norm) { return norm > 0 ? error / norm : error; };
+  out.rel_l2_omega = relative(out.l2_omega, std::sqrt(total.u2));
+  out.rel_h1semi_omega = relative(out.h1semi_omega, std::sqrt(total.du2));
+  out.rel_h1_omega = relative(out.h1_omega, std::sqrt(total.u2 + total.du2));
+  out.rel_l2_gamma = relative(out.l2_gamma, std::sqrt(gu2));
+  return out;
 }
 
 }  // namespace fictus

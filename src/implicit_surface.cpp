@@ -8,8 +8,8 @@
 
 #include <Eigen/Dense>
 
+#include "fictus/surface.hpp"
 #include "fictus/surface_kink.hpp"
-#include "fictus/surface_solver.hpp"
 
 namespace fictus {
 

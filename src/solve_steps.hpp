@@ -1,6 +1,6 @@
 #pragma once
-// Steps shared by the 2-D (fictitious_domain_solver.cpp) and 3-D (surface_solver.cpp) solves: the
-// phase clock, the Newton and GMRES settings from the options, and the Signorini checks at the points.
+// What the steps of a solve share (fictitious_domain_solver.cpp and the boundaries' files): the phase
+// clock, the Newton and GMRES settings from the options, and the Signorini checks at the points.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,9 +11,9 @@
 #include <Eigen/Dense>
 
 #include "fictus/execution.hpp"
-#include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/gmres.hpp"
 #include "fictus/semismooth_newton.hpp"
+#include "fictus/solution.hpp"
 #include "fictus/solver_options.hpp"
 #include "fictus/trace_operators.hpp"
 

@@ -1,5 +1,7 @@
 #include "fictus/surface_kink.hpp"
 
+#include "fictus/omega_quadrature.hpp"
+
 #include <algorithm>
 #include <array>
 #include <atomic>

@@ -37,8 +37,8 @@ ArcLengthTable offset_placement(const Curve& curve, double delta);
 /// The phase (among 32 candidates, ½ first) that keeps the points farthest from the curve's corners.
 double phase_off_corners(const Curve& curve, const ArcLengthTable& arc_length, int m);
 
-/// Default spacing of the multipliers in cells, s = L/m ≈ c·h at every N (docs/math.md, "Number of
-/// multipliers and offset": the contact ends are resolved to s, so s must shrink with h): 8 cells in
+/// Default spacing of the multipliers in cells, s = L/m ≈ c·h at every N (docs/math.md, "Rules for m
+/// and δ": the contact ends are resolved to s, so s must shrink with h): 8 cells in
 /// the smooth variant, 12 in the non-smooth one (measured on fitted-mesh references).
 inline constexpr double default_spacing_cells_smooth = 8.0;
 inline constexpr double default_spacing_cells_nonsmooth = 12.0;

@@ -1,7 +1,8 @@
 #pragma once
 // The boundary of a 2-D problem: a closed curve γ, its collocation points and the curve Γ that
 // carries λ (γ itself in the non-smooth variant, the offset curve at δ outside ω in the smooth one),
-// with the trace rows of the chosen rule (docs/math.md, "Trace matrices").
+// with the trace rows of the chosen rule (docs/math.md, "Trace matrices"). The solver keeps it for as
+// long as it keeps the solve's setup (`execution` must outlive it).
 #include <memory>
 
 #include "fictus/boundary_discretization.hpp"
@@ -12,7 +13,7 @@
 
 namespace fictus {
 
-class CurveDiscretization final : public BoundaryDiscretization {
+class CurveDiscretization final : public BoundaryDiscretization<2> {
  public:
   /// Steps 1–2 of the solve for curve γ on `grid` (c: the reaction coefficient the kink rows use):
   ///   1. geometry: γ checked (counter-clockwise, simple, 2h inside the box), m and δ by the rules of
@@ -24,29 +25,37 @@ class CurveDiscretization final : public BoundaryDiscretization {
 
   const std::vector<Point2>& points() const override { return collocation_.point; }
   const std::vector<Point2>& normals() const override { return collocation_.normal; }
-  const std::vector<double>& arc_positions() const override { return collocation_.s; }
+  /// The arc length s_i of each point from γ(0).
+  const std::vector<double>& arc_positions() const { return collocation_.s; }
+  const SpacingPlan& spacing() const override { return spacing_; }
+  double delta() const override { return delta_; }
   const SparseRows& B_gamma() const override { return B_gamma_; }
   const SparseRows& C_gamma() const override { return C_gamma_; }
   const SparseRows& B_Gamma() const override { return B_Gamma_; }
   const SparseRows& loads() const override { return loads_; }
   const DirectTerms& direct() const override { return direct_; }
+  /// g, or g(x, y, s) when data.g_along_curve is set, at the points.
+  std::vector<double> obstacle(const Data& data) const override;
   void finish_field(const std::vector<double>& lambda, GridVector& u) const override;
   std::optional<std::vector<double>> independent_normal_derivative(const GridVector& u,
                                                                    std::string& rule) const override;
-  ErrorNorms errors(const GridVector& u, const ContactData& data, int quadrature,
-                    const Execution& execution) const override;
+  ErrorNorms errors(const GridVector& u, const std::vector<double>& trace, const Data& data,
+                    int quadrature) const override;
+  /// ∂u/∂n of the exact solution from its gradient when given, else by a one-sided second-order
+  /// difference into ω (u may be defined in ω only): (3u(x) − 4u(x − εn) + u(x − 2εn))/(2ε), ε = 1e-5·box width.
+  PointErrors point_errors(const std::vector<double>& trace, const std::vector<double>& normal_derivative,
+                           const Data& data) const override;
+  void describe(SolutionBoundary<2>& out) const override;
 
   const Collocation& collocation() const { return collocation_; }
   const std::shared_ptr<const Curve>& gamma() const { return gamma_; }
   const std::shared_ptr<const Curve>& Gamma() const { return Gamma_; }
-  double delta() const { return delta_; }
-  /// m, s and δ as planned (spacing_rule.hpp), with the warning when the default rule was changed.
-  const SpacingPlan& spacing() const { return spacing_; }
 
  private:
   void make_geometry(const Grid2& grid, SolverOptions options);
-  void make_trace_rows(const Grid2& grid, const SolverOptions& options, double c, const Execution& execution);
+  void make_trace_rows(const Grid2& grid, const SolverOptions& options, double c);
 
+  const Execution& execution_;
   std::shared_ptr<const Curve> gamma_, Gamma_;
   Collocation collocation_;
   double delta_ = 0;

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "fictus/point.hpp"
-#include "fictus/surface_solver.hpp"
+#include "fictus/surface.hpp"
 
 namespace fictus {
 
@@ -42,7 +42,7 @@ class LatticeSpline {
 
 /// Lattice cells across the mesh's largest side (geometry.resolution). 0 chooses: the largest side
 /// over twice the median edge length, within [16, 128]: a lattice as fine as the edges sees the
-/// facets as ripples of the curvature (measured in docs/math.md, "Surfaces from meshes").
+/// facets as ripples of the curvature (measured in docs/notes/meshes.md, "The level function").
 inline constexpr int automatic_mesh_resolution = 0;
 inline constexpr int default_mesh_resolution = 128;
 inline constexpr int min_mesh_resolution = 16;

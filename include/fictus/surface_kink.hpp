@@ -21,7 +21,7 @@
 #include "fictus/execution.hpp"
 #include "fictus/fast_solver.hpp"
 #include "fictus/grid.hpp"
-#include "fictus/surface_solver.hpp"
+#include "fictus/surface.hpp"
 #include "fictus/trace_operators.hpp"
 
 namespace fictus {

@@ -18,7 +18,7 @@
 #include "fictus/mesh_surface.hpp"
 #include "fictus/options.hpp"
 #include "fictus/shapes.hpp"
-#include "fictus/surface_solver.hpp"
+#include "fictus/surface.hpp"
 
 namespace fictus {
 

@@ -31,16 +31,21 @@ bool reset_peak_memory() {
 
 std::size_t available_memory_bytes() { return proc_kib("/proc/meminfo", "MemAvailable:"); }
 
-void check_memory(const Problem& problem, const SolverOptions& options) {
+template <int dim>
+void check_memory(const BasicProblem<dim>& problem, const SolverOptions& options) {
   const double gib = double(1 << 30);
   const double need = double(estimated_peak_bytes(problem, options));
   const double limit = options.max_memory > 0 ? options.max_memory * gib : double(available_memory_bytes());
   if (limit <= 0 || need <= limit) return;
   char line[320];
   std::snprintf(line, sizeof line,
-                "domain.N: N = %d needs about %.3g GiB, more than the %.3g GiB %s (a smaller N, or solver.max_memory)",
-                problem.N, need / gib, limit / gib, options.max_memory > 0 ? "of solver.max_memory" : "available");
+                "%s: N = %d needs about %.3g GiB, more than the %.3g GiB %s (a smaller N, or solver.max_memory)",
+                options.max_memory > 0 ? "solver.max_memory" : "domain.N", problem.N, need / gib, limit / gib,
+                options.max_memory > 0 ? "of solver.max_memory" : "available");
   throw std::invalid_argument(line);
 }
+
+template void check_memory(const BasicProblem<2>&, const SolverOptions&);
+template void check_memory(const BasicProblem<3>&, const SolverOptions&);
 
 }  // namespace fictus

@@ -225,8 +225,8 @@ TEST(Manufactured3d, AnInterruptInTheNestedStartEndsTheSolve) {
 TEST(Manufactured3d, NonSmoothVariantConvergesWithTheKinkCorrection) {
   // Multipliers on γ itself, traces of the kink-corrected field (surface_kink.hpp: q(d) with its cubic
   // term; a voxel with corners on both sides of γ is cut), patches of 4h, the flux balance. Measured
-  // L²(ω) 2.35e-4, 1.01e-4, 5.24e-5 (rate 2.2 here, 2.2 over N = 64 … 192 in docs/math.md) with 32–34 %
-  // of the points in contact (40 % of γ is): the bands leave room of about 2× in the rates' spread and
+  // L²(ω) 2.35e-4, 1.01e-4, 5.24e-5 (rate 2.2 here, 2.15 over N = 64 … 192 in docs/notes/3d-manufactured-solutions.md)
+  // with 32–34 % of the points in contact (40 % of γ is): the bands leave room of about 2× in the rates' spread and
   // 1.5× in the error, and a stalled error (3e-4 at N = 96) or a lagging contact set (29 %) fails them.
   converges("sphere", {64, 96, 128}, fictus::Variant::nonsmooth, {1.5, 3.5, 0.8, 1.5, 3}, 8e-5);
 }

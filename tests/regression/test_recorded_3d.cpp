@@ -1,6 +1,6 @@
 // The 3-D answers of fictus, recorded: the manufactured sphere, ellipsoid, torus, implicit torus and
-// mesh torus of examples/, both variants, N = 64 and 96, the default rule for δ. Each case is reduced to digests of λ, the
-// traces, û and the errors, the active set and the Newton steps, and compared with
+// mesh torus of examples/, both variants, N = 64 and 96, the default rule for δ. Each case is reduced to digests of λ,
+// the traces, û and the errors, the active set and the Newton steps, and compared with
 // tests/regression/recorded_3d.json to 1e-12 relative (the digests' sums of squares to 2e-12). A change
 // of the code that moves an answer fails here; a change that is meant to move answers records them again:
 //   FICTUS_RECORD=1 build/tests/fictus_regression_tests --gtest_filter='Recorded3d*'
@@ -14,8 +14,11 @@
 #include <string>
 #include <vector>
 
+#include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/io/problem_file.hpp"
-#include "fictus/surface_solver.hpp"
+#include "fictus/omega_quadrature.hpp"
+#include "fictus/surface.hpp"
+#include "fictus/surface_discretization.hpp"
 #include "recorded.hpp"
 
 namespace {

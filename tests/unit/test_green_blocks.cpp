@@ -6,9 +6,12 @@
 #include <ostream>
 
 #include "fictus/fast_solver.hpp"
+#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/omega_quadrature.hpp"
 #include "fictus/schur_complement.hpp"
+#include "fictus/surface.hpp"
+#include "fictus/surface_discretization.hpp"
 #include "fictus/surface_integrals.hpp"
-#include "fictus/surface_solver.hpp"
 #include "fictus/trace_operators.hpp"
 
 namespace {

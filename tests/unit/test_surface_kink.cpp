@@ -11,9 +11,12 @@
 #include <Eigen/Core>
 
 #include "fictus/fast_solver.hpp"
+#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/omega_quadrature.hpp"
+#include "fictus/surface.hpp"
+#include "fictus/surface_discretization.hpp"
 #include "fictus/surface_integrals.hpp"
 #include "fictus/surface_kink.hpp"
-#include "fictus/surface_solver.hpp"
 #include "fictus/trace_operators.hpp"
 
 namespace {
@@ -233,8 +236,8 @@ FluxShares mean_flux_shares(int N, bool balanced = false) {
 TEST(SurfaceKink, MeanFluxOfAConstantLayerConvergesAgainstItsExactValue) {
   // The mean of ∂û/∂n carries no flux error a multiplier could hide: with c = 1 and a free γ it sets
   // the level of u. Measured with Φ on the same grid: −1.35e-4 (N = 64), −5.6e-5 (N = 96). (The table
-  // of docs/math.md, "An exact reference for the mean flux", takes Φ on a grid of 192 and weights
-  // with the flat triangles' areas: −1.47e-4, −6.1e-5.)
+  // of docs/notes/3d-kink-and-neumann-bias.md, "An exact reference for the mean flux", takes Φ on a grid of 192 and
+  // weights with the flat triangles' areas: −1.47e-4, −6.1e-5.)
   const FluxShares coarse = mean_flux_shares(64), fine = mean_flux_shares(96);
   std::cout << "mean flux bias of a constant layer: " << coarse.bias << " (N = 64), " << fine.bias
             << " (N = 96); per-patch scatter " << coarse.scatter << ", " << fine.scatter << " against Φ on γ "

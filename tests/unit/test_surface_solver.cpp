@@ -6,7 +6,10 @@
 #include <numbers>
 #include <random>
 
-#include "fictus/surface_solver.hpp"
+#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/omega_quadrature.hpp"
+#include "fictus/surface.hpp"
+#include "fictus/surface_discretization.hpp"
 #include "fictus/trace_operators.hpp"
 
 namespace {

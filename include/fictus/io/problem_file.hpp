@@ -6,7 +6,6 @@
 #include <vector>
 
 #include "fictus/problem.hpp"
-#include "fictus/surface_solver.hpp"
 
 namespace fictus {
 

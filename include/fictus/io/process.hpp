@@ -16,9 +16,10 @@ bool reset_peak_memory();
 /// Memory the system can give without swapping (MemAvailable; 0 where unknown).
 std::size_t available_memory_bytes();
 
-/// Refuses a solve whose estimated peak (estimated_peak_bytes) exceeds options.max_memory GiB, or the
-/// available memory when that is 0: throws std::invalid_argument naming domain.N, the estimate and
-/// the limit. Call it before the solver is made.
-void check_memory(const Problem& problem, const SolverOptions& options);
+/// Refuses a solve whose estimated peak (estimated_peak_bytes) exceeds options.max_memory GiB (throws
+/// std::invalid_argument naming solver.max_memory), or the available memory when that is 0 (naming
+/// domain.N), with the estimate and the limit. Call it before the solver is made.
+template <int dim>
+void check_memory(const BasicProblem<dim>& problem, const SolverOptions& options);
 
 }  // namespace fictus
