@@ -45,10 +45,9 @@ struct Crossing {
   Point2 p;
 };
 
-}  // namespace
-
-CurveGridIntersection::CurveGridIntersection(const Curve& curve, const Grid2& grid, const char* what)
-    : curve_(curve), grid_(grid) {
+/// The crossings of the curve with the grid lines, in steps of at most h/8 along it (the walk checks
+/// that the curve stays inside the box and can be followed), sorted by parameter.
+std::vector<Crossing> grid_crossings(const Curve& curve, const Grid2& grid, const char* what) {
   const double h = grid.h();
   const Box2& box = grid.box();
   double max_speed = 0.0;
@@ -97,6 +96,14 @@ CurveGridIntersection::CurveGridIntersection(const Curve& curve, const Grid2& gr
     pa = pb;
   }
   std::sort(crossings.begin(), crossings.end(), [](const Crossing& a, const Crossing& b) { return a.t < b.t; });
+  return crossings;
+}
+
+}  // namespace
+
+CurveGridIntersection::CurveGridIntersection(const Curve& curve, const Grid2& grid, const char* what)
+    : curve_(curve), grid_(grid) {
+  const std::vector<Crossing> crossings = grid_crossings(curve, grid, what);
 
   row_crossings_.assign(grid.ny() + 1, {});
   col_crossings_.assign(grid.nx() + 1, {});

@@ -247,23 +247,53 @@ Eigen::MatrixXd green_block(const GreenTable<dim>& green, const SparseRows& R, c
   return green_blocks(green, {&R}, Q, execution, far_field).front();
 }
 
-template <int dim>
-std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
-                                          const SparseRows& Q, const Execution& execution, const FarField& far_field,
-                                          FarFieldReport* report) {
-  for (const SparseRows* R : row_sets)
-    if (R->n_rows() != row_sets.front()->n_rows())
-      throw std::invalid_argument("green_blocks: the row sets differ in their number of rows");
-  const RowSide rows{row_sets}, cols{{&Q}};
-  const int n_rows = rows.n_rows(), n_cols = Q.n_rows();
-  std::vector<Eigen::MatrixXd> out;
-  for (const SparseRows* R : row_sets) out.emplace_back(R->n_rows(), n_cols);
-  if (far_field.order < 0 || (far_field.order > 0 && !(far_field.eta > 0 && far_field.leaf >= 1)))
-    throw std::invalid_argument("green_blocks: a far field needs order >= 0, eta > 0 and leaves of >= 1 row");
-  if (n_rows == 0 || n_cols == 0) return out;
-  const bool compress = far_field.order > 0;
+namespace {
 
-  // The trees: without compression one row cluster and columns in fours (the threads' work).
+/// The assembly of green_blocks step by step: the cluster trees, the block partition, each cluster's
+/// interpolation or distinct nodes, then the blocks themselves.
+template <int dim>
+struct BlockAssembly {
+  BlockAssembly(const GreenTable<dim>& g, const std::vector<const SparseRows*>& r, const SparseRows& q,
+                const Execution& e, const FarField& f)
+      : green(g), row_sets(r), Q(q), execution(e), far_field(f) {}
+  const GreenTable<dim>& green;
+  const std::vector<const SparseRows*>& row_sets;
+  const SparseRows& Q;
+  const Execution& execution;
+  const FarField& far_field;
+  RowSide rows{row_sets}, cols{{&Q}};
+  bool compress = far_field.order > 0;
+  std::unique_ptr<ClusterTree<dim>> X, Y;
+  std::vector<Block> blocks;
+  std::vector<std::unique_ptr<Interpolation<dim>>> x_interp, y_interp;
+  std::vector<std::vector<Eigen::MatrixXd>> U;  // per row cluster with far blocks: R L, one per row set
+  std::vector<Eigen::MatrixXd> V;               // per column cluster with far blocks: Q L
+  std::vector<std::unique_ptr<DistinctNodes<dim>>> distinct;
+  std::exception_ptr failure;  // an exception (out of memory) inside a parallel loop, thrown after it
+
+  void keep() {
+#pragma omp critical(fictus_green_blocks_failure)
+    if (!failure) failure = std::current_exception();
+  }
+  void trees();
+  void partition();
+  void cluster_data();
+  void fill(std::vector<Eigen::MatrixXd>& out);
+  void far_block(const Block& b, Eigen::MatrixXd& core, Eigen::MatrixXd& half, Eigen::MatrixXd& block,
+                 std::vector<Eigen::MatrixXd>& out) const;
+  void near_block(const Block& b, const std::vector<Index<dim>>& q_nodes, const std::vector<double>& q_values,
+                  std::vector<double>& column, std::vector<Eigen::MatrixXd>& out) const;
+  void report(FarFieldReport& r) const;
+  std::vector<int> cluster_items(const ClusterTree<dim>& T, int c) const {
+    const auto& cl = T.clusters[std::size_t(c)];
+    return std::vector<int>(T.item.begin() + cl.begin, T.item.begin() + cl.end);
+  }
+};
+
+/// The trees: without compression one row cluster and columns in fours (the threads' work).
+template <int dim>
+void BlockAssembly<dim>::trees() {
+  const int n_rows = rows.n_rows(), n_cols = Q.n_rows();
   const auto n_r = std::size_t(n_rows), n_c = std::size_t(n_cols);
   std::vector<NodeBox<dim>> row_boxes(n_r), col_boxes(n_c);
   std::vector<double> row_work(n_r, 0.0), col_work(n_c, 0.0);
@@ -276,20 +306,21 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
     col_boxes[std::size_t(c)] = item_box<dim>(cols, c);
     col_work[std::size_t(c)] = double(Q.row_begin[std::size_t(c) + 1] - Q.row_begin[std::size_t(c)]);
   }
-  const ClusterTree<dim> X(row_boxes, row_work, compress ? far_field.leaf : n_rows);
-  const ClusterTree<dim> Y(col_boxes, col_work, compress ? far_field.leaf : 4);
-  std::vector<Interpolation<dim>> no_interpolation;
+  X = std::make_unique<ClusterTree<dim>>(row_boxes, row_work, compress ? far_field.leaf : n_rows);
+  Y = std::make_unique<ClusterTree<dim>>(col_boxes, col_work, compress ? far_field.leaf : 4);
+}
+
+/// The block partition: a pair far apart (max radius ≤ eta·distance) is interpolated when that is
+/// cheaper than exact; otherwise split, down to pairs of leaves computed exactly. Dearest first.
+template <int dim>
+void BlockAssembly<dim>::partition() {
   const auto interpolation_size = [&](const NodeBox<dim>& b) {
     double s = 1;
     for (int d = 0; d < dim && !b.empty(); ++d) s *= std::min(double(far_field.order), double(b.hi[d]) - b.lo[d] + 1);
     return s;
   };
-
-  // The block partition: a pair far apart (max radius ≤ eta·distance) is interpolated when that is
-  // cheaper than exact; otherwise split, down to pairs of leaves computed exactly.
-  std::vector<Block> blocks;
-  const auto partition = [&](auto&& self, int x, int y) -> void {
-    const auto &cx = X.clusters[std::size_t(x)], &cy = Y.clusters[std::size_t(y)];
+  const auto split = [&](auto&& self, int x, int y) -> void {
+    const auto &cx = X->clusters[std::size_t(x)], &cy = Y->clusters[std::size_t(y)];
     const double exact = cx.work * cy.work;
     if (compress) {
       const double interpolated = interpolation_size(cx.box) * interpolation_size(cy.box);
@@ -299,9 +330,9 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
         return;
       }
     }
-    if (X.leaf(x) && Y.leaf(y)) {
+    if (X->leaf(x) && Y->leaf(y)) {
       blocks.push_back({x, y, false, exact});
-    } else if (X.leaf(x) || (!Y.leaf(y) && cy.end - cy.begin > cx.end - cx.begin)) {
+    } else if (X->leaf(x) || (!Y->leaf(y) && cy.end - cy.begin > cx.end - cx.begin)) {
       self(self, x, cy.left);
       self(self, x, cy.right);
     } else {
@@ -309,26 +340,23 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
       self(self, cx.right, y);
     }
   };
-  partition(partition, 0, 0);
+  split(split, 0, 0);
   std::sort(blocks.begin(), blocks.end(), [](const Block& a, const Block& b) { return a.cost > b.cost; });
+}
 
-  // Per cluster: the interpolation and U = R L (rows) or V = Q L (columns) for the far blocks; the
-  // distinct nodes for the near ones.
-  const auto cluster_items = [](const ClusterTree<dim>& T, int c) {
-    const auto& cl = T.clusters[std::size_t(c)];
-    return std::vector<int>(T.item.begin() + cl.begin, T.item.begin() + cl.end);
-  };
-  std::vector<char> x_far(X.clusters.size(), 0), y_far(Y.clusters.size(), 0), x_near(X.clusters.size(), 0);
+/// Per cluster: the interpolation and U = R L (rows) or V = Q L (columns) for the far blocks; the
+/// distinct nodes for the near ones.
+template <int dim>
+void BlockAssembly<dim>::cluster_data() {
+  const std::size_t nx = X->clusters.size(), ny = Y->clusters.size();
+  std::vector<char> x_far(nx, 0), y_far(ny, 0), x_near(nx, 0);
   for (const Block& b : blocks) {
     if (b.far)
       x_far[std::size_t(b.x)] = y_far[std::size_t(b.y)] = 1;
     else
       x_near[std::size_t(b.x)] = 1;
   }
-  std::vector<std::unique_ptr<Interpolation<dim>>> x_interp(X.clusters.size()), y_interp(Y.clusters.size());
-  std::vector<std::vector<Eigen::MatrixXd>> U(X.clusters.size());
-  std::vector<Eigen::MatrixXd> V(Y.clusters.size());
-  std::vector<std::unique_ptr<DistinctNodes<dim>>> distinct(X.clusters.size());
+  x_interp.resize(nx), y_interp.resize(ny), U.resize(nx), V.resize(ny), distinct.resize(nx);
   const auto interpolate = [&](const RowSide& side, const std::vector<int>& items, const Interpolation<dim>& L,
                                std::vector<Eigen::MatrixXd>& mats) {
     mats.clear();
@@ -342,29 +370,23 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
       mats.push_back(rowmajor);
     }
   };
-  // An exception (out of memory) inside a parallel loop is kept and thrown after it.
-  std::exception_ptr failure;
-  const auto keep = [&failure] {
-#pragma omp critical(fictus_green_blocks_failure)
-    if (!failure) failure = std::current_exception();
-  };
 #pragma omp parallel for schedule(dynamic, 1) num_threads(execution.threads())
-  for (int c = 0; c < int(X.clusters.size()) + int(Y.clusters.size()); ++c) try {
-      if (c < int(X.clusters.size())) {
+  for (int c = 0; c < int(nx) + int(ny); ++c) try {
+      if (c < int(nx)) {
         if (x_far[std::size_t(c)]) {
           x_interp[std::size_t(c)] =
-              std::make_unique<Interpolation<dim>>(X.clusters[std::size_t(c)].box, far_field.order);
-          interpolate(rows, cluster_items(X, c), *x_interp[std::size_t(c)], U[std::size_t(c)]);
+              std::make_unique<Interpolation<dim>>(X->clusters[std::size_t(c)].box, far_field.order);
+          interpolate(rows, cluster_items(*X, c), *x_interp[std::size_t(c)], U[std::size_t(c)]);
         }
         if (x_near[std::size_t(c)])
-          distinct[std::size_t(c)] = std::make_unique<DistinctNodes<dim>>(rows, cluster_items(X, c));
+          distinct[std::size_t(c)] = std::make_unique<DistinctNodes<dim>>(rows, cluster_items(*X, c));
       } else {
-        const int y = c - int(X.clusters.size());
+        const int y = c - int(nx);
         if (!y_far[std::size_t(y)]) continue;
         y_interp[std::size_t(y)] =
-            std::make_unique<Interpolation<dim>>(Y.clusters[std::size_t(y)].box, far_field.order);
+            std::make_unique<Interpolation<dim>>(Y->clusters[std::size_t(y)].box, far_field.order);
         std::vector<Eigen::MatrixXd> mats;
-        interpolate(cols, cluster_items(Y, y), *y_interp[std::size_t(y)], mats);
+        interpolate(cols, cluster_items(*Y, y), *y_interp[std::size_t(y)], mats);
         V[std::size_t(y)] = std::move(mats.front());
       }
     } catch (...) {
@@ -372,13 +394,61 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
     }
   if (failure) std::rethrow_exception(failure);
   execution.throw_if_interrupted();
+}
 
+/// A far block: U_x (G between the interpolation nodes) V_yᵀ.
+template <int dim>
+void BlockAssembly<dim>::far_block(const Block& b, Eigen::MatrixXd& core, Eigen::MatrixXd& half, Eigen::MatrixXd& block,
+                                   std::vector<Eigen::MatrixXd>& out) const {
+  const auto &cx = X->clusters[std::size_t(b.x)], &cy = Y->clusters[std::size_t(b.y)];
+  const Interpolation<dim>&Lx = *x_interp[std::size_t(b.x)], &Ly = *y_interp[std::size_t(b.y)];
+  core.resize(Lx.size(), Ly.size());
+  green.G(Lx.nodes, Ly.nodes, core.data(), std::size_t(Lx.size()));
+  half.noalias() = core * V[std::size_t(b.y)].transpose();
+  for (std::size_t s = 0; s < row_sets.size(); ++s) {
+    block.noalias() = U[std::size_t(b.x)][s] * half;
+    for (int j = cy.begin; j < cy.end; ++j)
+      for (int i = cx.begin; i < cx.end; ++i)
+        out[s](X->item[std::size_t(i)], Y->item[std::size_t(j)]) = block(i - cx.begin, j - cy.begin);
+  }
+}
+
+/// A near block, exactly: for each column, G between the row cluster's distinct nodes and the column's
+/// entries, then each row's weighted sum.
+template <int dim>
+void BlockAssembly<dim>::near_block(const Block& b, const std::vector<Index<dim>>& q_nodes,
+                                    const std::vector<double>& q_values, std::vector<double>& column,
+                                    std::vector<Eigen::MatrixXd>& out) const {
+  const auto &cx = X->clusters[std::size_t(b.x)], &cy = Y->clusters[std::size_t(b.y)];
+  const DistinctNodes<dim>& nodes = *distinct[std::size_t(b.x)];
+  column.resize(nodes.nodes.size());
+  for (int j = cy.begin; j < cy.end; ++j) {
+    const int col = Y->item[std::size_t(j)];
+    const std::size_t first = Q.row_begin[std::size_t(col)];
+    green.G(nodes.nodes.data(), nodes.nodes.size(), q_nodes.data() + first, q_values.data() + first,
+            Q.row_begin[std::size_t(col) + 1] - first, column.data());
+    std::size_t entry = 0;
+    for (std::size_t s = 0; s < row_sets.size(); ++s) {
+      const SparseRows& R = *row_sets[s];
+      for (int i = cx.begin; i < cx.end; ++i) {
+        const int row = X->item[std::size_t(i)];
+        double sum = 0.0;
+        for (std::size_t a = R.row_begin[std::size_t(row)]; a < R.row_begin[std::size_t(row) + 1]; ++a, ++entry)
+          sum += R.entries[a].value * column[nodes.slot[entry]];
+        out[s](row, col) = sum;
+      }
+    }
+  }
+}
+
+/// Every block, dearest first, on the threads.
+template <int dim>
+void BlockAssembly<dim>::fill(std::vector<Eigen::MatrixXd>& out) {
   std::vector<Index<dim>> q_nodes;  // Q's entries' nodes and values, for the near blocks' sums
   std::vector<double> q_values;
   q_nodes.reserve(Q.entries.size());
   q_values.reserve(Q.entries.size());
   for (const SparseRows::Entry& e : Q.entries) q_nodes.push_back(node_of<dim>(e)), q_values.push_back(e.value);
-
   std::atomic<bool> stop = false;  // an interruption seen by thread 0 (the caller's) ends every thread's work
 #pragma omp parallel num_threads(execution.threads())
   {
@@ -388,40 +458,10 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
     for (std::size_t k = 0; k < blocks.size(); ++k) try {
         if (omp_get_thread_num() == 0 && execution.interrupt_requested()) stop = true;
         if (stop) continue;
-        const Block& b = blocks[k];
-        const auto &cx = X.clusters[std::size_t(b.x)], &cy = Y.clusters[std::size_t(b.y)];
-        if (b.far) {
-          const Interpolation<dim>&Lx = *x_interp[std::size_t(b.x)], &Ly = *y_interp[std::size_t(b.y)];
-          core.resize(Lx.size(), Ly.size());
-          green.G(Lx.nodes, Ly.nodes, core.data(), std::size_t(Lx.size()));
-          half.noalias() = core * V[std::size_t(b.y)].transpose();
-          for (std::size_t s = 0; s < row_sets.size(); ++s) {
-            block.noalias() = U[std::size_t(b.x)][s] * half;
-            for (int j = cy.begin; j < cy.end; ++j)
-              for (int i = cx.begin; i < cx.end; ++i)
-                out[s](X.item[std::size_t(i)], Y.item[std::size_t(j)]) = block(i - cx.begin, j - cy.begin);
-          }
-          continue;
-        }
-        const DistinctNodes<dim>& nodes = *distinct[std::size_t(b.x)];
-        column.resize(nodes.nodes.size());
-        for (int j = cy.begin; j < cy.end; ++j) {
-          const int col = Y.item[std::size_t(j)];
-          const std::size_t first = Q.row_begin[std::size_t(col)];
-          green.G(nodes.nodes.data(), nodes.nodes.size(), q_nodes.data() + first, q_values.data() + first,
-                  Q.row_begin[std::size_t(col) + 1] - first, column.data());
-          std::size_t entry = 0;
-          for (std::size_t s = 0; s < row_sets.size(); ++s) {
-            const SparseRows& R = *row_sets[s];
-            for (int i = cx.begin; i < cx.end; ++i) {
-              const int row = X.item[std::size_t(i)];
-              double sum = 0.0;
-              for (std::size_t a = R.row_begin[std::size_t(row)]; a < R.row_begin[std::size_t(row) + 1]; ++a, ++entry)
-                sum += R.entries[a].value * column[nodes.slot[entry]];
-              out[s](row, col) = sum;
-            }
-          }
-        }
+        if (blocks[k].far)
+          far_block(blocks[k], core, half, block, out);
+        else
+          near_block(blocks[k], q_nodes, q_values, column, out);
       } catch (...) {
         keep();
         stop = true;
@@ -429,15 +469,40 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
   }
   if (failure) std::rethrow_exception(failure);
   if (stop) throw Interrupted();
-  if (report) {
-    *report = {};
-    for (const Block& b : blocks) {
-      const double pairs = double(X.clusters[std::size_t(b.x)].end - X.clusters[std::size_t(b.x)].begin) *
-                           double(Y.clusters[std::size_t(b.y)].end - Y.clusters[std::size_t(b.y)].begin);
-      (b.far ? report->far_pairs : report->near_pairs) += pairs;
-      (b.far ? report->far_blocks : report->near_blocks) += 1;
-    }
+}
+
+template <int dim>
+void BlockAssembly<dim>::report(FarFieldReport& r) const {
+  r = {};
+  for (const Block& b : blocks) {
+    const double pairs = double(X->clusters[std::size_t(b.x)].end - X->clusters[std::size_t(b.x)].begin) *
+                         double(Y->clusters[std::size_t(b.y)].end - Y->clusters[std::size_t(b.y)].begin);
+    (b.far ? r.far_pairs : r.near_pairs) += pairs;
+    (b.far ? r.far_blocks : r.near_blocks) += 1;
   }
+}
+
+}  // namespace
+
+template <int dim>
+std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
+                                          const SparseRows& Q, const Execution& execution, const FarField& far_field,
+                                          FarFieldReport* report) {
+  for (const SparseRows* R : row_sets)
+    if (R->n_rows() != row_sets.front()->n_rows())
+      throw std::invalid_argument("green_blocks: the row sets differ in their number of rows");
+  const int n_cols = Q.n_rows();
+  std::vector<Eigen::MatrixXd> out;
+  for (const SparseRows* R : row_sets) out.emplace_back(R->n_rows(), n_cols);
+  if (far_field.order < 0 || (far_field.order > 0 && !(far_field.eta > 0 && far_field.leaf >= 1)))
+    throw std::invalid_argument("green_blocks: a far field needs order >= 0, eta > 0 and leaves of >= 1 row");
+  if (row_sets.front()->n_rows() == 0 || n_cols == 0) return out;
+  BlockAssembly<dim> assembly(green, row_sets, Q, execution, far_field);
+  assembly.trees();
+  assembly.partition();
+  assembly.cluster_data();
+  assembly.fill(out);
+  if (report) assembly.report(*report);
   return out;
 }
 

@@ -243,8 +243,42 @@ KinkCorrection& KinkCorrection::operator=(KinkCorrection&&) noexcept = default;
 
 const SparseRows& KinkCorrection::galerkin() const { return state_->galerkin; }
 
-// Steps 1–2 stay together: step 2 is one quadrature loop over the cut cells that shares step 1's
-// band of kink values and nearest points.
+namespace {
+
+double cell_parameter(const CurveGridIntersection& gamma, const CutCell& cell) {
+  const CurvePiece& piece = gamma.pieces()[cell.pieces.front()];
+  return 0.5 * (piece.t0 + piece.t1);
+}
+
+/// Step 1 of the kink correction: the nearest point of every cut cell's centre (exact) and the curve's
+/// speed there, then the kink values at the nodes of the cut cells and of the two rings of cells
+/// around them (the band that trace stencils reach).
+void nearest_points_and_band(const CurveGridIntersection& gamma, const Projector& project, NodeKinks& nodes,
+                             std::vector<Kink>& centres, std::vector<double>& speeds, const Execution& execution) {
+  const Grid2& grid = gamma.grid();
+  const double h = grid.h();
+  const auto& cells = gamma.cut_cells();
+  centres.resize(cells.size());
+  speeds.resize(cells.size());
+#pragma omp parallel for num_threads(execution.threads()) schedule(static)
+  for (std::size_t n = 0; n < cells.size(); ++n) {
+    centres[n] =
+        project({grid.x(cells[n].ix) + 0.5 * h, grid.y(cells[n].iy) + 0.5 * h}, cell_parameter(gamma, cells[n]));
+    speeds[n] = gamma.curve().speed(centres[n].t);
+  }
+  std::vector<std::pair<std::size_t, int>> band;
+  band.reserve(36 * cells.size());
+  for (std::size_t n = 0; n < cells.size(); ++n)
+    for (int j = cells[n].iy - 2; j <= cells[n].iy + 3; ++j)
+      for (int i = cells[n].ix - 2; i <= cells[n].ix + 3; ++i)
+        if (i >= 0 && j >= 0 && i <= grid.nx() && j <= grid.ny()) band.emplace_back(nodes.key(i, j), int(n));
+  nodes.build(std::move(band), centres, speeds, execution);
+}
+
+}  // namespace
+
+// Step 2 is one quadrature loop over the cut cells that shares step 1's band of kink values and
+// nearest points.
 KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Collocation& arcs, double c,
                                const Execution& execution)
     : state_(std::make_unique<State>(gamma, arcs)) {
@@ -255,29 +289,9 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
   const ArcIndex& arc_of = state_->arc_of;
   NodeKinks& nodes = state_->nodes;
   const auto& cells = gamma.cut_cells();
-  auto cell_parameter = [&](const CutCell& cell) {
-    const CurvePiece& piece = gamma.pieces()[cell.pieces.front()];
-    return 0.5 * (piece.t0 + piece.t1);
-  };
-
-  // 1. The nearest point of every cut cell's centre (exact), then the kink values at the nodes of the
-  //    cut cells and of the two rings of cells around them (the band that trace stencils reach).
-  std::vector<Kink> centres(cells.size());
-  std::vector<double> speeds(cells.size());
-#pragma omp parallel for num_threads(execution.threads()) schedule(static)
-  for (std::size_t n = 0; n < cells.size(); ++n) {
-    centres[n] = project({grid.x(cells[n].ix) + 0.5 * h, grid.y(cells[n].iy) + 0.5 * h}, cell_parameter(cells[n]));
-    speeds[n] = gamma.curve().speed(centres[n].t);
-  }
-  {
-    std::vector<std::pair<std::size_t, int>> band;
-    band.reserve(36 * cells.size());
-    for (std::size_t n = 0; n < cells.size(); ++n)
-      for (int j = cells[n].iy - 2; j <= cells[n].iy + 3; ++j)
-        for (int i = cells[n].ix - 2; i <= cells[n].ix + 3; ++i)
-          if (i >= 0 && j >= 0 && i <= grid.nx() && j <= grid.ny()) band.emplace_back(nodes.key(i, j), int(n));
-    nodes.build(std::move(band), centres, speeds, execution);
-  }
+  std::vector<Kink> centres;
+  std::vector<double> speeds;
+  nearest_points_and_band(gamma, project, nodes, centres, speeds, execution);  // 1.
   // 2. r_j,k = a(ψ_j − I_hψ_j, φ_k) on every cut cell: the part outside ω is the whole cell minus
   //    its part in ω (ψ_j's smooth extension q(d) on both), and I_hψ_j takes the element matrix.
   //    Each quadrature point goes to the arc its nearest curve point lies on.

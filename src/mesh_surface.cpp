@@ -248,10 +248,15 @@ void check_mesh_resolution(double resolution) {
 
 MeshSurface::~MeshSurface() = default;
 
-MeshSurface::MeshSurface(const PolygonSoup& soup, int resolution, const std::string& field) {
-  check_mesh_resolution(resolution);
+namespace {
+
+/// The soup's points and faces, checked (finite coordinates, faces of three or more existing vertices),
+/// the duplicate points of STL-like files merged, degenerate and repeated faces dropped, the faces
+/// oriented consistently (refused when some edge has more than two faces, or a vertex joins sheets
+/// that meet only there).
+void checked_soup(const PolygonSoup& soup, const std::string& field, std::vector<CgalPoint>& points,
+                  std::vector<std::vector<std::size_t>>& polygons) {
   if (soup.faces.empty()) fail(field, "the mesh has no faces");
-  std::vector<CgalPoint> points;
   points.reserve(soup.vertices.size());
   for (const Point3& v : soup.vertices) {
     for (int d = 0; d < 3; ++d)
@@ -259,25 +264,25 @@ MeshSurface::MeshSurface(const PolygonSoup& soup, int resolution, const std::str
         fail(field, "a vertex coordinate is not finite or beyond 1e100 in size");
     points.emplace_back(v.x, v.y, v.z);
   }
-  std::vector<std::vector<std::size_t>> polygons = soup.faces;
+  polygons = soup.faces;
   for (const auto& face : polygons) {
     if (face.size() < 3) fail(field, "a face has fewer than three vertices");
     for (std::size_t index : face)
       if (index >= points.size())
         fail(field, "a face refers to vertex " + std::to_string(index) + " of " + std::to_string(points.size()));
   }
-
-  // Merge the duplicate points of STL-like files, drop degenerate and repeated faces, then orient
-  // the faces consistently: false when some edge has more than two faces, or a vertex joins sheets
-  // that meet only there.
   PMP::repair_polygon_soup(points, polygons, CGAL::parameters::erase_all_duplicates(false));
   if (polygons.empty()) fail(field, "every face of the mesh is degenerate");
   if (!PMP::orient_polygon_soup(points, polygons))
     fail(field,
          "the mesh is not a manifold surface: an edge with more than two faces, a vertex where separate "
          "sheets meet, or faces that cannot be oriented consistently");
-  auto mesh = std::make_unique<Mesh>();
-  TriangleMeshCgal& m = mesh->mesh;
+}
+
+/// The triangle mesh of the checked soup: closed, free of self-intersections, oriented to bound a
+/// positive volume (a warning when it was reoriented).
+void closed_mesh(const std::vector<CgalPoint>& points, const std::vector<std::vector<std::size_t>>& polygons,
+                 const std::string& field, TriangleMeshCgal& m, std::vector<std::string>& warnings) {
   PMP::polygon_soup_to_polygon_mesh(points, polygons, m);
   if (!CGAL::is_triangle_mesh(m) && !PMP::triangulate_faces(m)) fail(field, "a face could not be triangulated");
   for (auto h : halfedges(m))
@@ -301,46 +306,39 @@ MeshSurface::MeshSurface(const PolygonSoup& soup, int resolution, const std::str
   const double volume = PMP::volume(m);
   if (!(volume > 0)) fail(field, "the mesh encloses no volume");
   if (std::abs(before - volume) > 1e-12 * volume)  // also a shell inside another that pointed outward
-    warnings_.push_back(before <= -volume * (1 - 1e-12)
-                            ? "the mesh's faces pointed inward: reoriented outward"
-                            : "some components of the mesh were oriented the wrong way: reoriented to bound a volume");
-  vertices_ = num_vertices(m);
-  faces_ = num_faces(m);
+    warnings.push_back(before <= -volume * (1 - 1e-12)
+                           ? "the mesh's faces pointed inward: reoriented outward"
+                           : "some components of the mesh were oriented the wrong way: reoriented to bound a volume");
+}
 
-  mesh->tree.insert(faces(m).first, faces(m).second, m);
-  mesh->tree.build();
-  mesh->tree.accelerate_distance_queries();
-  Side side(m);  // ray casting with exact predicates (its own tree)
+/// The automatic resolution: the largest side over twice the median edge length, within bounds.
+int automatic_resolution(const TriangleMeshCgal& m, double largest) {
+  std::vector<double> lengths;
+  lengths.reserve(num_edges(m));
+  for (auto e : edges(m)) lengths.push_back(PMP::edge_length(e, m));
+  std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2), lengths.end());
+  const double median = lengths[lengths.size() / 2];
+  return int(
+      std::clamp(std::round(largest / (2 * median)), double(min_mesh_resolution), double(default_mesh_resolution)));
+}
 
-  // The lattice: `resolution` cells across the mesh's largest side, a margin of 8 cells around it.
-  const CGAL::Bbox_3 box = PMP::bbox(m);
-  const double largest = std::max({box.xmax() - box.xmin(), box.ymax() - box.ymin(), box.zmax() - box.zmin()});
-  if (!(largest > 0)) fail(field, "the mesh is flat");
-  if (resolution == automatic_mesh_resolution) {
-    std::vector<double> lengths;
-    lengths.reserve(num_edges(m));
-    for (auto e : edges(m)) lengths.push_back(PMP::edge_length(e, m));
-    std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2), lengths.end());
-    const double median = lengths[lengths.size() / 2];
-    resolution = int(
-        std::clamp(std::round(largest / (2 * median)), double(min_mesh_resolution), double(default_mesh_resolution)));
-  }
-  resolution_ = resolution;
-  const double spacing = largest / resolution;
-  constexpr int margin = 8;
-  const int n = resolution + 2 * margin;
-  const Point3 center{(box.xmin() + box.xmax()) / 2, (box.ymin() + box.ymax()) / 2, (box.zmin() + box.zmax()) / 2};
-  const Point3 lower = center - (0.5 * n * spacing) * Point3{1, 1, 1};
-  const std::size_t side_nodes = std::size_t(n) + 1, nodes = side_nodes * side_nodes * side_nodes;
-  const auto node = [&](std::size_t i, std::size_t j, std::size_t k) {
+/// The lattice of the level function: n cells of `spacing` per side from `lower`, around `center`.
+struct Lattice {
+  Point3 lower, center;
+  double spacing = 0;
+  int n = 0;
+  std::size_t side() const { return std::size_t(n) + 1; }
+  std::size_t nodes() const { return side() * side() * side(); }
+  std::size_t index(std::size_t i, std::size_t j, std::size_t k) const { return (k * side() + j) * side() + i; }
+  CgalPoint node(std::size_t i, std::size_t j, std::size_t k) const {
     return CgalPoint(lower.x + double(i) * spacing, lower.y + double(j) * spacing, lower.z + double(k) * spacing);
-  };
-  const auto index = [&](std::size_t i, std::size_t j, std::size_t k) { return (k * side_nodes + j) * side_nodes + i; };
+  }
+};
 
-  // Exact distances by the AABB tree in a band of 6ℓ around the faces (the nodes in each face's box
-  // grown by the band), the nearest points of the others by closest-point sweeps from the band.
+/// The nodes within 6ℓ of some face (the nodes in each face's box grown by that band).
+std::vector<std::uint8_t> band_of(const TriangleMeshCgal& m, const Lattice& L) {
   constexpr double band = 6;
-  std::vector<std::uint8_t> in_band(nodes, 0);
+  std::vector<std::uint8_t> in_band(L.nodes(), 0);
   for (auto f : faces(m)) {
     std::array<double, 3> lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
                              std::numeric_limits<double>::infinity()};
@@ -349,71 +347,119 @@ MeshSurface::MeshSurface(const PolygonSoup& soup, int resolution, const std::str
       for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], m.point(v)[d]), hi[d] = std::max(hi[d], m.point(v)[d]);
     std::array<std::size_t, 3> first, last;
     for (int d = 0; d < 3; ++d) {
-      first[d] = std::size_t(std::max(0.0, std::ceil((lo[d] - band * spacing - lower[d]) / spacing)));
-      last[d] = std::size_t(std::min(double(n), std::floor((hi[d] + band * spacing - lower[d]) / spacing)));
+      first[d] = std::size_t(std::max(0.0, std::ceil((lo[d] - band * L.spacing - L.lower[d]) / L.spacing)));
+      last[d] = std::size_t(std::min(double(L.n), std::floor((hi[d] + band * L.spacing - L.lower[d]) / L.spacing)));
     }
     for (std::size_t k = first[2]; k <= last[2]; ++k)
       for (std::size_t j = first[1]; j <= last[1]; ++j)
-        for (std::size_t i = first[0]; i <= last[0]; ++i) in_band[index(i, j, k)] = 1;
+        for (std::size_t i = first[0]; i <= last[0]; ++i) in_band[L.index(i, j, k)] = 1;
   }
-  std::vector<std::size_t> band_nodes;
-  for (std::size_t q = 0; q < nodes; ++q)
-    if (in_band[q]) band_nodes.push_back(q);
-  std::vector<double> distance(nodes, std::numeric_limits<double>::infinity());
-  std::vector<std::array<float, 3>> nearest(nodes, {NAN, NAN, NAN});
-  const auto coordinates = [&](std::size_t q) {
-    return std::array<std::size_t, 3>{q % side_nodes, (q / side_nodes) % side_nodes, q / (side_nodes * side_nodes)};
-  };
-  const CgalPoint middle(center.x, center.y, center.z);  // inside the mesh's box: lazy set-ups happen here
-  (void)mesh->tree.closest_point(middle);
-  (void)side(middle);
-#pragma omp parallel for schedule(dynamic, 256)
-  for (std::size_t b = 0; b < band_nodes.size(); ++b) {
-    const std::size_t q = band_nodes[b];
-    const auto [i, j, k] = coordinates(q);
-    const CgalPoint p = node(i, j, k);
-    const CgalPoint c = mesh->tree.closest_point(p);
-    distance[q] = std::sqrt(CGAL::squared_distance(p, c));
-    nearest[q] = {float(c.x() - center.x), float(c.y() - center.y), float(c.z() - center.z)};  // from the centre
-  }
-  // Sweeps in the eight diagonal orders, twice: each node away from the band tries the nearest
-  // points of its three upwind neighbours.
+  return in_band;
+}
+
+/// Sweeps in the eight diagonal orders, twice: each node away from the band tries the nearest points
+/// (relative to the centre) of its three upwind neighbours.
+void sweep_nearest_points(const Lattice& L, const std::vector<std::uint8_t>& in_band, std::vector<double>& distance,
+                          std::vector<std::array<float, 3>>& nearest) {
+  const std::size_t n = std::size_t(L.n);
   for (int round = 0; round < 2; ++round)
     for (int order = 0; order < 8; ++order) {
       const int step[3] = {order & 1 ? -1 : 1, order & 2 ? -1 : 1, order & 4 ? -1 : 1};
-      for (std::size_t kk = 0; kk < side_nodes; ++kk)
-        for (std::size_t jj = 0; jj < side_nodes; ++jj)
-          for (std::size_t ii = 0; ii < side_nodes; ++ii) {
+      for (std::size_t kk = 0; kk < L.side(); ++kk)
+        for (std::size_t jj = 0; jj < L.side(); ++jj)
+          for (std::size_t ii = 0; ii < L.side(); ++ii) {
             const std::size_t i = step[0] > 0 ? ii : n - ii, j = step[1] > 0 ? jj : n - jj,
                               k = step[2] > 0 ? kk : n - kk;
-            const std::size_t q = index(i, j, k);
+            const std::size_t q = L.index(i, j, k);
             if (in_band[q]) continue;
             const std::array<std::size_t, 3> here{i, j, k};
-            const Point3 x = lower - center + spacing * Point3{double(i), double(j), double(k)};
+            const Point3 x = L.lower - L.center + L.spacing * Point3{double(i), double(j), double(k)};
             for (int d = 0; d < 3; ++d) {
-              if ((step[d] > 0 && here[d] == 0) || (step[d] < 0 && here[d] == std::size_t(n))) continue;
+              if ((step[d] > 0 && here[d] == 0) || (step[d] < 0 && here[d] == n)) continue;
               std::array<std::size_t, 3> from = here;
               from[d] = step[d] > 0 ? from[d] - 1 : from[d] + 1;
-              const auto& c = nearest[index(from[0], from[1], from[2])];
+              const auto& c = nearest[L.index(from[0], from[1], from[2])];
               if (std::isnan(c[0])) continue;
               const double candidate = norm(x - Point3{double(c[0]), double(c[1]), double(c[2])});
               if (candidate < distance[q]) distance[q] = candidate, nearest[q] = c;
             }
           }
     }
+}
+
+/// The signed distance to the mesh at every lattice node: exact by the AABB tree in the band around
+/// the faces, from the sweeps elsewhere; negative inside (ray casting with exact predicates).
+std::vector<double> signed_distances(const TriangleMeshCgal& m, const Tree& tree, const Lattice& L) {
+  Side side(m);  // its own tree
+  const std::vector<std::uint8_t> in_band = band_of(m, L);
+  std::vector<std::size_t> band_nodes;
+  for (std::size_t q = 0; q < L.nodes(); ++q)
+    if (in_band[q]) band_nodes.push_back(q);
+  std::vector<double> distance(L.nodes(), std::numeric_limits<double>::infinity());
+  std::vector<std::array<float, 3>> nearest(L.nodes(), {NAN, NAN, NAN});
+  const std::size_t side_nodes = L.side();
+  const auto coordinates = [&](std::size_t q) {
+    return std::array<std::size_t, 3>{q % side_nodes, (q / side_nodes) % side_nodes, q / (side_nodes * side_nodes)};
+  };
+  const Point3 center = L.center;
+  const CgalPoint middle(center.x, center.y, center.z);  // inside the mesh's box: lazy set-ups happen here
+  (void)tree.closest_point(middle);
+  (void)side(middle);
+#pragma omp parallel for schedule(dynamic, 256)
+  for (std::size_t b = 0; b < band_nodes.size(); ++b) {
+    const std::size_t q = band_nodes[b];
+    const auto [i, j, k] = coordinates(q);
+    const CgalPoint p = L.node(i, j, k);
+    const CgalPoint c = tree.closest_point(p);
+    distance[q] = std::sqrt(CGAL::squared_distance(p, c));
+    nearest[q] = {float(c.x() - center.x), float(c.y() - center.y), float(c.z() - center.z)};  // from the centre
+  }
+  sweep_nearest_points(L, in_band, distance, nearest);
   std::vector<std::array<float, 3>>().swap(nearest);
   std::atomic<bool> unreached = false;
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::size_t k = 0; k < side_nodes; ++k)
     for (std::size_t j = 0; j < side_nodes; ++j)
       for (std::size_t i = 0; i < side_nodes; ++i) {
-        const std::size_t q = index(i, j, k);
+        const std::size_t q = L.index(i, j, k);
         if (!std::isfinite(distance[q])) unreached = true;
-        if (side(node(i, j, k)) == CGAL::ON_BOUNDED_SIDE) distance[q] = -distance[q];
+        if (side(L.node(i, j, k)) == CGAL::ON_BOUNDED_SIDE) distance[q] = -distance[q];
       }
   if (unreached) throw std::logic_error("MeshSurface: a lattice node without a nearest point");
-  spline_ = std::make_shared<const LatticeSpline>(lower, spacing, n, std::move(distance));
+  return distance;
+}
+
+}  // namespace
+
+MeshSurface::MeshSurface(const PolygonSoup& soup, int resolution, const std::string& field) {
+  check_mesh_resolution(resolution);
+  std::vector<CgalPoint> points;
+  std::vector<std::vector<std::size_t>> polygons;
+  checked_soup(soup, field, points, polygons);
+  auto mesh = std::make_unique<Mesh>();
+  TriangleMeshCgal& m = mesh->mesh;
+  closed_mesh(points, polygons, field, m, warnings_);
+  vertices_ = num_vertices(m);
+  faces_ = num_faces(m);
+  mesh->tree.insert(faces(m).first, faces(m).second, m);
+  mesh->tree.build();
+  mesh->tree.accelerate_distance_queries();
+
+  // The lattice: `resolution` cells across the mesh's largest side, a margin of 8 cells around it.
+  const CGAL::Bbox_3 box = PMP::bbox(m);
+  const double largest = std::max({box.xmax() - box.xmin(), box.ymax() - box.ymin(), box.zmax() - box.zmin()});
+  if (!(largest > 0)) fail(field, "the mesh is flat");
+  if (resolution == automatic_mesh_resolution) resolution = automatic_resolution(m, largest);
+  resolution_ = resolution;
+  constexpr int margin = 8;
+  Lattice L;
+  L.spacing = largest / resolution;
+  L.n = resolution + 2 * margin;
+  L.center = {(box.xmin() + box.xmax()) / 2, (box.ymin() + box.ymax()) / 2, (box.zmin() + box.zmax()) / 2};
+  L.lower = L.center - (0.5 * L.n * L.spacing) * Point3{1, 1, 1};
+  spline_ = std::make_shared<const LatticeSpline>(L.lower, L.spacing, L.n, signed_distances(m, mesh->tree, L));
   mesh_ = std::move(mesh);
+  const double spacing = L.spacing;
 
   const std::shared_ptr<const LatticeSpline> spline = spline_;
   try {

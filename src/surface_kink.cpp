@@ -217,6 +217,7 @@ struct RowEntry {
 
 struct SurfaceKink::State {
   explicit State(const Grid3& g) : grid(g) {}
+  struct Build;
   const Grid3& grid;
   int m = 0;
   std::vector<BandNode> band;  // sorted by key
@@ -244,38 +245,64 @@ SurfaceKink& SurfaceKink::operator=(SurfaceKink&&) noexcept = default;
 const SparseRows& SurfaceKink::galerkin() const { return state_->galerkin; }
 std::size_t SurfaceKink::cut_voxels() const { return state_->cut_voxels; }
 
-// Steps 1–2 stay together: step 2 is one quadrature loop over the cut voxels that shares step 1's
-// band of kink values and the patch locator.
-SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedSurface& patches, double c,
-                         const Execution& execution)
-    : state_(std::make_unique<State>(grid)) {
-  State& st = *state_;
-  st.m = patches.m;
-  const double h = grid.h();
-  const double band_width = 6 * h;  // the nodes of the two rings of voxels around the cut ones (≤ 5.2h)
-  const double tolerance = 1e-13 * h;
+/// The construction of the kink model, step by step, with what the steps share.
+struct SurfaceKink::State::Build {
+  Build(State& s, const Grid3& g, const Surface& surface, const PatchedSurface& p, double coefficient,
+        const Execution& e)
+      : st(s), grid(g), gamma(surface), patches(p), c(coefficient), execution(e) {}
+  State& st;
+  const Grid3& grid;
+  const Surface& gamma;
+  const PatchedSurface& patches;
+  double c;
+  const Execution& execution;
+  double h = grid.h();
+  double band_width = 6 * h;  // the nodes of the two rings of voxels around the cut ones (≤ 5.2h)
+  double tolerance = 1e-13 * h;
   // The feet of a voxel's points lie within 0.9h of its centre's (a point farther is sought among
   // all the triangles near the centre's); the triangles (edges about h) lie within 0.25h of γ, their
   // sag, which is O(κh²).
-  const double spread = 0.9 * h, margin = 0.25 * h;
-  const PatchLocator locate(patches, h);
-  const Box3 bounds = gamma.bounds();
-  std::array<int, 3> first, last;
-  for (int d = 0; d < 3; ++d) {
-    first[d] = std::max(0, grid.cell(d, bounds.lower[d] - band_width) - 1);
-    last[d] = std::min(grid.n(d), grid.cell(d, bounds.upper[d] + band_width) + 2);
-  }
+  double spread = 0.9 * h, margin = 0.25 * h;
+  PatchLocator locate{patches, h};
+  std::array<int, 3> first{}, last{};
+  std::exception_ptr failure;      // nearest_point throws on a vanishing gradient: kept, thrown after each loop
+  std::atomic<bool> stop = false;  // an interruption seen by thread 0 (the caller's) ends every thread's work
+  const GaussRule& rule = gauss_legendre(3);  // q(d) is smooth on the voxel: degree-5 exactness suffices
+  static constexpr int cut_q = 3;
+  double K[8][8] = {}, M[8][8] = {};  // the element matrices of a voxel
 
-  // nearest_point throws on a vanishing gradient: kept here and thrown after each parallel loop.
-  std::exception_ptr failure;
-  const auto keep = [&failure] {
+  void keep() {
 #pragma omp critical(fictus_surface_kink_failure)
     if (!failure) failure = std::current_exception();
-  };
+  }
+  void rethrow() const {
+    if (failure) std::rethrow_exception(failure);
+    execution.throw_if_interrupted();
+  }
+  void bounds();
+  void band();
+  void element_matrices();
+  std::vector<Grid3::Index> cut_voxels();
+  void add_rings(std::vector<Grid3::Index>& voxels);
+  std::vector<std::vector<RowEntry>> residuals(const std::vector<Grid3::Index>& voxels);
+  void voxel_residual(const Grid3::Index& cell, std::vector<int>& near, std::vector<int>& local,
+                      std::vector<std::pair<int, std::array<double, 8>>>& sums,
+                      std::vector<std::pair<Point3, double>>& inside, std::vector<RowEntry>& out);
+  void rows(std::vector<std::vector<RowEntry>> by_voxel);
+};
 
-  // 1. The band: the nodes outside ω within 6h of γ, with ψ and the patch of their nearest point.
+/// The range of nodes within the band's reach of γ's box.
+void SurfaceKink::State::Build::bounds() {
+  const Box3 box = gamma.bounds();
+  for (int d = 0; d < 3; ++d) {
+    first[d] = std::max(0, grid.cell(d, box.lower[d] - band_width) - 1);
+    last[d] = std::min(grid.n(d), grid.cell(d, box.upper[d] + band_width) + 2);
+  }
+}
+
+/// Step 1. The band: the nodes outside ω within 6h of γ, with ψ and the patch of their nearest point.
+void SurfaceKink::State::Build::band() {
   std::vector<std::vector<BandNode>> band_by_z(std::size_t(last[2] - first[2] + 1));
-  std::atomic<bool> stop = false;  // an interruption seen by thread 0 (the caller's) ends every thread's work
 #pragma omp parallel for num_threads(execution.threads()) schedule(dynamic, 1)
   for (int k = first[2]; k <= last[2]; ++k) {
     if (omp_get_thread_num() == 0 && execution.interrupt_requested()) stop = true;
@@ -295,34 +322,29 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
       keep();
     }
   }
-  if (failure) std::rethrow_exception(failure);
-  execution.throw_if_interrupted();
+  rethrow();
   for (auto& layer : band_by_z) st.band.insert(st.band.end(), layer.begin(), layer.end());
   std::sort(st.band.begin(), st.band.end(), [](const BandNode& a, const BandNode& b) { return a.key < b.key; });
+}
 
-  // 2. r_j,k = a(ψ_j − I_hψ_j, φ_k) on every cut voxel (the part outside ω is the whole voxel minus
-  //    its part in ω, ψ_j's smooth extension q(d) on both) and on two rings of outside voxels around
-  //    them; I_hψ_j takes the element matrix.
-  //    Each quadrature point goes to the patch its nearest point of γ lies on.
-  const GaussRule& rule = gauss_legendre(3);  // q(d) is smooth on the voxel: degree-5 exactness suffices
-  constexpr int cut_q = 3;
-  // The element matrices of a voxel (exact by 2 Gauss points per axis).
-  double K[8][8] = {}, M[8][8] = {};
-  {
-    const GaussRule& two = gauss_legendre(2);
-    for (int c3 = 0; c3 < 2; ++c3)
-      for (int b = 0; b < 2; ++b)
-        for (int a = 0; a < 2; ++a) {
-          const Q1Element<3> e({two.nodes[a], two.nodes[b], two.nodes[c3]}, h);
-          const double w = two.weights[a] * two.weights[b] * two.weights[c3] * h * h * h;
-          for (int l = 0; l < 8; ++l)
-            for (int k = 0; k < 8; ++k) {
-              K[l][k] += w * dot(e.gradient(l), e.gradient(k));
-              M[l][k] += w * e.value[l] * e.value[k];
-            }
-        }
-  }
-  // The cut voxels: those near γ with corners on both sides of γ or a part in ω neither empty nor whole.
+/// The element matrices of a voxel (exact by 2 Gauss points per axis).
+void SurfaceKink::State::Build::element_matrices() {
+  const GaussRule& two = gauss_legendre(2);
+  for (int c3 = 0; c3 < 2; ++c3)
+    for (int b = 0; b < 2; ++b)
+      for (int a = 0; a < 2; ++a) {
+        const Q1Element<3> e({two.nodes[a], two.nodes[b], two.nodes[c3]}, h);
+        const double w = two.weights[a] * two.weights[b] * two.weights[c3] * h * h * h;
+        for (int l = 0; l < 8; ++l)
+          for (int k = 0; k < 8; ++k) {
+            K[l][k] += w * dot(e.gradient(l), e.gradient(k));
+            M[l][k] += w * e.value[l] * e.value[k];
+          }
+      }
+}
+
+/// Step 2a. The cut voxels: those near γ with corners on both sides of γ or a part in ω neither empty nor whole.
+std::vector<Grid3::Index> SurfaceKink::State::Build::cut_voxels() {
   std::vector<Grid3::Index> near_voxels;
   for (int k = first[2]; k < last[2]; ++k)
     for (int j = first[1]; j < last[1]; ++j)
@@ -355,48 +377,54 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
     is_cut[n] = volume > 1e-12 * h * h * h && volume < (1 - 1e-12) * h * h * h;
   }
   execution.throw_if_interrupted();
-  std::vector<Grid3::Index> voxels;  // the cut ones, then the ring of outside voxels around their nodes
+  std::vector<Grid3::Index> voxels;
   for (std::size_t n = 0; n < near_voxels.size(); ++n)
     if (is_cut[n]) voxels.push_back(near_voxels[n]);
-  near_voxels = {};
-  st.cut_voxels = voxels.size();
-  // Two rings of outside voxels around them. Σ_j λ_j ψ_j jumps by (λ_j − λ_k)·q(d) across the normal
-  // planes through the patches' borders, so its residual a(ψ − I_hψ, φ) is not small in the voxels
-  // beside the cut ones either (measured on the manufactured sphere, L²(ω) at N = 64: cut voxels only
-  // 4.0e-3, one ring 1.3e-3, two 8.2e-4, three 8.3e-4).
+  return voxels;
+}
+
+/// Step 2b. Two rings of outside voxels around the cut ones. Σ_j λ_j ψ_j jumps by (λ_j − λ_k)·q(d) across the normal
+/// planes through the patches' borders, so its residual a(ψ − I_hψ, φ) is not small in the voxels
+/// beside the cut ones either (measured on the manufactured sphere, L²(ω) at N = 64: cut voxels only
+/// 4.0e-3, one ring 1.3e-3, two 8.2e-4, three 8.3e-4).
+void SurfaceKink::State::Build::add_rings(std::vector<Grid3::Index>& voxels) {
   constexpr int rings = 2;
-  {
-    std::vector<std::size_t> have;
-    for (const Grid3::Index& cell : voxels) have.push_back(st.key(cell));
-    std::sort(have.begin(), have.end());
-    const std::size_t n0 = std::size_t(grid.n(0) + 1), n1 = std::size_t(grid.n(1) + 1);
-    std::size_t begin = 0;
-    for (int ring = 0; ring < rings; ++ring) {
-      std::vector<std::size_t> next;
-      const std::size_t end_of_layer = voxels.size();
-      for (std::size_t v = begin; v < end_of_layer; ++v)
-        for (int dz = -1; dz <= 1; ++dz)
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-              const Grid3::Index cell{voxels[v][0] + dx, voxels[v][1] + dy, voxels[v][2] + dz};
-              if (cell[0] >= 0 && cell[1] >= 0 && cell[2] >= 0 && cell[0] < grid.n(0) && cell[1] < grid.n(1) &&
-                  cell[2] < grid.n(2))
-                next.push_back(st.key(cell));
-            }
-      std::sort(next.begin(), next.end());
-      next.erase(std::unique(next.begin(), next.end()), next.end());
-      std::vector<std::size_t> added;
-      for (std::size_t key : next) {
-        if (std::binary_search(have.begin(), have.end(), key)) continue;
-        const Grid3::Index cell{int(key % n0), int(key / n0 % n1), int(key / (n0 * n1))};
-        const Point3 center{grid.x(cell[0]) + h / 2, grid.y(cell[1]) + h / 2, grid.z(cell[2]) + h / 2};
-        if (gamma.level(center) > 0) voxels.push_back(cell), added.push_back(key);  // wholly outside ω
-      }
-      have.insert(have.end(), added.begin(), added.end());
-      std::sort(have.begin(), have.end());
-      begin = end_of_layer;
+  std::vector<std::size_t> have;
+  for (const Grid3::Index& cell : voxels) have.push_back(st.key(cell));
+  std::sort(have.begin(), have.end());
+  const std::size_t n0 = std::size_t(grid.n(0) + 1), n1 = std::size_t(grid.n(1) + 1);
+  std::size_t begin = 0;
+  for (int ring = 0; ring < rings; ++ring) {
+    std::vector<std::size_t> next;
+    const std::size_t end_of_layer = voxels.size();
+    for (std::size_t v = begin; v < end_of_layer; ++v)
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const Grid3::Index cell{voxels[v][0] + dx, voxels[v][1] + dy, voxels[v][2] + dz};
+            if (cell[0] >= 0 && cell[1] >= 0 && cell[2] >= 0 && cell[0] < grid.n(0) && cell[1] < grid.n(1) &&
+                cell[2] < grid.n(2))
+              next.push_back(st.key(cell));
+          }
+    std::sort(next.begin(), next.end());
+    next.erase(std::unique(next.begin(), next.end()), next.end());
+    std::vector<std::size_t> added;
+    for (std::size_t key : next) {
+      if (std::binary_search(have.begin(), have.end(), key)) continue;
+      const Grid3::Index cell{int(key % n0), int(key / n0 % n1), int(key / (n0 * n1))};
+      const Point3 center{grid.x(cell[0]) + h / 2, grid.y(cell[1]) + h / 2, grid.z(cell[2]) + h / 2};
+      if (gamma.level(center) > 0) voxels.push_back(cell), added.push_back(key);  // wholly outside ω
     }
+    have.insert(have.end(), added.begin(), added.end());
+    std::sort(have.begin(), have.end());
+    begin = end_of_layer;
   }
+}
+
+/// Step 2c. r_j,k = a(ψ_j − I_hψ_j, φ_k) on every cut voxel (the part outside ω is the whole voxel minus
+/// its part in ω, ψ_j's smooth extension q(d) on both) and on the rings of outside voxels around them;
+/// I_hψ_j takes the element matrix. Each quadrature point goes to the patch its nearest point of γ lies on.
+std::vector<std::vector<RowEntry>> SurfaceKink::State::Build::residuals(const std::vector<Grid3::Index>& voxels) {
   std::vector<std::vector<RowEntry>> by_voxel(voxels.size());  // summed in voxel order: any thread count
 #pragma omp parallel num_threads(execution.threads())
   {
@@ -407,70 +435,81 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
     for (std::size_t n = 0; n < voxels.size(); ++n) try {
         if (omp_get_thread_num() == 0 && n % 64 == 0 && execution.interrupt_requested()) stop = true;
         if (stop) continue;
-        const Grid3::Index cell = voxels[n];
-        const Point3 lower{grid.x(cell[0]), grid.y(cell[1]), grid.z(cell[2])};
-        const Point3 center = lower + Point3{h / 2, h / 2, h / 2};
-        const SurfaceFoot centre = nearest_point(gamma, center, center, tolerance);
-        locate.near(centre.foot, near);
-        // The triangles that can hold the feet within `spread` of the centre's (the margin covers the
-        // triangles' distance from γ): each point's patch is sought among those alone.
-        locate.within(centre.foot, spread + margin, near, local);
-        bool one_patch = !local.empty();
-        for (int t : local)
-          one_patch = one_patch && patches.patch_of[std::size_t(t)] == patches.patch_of[std::size_t(local[0])];
-        sums.clear();
-        auto sums_of = [&](int patch) -> std::array<double, 8>& {
-          for (auto& [p, v] : sums)
-            if (p == patch) return v;
-          return sums.emplace_back(patch, std::array<double, 8>{}).second;
-        };
-        auto add_point = [&](const Point3& x, double w) {
-          const SurfaceFoot foot = nearest_point(gamma, x, centre.foot, tolerance);
-          const bool close = norm(foot.foot - centre.foot) <= spread && !local.empty();
-          const std::vector<int>& pool = close ? local : near;
-          const int patch = close && one_patch ? patches.patch_of[std::size_t(local[0])]
-                            : pool.empty()     ? locate.patch(foot.foot)
-                                               : locate.patch(foot.foot, pool);
-          Point3 xi;
-          for (int d = 0; d < 3; ++d) xi[d] = (x[d] - lower[d]) / h;
-          const Q1Element<3> basis(xi, h);
-          const double q = foot.q();
-          const Point3 grad = foot.grad_q();
-          std::array<double, 8>& v = sums_of(patch);
-          for (int l = 0; l < 8; ++l) v[l] += w * (dot(grad, basis.gradient(l)) + c * q * basis.value[l]);
-        };
-        for (std::size_t c3 = 0; c3 < rule.nodes.size(); ++c3)
-          for (std::size_t b = 0; b < rule.nodes.size(); ++b)
-            for (std::size_t a = 0; a < rule.nodes.size(); ++a)
-              add_point(lower + h * Point3{rule.nodes[a], rule.nodes[b], rule.nodes[c3]},
-                        rule.weights[a] * rule.weights[b] * rule.weights[c3] * h * h * h);
-        inside.clear();
-        for_each_omega_point_in_voxel(grid, gamma, cell, cut_q,
-                                      [&](const Point3& x, double w) { inside.emplace_back(x, w); });
-        for (const auto& [x, w] : inside) add_point(x, -w);
-        for (int l = 0; l < 8; ++l) {
-          const Grid3::Index node{cell[0] + Q1Element<3>::offset(l, 0), cell[1] + Q1Element<3>::offset(l, 1),
-                                  cell[2] + Q1Element<3>::offset(l, 2)};
-          const BandNode* b = st.find(node);
-          if (!b || b->patch < 0) continue;
-          std::array<double, 8>& v = sums_of(b->patch);
-          for (int k = 0; k < 8; ++k) v[k] -= b->psi * (K[l][k] + c * M[l][k]);
-        }
-        by_voxel[n].reserve(8 * sums.size());
-        for (const auto& [patch, v] : sums)
-          for (int k = 0; k < 8; ++k) {
-            const Grid3::Index node{cell[0] + Q1Element<3>::offset(k, 0), cell[1] + Q1Element<3>::offset(k, 1),
-                                    cell[2] + Q1Element<3>::offset(k, 2)};
-            if (patch >= 0) by_voxel[n].push_back({patch, node, v[k]});
-          }
+        voxel_residual(voxels[n], near, local, sums, inside, by_voxel[n]);
       } catch (...) {
         keep();
       }
   }
-  if (failure) std::rethrow_exception(failure);
-  execution.throw_if_interrupted();
+  rethrow();
+  return by_voxel;
+}
 
-  // The rows: entries merged per (patch, node) in voxel order, nodes without an unknown dropped.
+/// The entries of r in one voxel.
+void SurfaceKink::State::Build::voxel_residual(const Grid3::Index& cell_index, std::vector<int>& near,
+                                               std::vector<int>& local,
+                                               std::vector<std::pair<int, std::array<double, 8>>>& sums,
+                                               std::vector<std::pair<Point3, double>>& inside,
+                                               std::vector<RowEntry>& out) {
+  const Grid3::Index cell = cell_index;
+  const Point3 lower{grid.x(cell[0]), grid.y(cell[1]), grid.z(cell[2])};
+  const Point3 center = lower + Point3{h / 2, h / 2, h / 2};
+  const SurfaceFoot centre = nearest_point(gamma, center, center, tolerance);
+  locate.near(centre.foot, near);
+  // The triangles that can hold the feet within `spread` of the centre's (the margin covers the
+  // triangles' distance from γ): each point's patch is sought among those alone.
+  locate.within(centre.foot, spread + margin, near, local);
+  bool one_patch = !local.empty();
+  for (int t : local)
+    one_patch = one_patch && patches.patch_of[std::size_t(t)] == patches.patch_of[std::size_t(local[0])];
+  sums.clear();
+  auto sums_of = [&](int patch) -> std::array<double, 8>& {
+    for (auto& [p, v] : sums)
+      if (p == patch) return v;
+    return sums.emplace_back(patch, std::array<double, 8>{}).second;
+  };
+  auto add_point = [&](const Point3& x, double w) {
+    const SurfaceFoot foot = nearest_point(gamma, x, centre.foot, tolerance);
+    const bool close = norm(foot.foot - centre.foot) <= spread && !local.empty();
+    const std::vector<int>& pool = close ? local : near;
+    const int patch = close && one_patch ? patches.patch_of[std::size_t(local[0])]
+                      : pool.empty()     ? locate.patch(foot.foot)
+                                         : locate.patch(foot.foot, pool);
+    Point3 xi;
+    for (int d = 0; d < 3; ++d) xi[d] = (x[d] - lower[d]) / h;
+    const Q1Element<3> basis(xi, h);
+    const double q = foot.q();
+    const Point3 grad = foot.grad_q();
+    std::array<double, 8>& v = sums_of(patch);
+    for (int l = 0; l < 8; ++l) v[l] += w * (dot(grad, basis.gradient(l)) + c * q * basis.value[l]);
+  };
+  for (std::size_t c3 = 0; c3 < rule.nodes.size(); ++c3)
+    for (std::size_t b = 0; b < rule.nodes.size(); ++b)
+      for (std::size_t a = 0; a < rule.nodes.size(); ++a)
+        add_point(lower + h * Point3{rule.nodes[a], rule.nodes[b], rule.nodes[c3]},
+                  rule.weights[a] * rule.weights[b] * rule.weights[c3] * h * h * h);
+  inside.clear();
+  for_each_omega_point_in_voxel(grid, gamma, cell, cut_q,
+                                [&](const Point3& x, double w) { inside.emplace_back(x, w); });
+  for (const auto& [x, w] : inside) add_point(x, -w);
+  for (int l = 0; l < 8; ++l) {
+    const Grid3::Index node{cell[0] + Q1Element<3>::offset(l, 0), cell[1] + Q1Element<3>::offset(l, 1),
+                            cell[2] + Q1Element<3>::offset(l, 2)};
+    const BandNode* b = st.find(node);
+    if (!b || b->patch < 0) continue;
+    std::array<double, 8>& v = sums_of(b->patch);
+    for (int k = 0; k < 8; ++k) v[k] -= b->psi * (K[l][k] + c * M[l][k]);
+  }
+  out.reserve(8 * sums.size());
+  for (const auto& [patch, v] : sums)
+    for (int k = 0; k < 8; ++k) {
+      const Grid3::Index node{cell[0] + Q1Element<3>::offset(k, 0), cell[1] + Q1Element<3>::offset(k, 1),
+                              cell[2] + Q1Element<3>::offset(k, 2)};
+      if (patch >= 0) out.push_back({patch, node, v[k]});
+    }
+}
+
+/// Step 3. The rows: entries merged per (patch, node) in voxel order, nodes without an unknown dropped.
+void SurfaceKink::State::Build::rows(std::vector<std::vector<RowEntry>> by_voxel) {
   std::vector<RowEntry> entries;
   for (const auto& voxel : by_voxel) entries.insert(entries.end(), voxel.begin(), voxel.end());
   by_voxel = {};
@@ -490,6 +529,20 @@ SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedS
     }
     rows.row_begin.push_back(rows.entries.size());
   }
+}
+
+SurfaceKink::SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedSurface& patches, double c,
+                         const Execution& execution)
+    : state_(std::make_unique<State>(grid)) {
+  state_->m = patches.m;
+  State::Build build(*state_, grid, gamma, patches, c, execution);
+  build.bounds();
+  build.band();  // 1.
+  build.element_matrices();
+  std::vector<Grid3::Index> voxels = build.cut_voxels();  // 2.
+  state_->cut_voxels = voxels.size();
+  build.add_rings(voxels);
+  build.rows(build.residuals(voxels));  // 3.
 }
 
 Eigen::SparseMatrix<double> SurfaceKink::direct(const SparseRows& rows) const {
@@ -578,18 +631,14 @@ std::pair<std::vector<int>, int> connected_parts(const Eigen::SparseMatrix<doubl
 
 }  // namespace
 
-FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, const SparseRows& C_gamma,
-                         const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C, GridVector load_of_omega,
-                         const FastSolver<3>& fast) {
-  const int m = B_Gamma.n_rows();
-  if (fast.singular()) throw std::invalid_argument("flux_balance: A is singular (a periodic box with c = 0)");
-  if (C_gamma.n_rows() != m || loads.n_rows() != m || D_C.rows() != m || D_C.cols() != m ||
-      (fast.c() != 0.0 && load_of_omega.size() != fast.grid().n_unknowns()))
-    throw std::invalid_argument("flux_balance: the rows, D_C and the load of ω do not match");
-  FluxBalance result;
-  result.area = detail::row_sums(B_Gamma);  // ∫_{P_j} 1 dS (no wall node lies near γ)
-  const Eigen::VectorXd& a = result.area;
+namespace {
 
+/// β_j: how far the readings' area-weighted column sums Σ_i a_i S_ij miss c∫_ω of the field of a unit
+/// layer on patch j (one adjoint solve, and one more for Φ when c ≠ 0).
+Eigen::VectorXd missed_fluxes(const SurfaceKink& kink, const SparseRows& C_gamma, const SparseRows& loads,
+                              const Eigen::SparseMatrix<double>& D_C, GridVector load_of_omega,
+                              const FastSolver<3>& fast, const Eigen::VectorXd& a, int& fast_solves) {
+  const int m = int(a.size());
   // Σ_i a_i S_ij = (B_Γ + R)_j·y + (D_Cᵀa)_j with y = A⁻¹C_γᵀa (one adjoint solve).
   std::vector<double> share;
   {
@@ -597,7 +646,7 @@ FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, con
     C_gamma.add_transposed(std::vector<double>(a.begin(), a.end()), y);
     fast.solve_in_place(y);
     loads.multiply(y, share);
-    ++result.fast_solves;
+    ++fast_solves;
   }
   const Eigen::VectorXd from_direct = D_C.transpose() * a;
   // c∫_ω of the field of a unit layer on patch j, I_h w_j = A⁻¹(B_Γ + R)ᵀe_j + I_hψ_j: with
@@ -606,20 +655,19 @@ FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, con
   if (fast.c() != 0.0) {
     const std::vector<double> band = kink.band_sums(load_of_omega);
     fast.solve_in_place(load_of_omega);  // now Φ
-    ++result.fast_solves;
+    ++fast_solves;
     loads.multiply(load_of_omega, flux);
     for (int j = 0; j < m; ++j) flux[std::size_t(j)] = fast.c() * (flux[std::size_t(j)] + band[std::size_t(j)]);
   }
   Eigen::VectorXd beta(m);
   for (int j = 0; j < m; ++j) beta[j] = share[std::size_t(j)] + from_direct[j] - flux[std::size_t(j)];
-  {
-    double mean = 0, square = 0;
-    for (int j = 0; j < m; ++j) mean += beta[j] / a[j] / m;
-    for (int j = 0; j < m; ++j) square += std::pow(beta[j] / a[j] - mean, 2) / m;
-    result.scatter = std::sqrt(square);
-    result.mean = beta.sum() / a.sum();
-  }
+  return beta;
+}
 
+/// X from β and the patch areas a (docs/math.md, "The flux balance of the patches").
+Eigen::SparseMatrix<double> balance_correction(const SparseRows& B_Gamma, const Eigen::VectorXd& beta,
+                                               const Eigen::VectorXd& a) {
+  const int m = int(a.size());
   // On each connected part of γ: μ = Σβ/Σa, and Lφ = (β − μa)/2 with φ = 0 at the part's first patch
   // (L is singular there; its right-hand side sums to zero over the part, so the pinned row holds too).
   const Eigen::SparseMatrix<double> W = row_overlaps(B_Gamma);
@@ -668,8 +716,36 @@ FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, con
     }
     x.emplace_back(i, i, diagonal);
   }
-  result.correction.resize(m, m);
-  result.correction.setFromTriplets(x.begin(), x.end());
+  Eigen::SparseMatrix<double> correction(m, m);
+  correction.setFromTriplets(x.begin(), x.end());
+  return correction;
+}
+
+}  // namespace
+
+FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, const SparseRows& C_gamma,
+                         const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C, GridVector load_of_omega,
+                         const FastSolver<3>& fast) {
+  const int m = B_Gamma.n_rows();
+  if (fast.singular()) throw std::invalid_argument("flux_balance: A is singular (a periodic box with c = 0)");
+  if (C_gamma.n_rows() != m || loads.n_rows() != m || D_C.rows() != m || D_C.cols() != m ||
+      (fast.c() != 0.0 && load_of_omega.size() != fast.grid().n_unknowns()))
+    throw std::invalid_argument("flux_balance: the rows, D_C and the load of ω do not match");
+  FluxBalance result;
+  result.area = detail::row_sums(B_Gamma);  // ∫_{P_j} 1 dS (no wall node lies near γ)
+  const Eigen::VectorXd& a = result.area;
+
+  const Eigen::VectorXd beta =
+      missed_fluxes(kink, C_gamma, loads, D_C, std::move(load_of_omega), fast, a, result.fast_solves);
+  {
+    double mean = 0, square = 0;
+    for (int j = 0; j < m; ++j) mean += beta[j] / a[j] / m;
+    for (int j = 0; j < m; ++j) square += std::pow(beta[j] / a[j] - mean, 2) / m;
+    result.scatter = std::sqrt(square);
+    result.mean = beta.sum() / a.sum();
+  }
+
+  result.correction = balance_correction(B_Gamma, beta, a);
   return result;
 }
 
