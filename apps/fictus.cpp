@@ -81,15 +81,37 @@ std::string parse_error_line(const std::string& message, const std::vector<std::
 
 bool formulation_or_solver(const fictus::OptionSpec& s) { return s.section == "formulation" || s.section == "solver"; }
 
-void print_summary(const fictus::Solution& s) {
-  std::printf("N = %d (h = %.3g), n = %zu nodes, m = %d, variant %s, inner solver %s\n", s.grid.nx(), s.grid.h(),
-              s.grid.n_nodes(), s.collocation.m, fictus::to_string(s.options.variant),
-              fictus::to_string(s.options.inner));
+/// What a 3-D solve adds to the summary: the nested start, the flux balance, the far field.
+template <int dim>
+void print_solver_extras(const fictus::BasicSolution<dim>& s) {
+  if (s.nested_start && s.nested_start->skipped.empty())
+    std::printf("Newton started from the contact set of the N = %d solve (m = %d, %d Newton steps, %.2f s)\n",
+                s.nested_start->N, s.nested_start->multipliers, s.nested_start->newton_steps, s.nested_start->seconds);
+  else if (s.nested_start)
+    std::printf("no nested start (%s)\n", s.nested_start->skipped.c_str());
+  if (s.flux_balance)
+    std::printf(
+        "flux balance: before it each patch's reading missed its share of the flux by %.2e (scatter), "
+        "a constant layer's by %.2e; the data's readings moved by %.2e\n",
+        s.flux_balance->scatter, s.flux_balance->mean, s.flux_balance->data_shift);
+  if (s.far_field) {
+    const fictus::FarFieldReport& a = s.far_field->assembly;
+    std::printf("Schur complement: %.1f%% of the pairs interpolated; the last %d Newton steps on the exact one\n",
+                100 * a.far_pairs / (a.far_pairs + a.near_pairs), s.far_field->exact_steps);
+  }
+  if (s.condition_number) std::printf("condition number of the Newton matrix: %.3e\n", *s.condition_number);
+}
+
+template <int dim>
+void print_summary(const fictus::BasicSolution<dim>& s) {
+  std::printf("%sN = %d (h = %.3g), n = %zu nodes, m = %d%s, variant %s, inner solver %s\n", dim == 3 ? "3-D, " : "",
+              s.grid.nx(), s.grid.h(), s.grid.n_nodes(), s.n_points(), dim == 3 ? " patches" : "",
+              fictus::to_string(s.options.variant), fictus::to_string(s.options.inner));
   std::printf("Newton: %d steps, %s, %ld active of %d; fast solves %zu, Krylov iterations %d\n", s.newton.iterations,
               s.newton.converged ? "converged" : "NOT converged",
-              long(std::count(s.newton.active.begin(), s.newton.active.end(), 1)), s.collocation.m, s.fast_solves,
+              long(std::count(s.newton.active.begin(), s.newton.active.end(), 1)), s.n_points(), s.fast_solves,
               s.inner_iterations);
-  if (s.condition_number) std::printf("condition number of the Newton matrix: %.3e\n", *s.condition_number);
+  print_solver_extras(s);
   std::printf("Signorini checks: min gap %.2e, min du/dn %.2e, max |complementarity| %.2e\n", s.signorini.min_gap,
               s.signorini.min_normal_derivative, s.signorini.max_complementarity);
   if (s.check)
@@ -133,6 +155,8 @@ std::pair<int, int> parse_levels(const std::string& text) {
 /// What `fictus solve` was given on the command line.
 struct SolveCommand {
   std::string problem_path, out = "results/solve";
+  std::string mesh_file;                       // --file: geometry.file of a 3-D mesh problem
+  double mesh_resolution = -1;                 // --resolution: geometry.resolution (-1: the file's)
   std::vector<std::string> files, parameters;  // parameters: NAME=VALUE
   bool quiet = false;
   fictus::cli::OptionFlags flags;
@@ -142,128 +166,20 @@ struct SolveCommand {
 
 /// Progress on stderr, flushed (also when redirected): each step of a long solve as it ends, with
 /// the time since the start and the peak memory so far.
-void print_progress_lines(fictus::FictitiousDomainSolver<2>& solver) {
+std::function<void(const std::string&, double)> progress_lines() {
   const auto start = std::chrono::steady_clock::now();
-  solver.set_progress([start](const std::string& phase, double seconds) {
+  return [start](const std::string& phase, double seconds) {
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::fprintf(stderr, "fictus:   %-16s %8.2f s   (elapsed %.1f s, peak memory %.2f GiB)\n", phase.c_str(), seconds,
                  elapsed, fictus::peak_memory_bytes() / double(1 << 30));
     std::fflush(stderr);
-  });
+  };
 }
 
-/// `fictus solve` of a 3-D problem file ([domain] dim = 3): the surface solver, its output files.
-int run_solve_surface(const std::string& text, const SolveCommand& command) {
-  if (!command.parameters.empty()) throw std::invalid_argument("--parameter: 3-D problem files have no [parameters]");
-  fictus::SurfaceProblemSpec spec = fictus::parse_surface_problem_text(text, command.problem_path);
-  for (const std::string& w : spec.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
-  std::string name = command.problem_path.substr(command.problem_path.find_last_of('/') + 1);
-  spec.name = name.substr(0, name.rfind(".toml"));
-  if (command.flags.given("box"))
-    throw std::invalid_argument("--box: a 3-D box is domain.box = [x0, y0, z0, x1, y1, z1] in the problem file");
-  fictus::Problem plane;  // the flags set N, boundary and c through a 2-D problem: taken over when given
-  plane.N = spec.problem.N;
-  plane.boundary = spec.problem.boundary;
-  plane.c = spec.problem.c;
-  command.flags.apply(plane, spec.options);
-  spec.problem.N = plane.N;
-  spec.problem.boundary = plane.boundary;
-  spec.problem.c = plane.c;
-  if (spec.problem.N > 1024) throw std::invalid_argument("domain.N: at most 1024 in 3-D");
-  spec.options.validate();
-  if (command.out_option->count() > 0) spec.output.dir = command.out;
-  if (command.files_option->count() > 0) {
-    const auto& names = fictus::surface_output_file_names();
-    for (const std::string& f : command.files)
-      if (std::find(names.begin(), names.end(), f) == names.end())
-        throw std::invalid_argument("output.files: unknown file \"" + f +
-                                    "\" (results.json, points.csv, solution.vti, surface.vtp)");
-    spec.output.files = command.files;
-  }
-  if (!spec.output.dir.empty()) fictus::cli::check_output_folder(spec.output.dir, spec.output.files);
-  fictus::check_memory(spec.problem, spec.options);  // before anything is allocated
-  const double seconds = fictus::estimated_seconds(spec.problem, spec.options);
-  const auto start = std::chrono::steady_clock::now();
-  std::function<void(const std::string&, double)> progress;
-  const bool long_run = !command.quiet && seconds >= 2;  // long runs say what is coming and how it goes
-  if (long_run)
-    progress = [start](const std::string& phase, double seconds) {
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      std::fprintf(stderr, "fictus:   %-16s %8.2f s   (elapsed %.1f s, peak memory %.2f GiB)\n", phase.c_str(), seconds,
-                   elapsed, fictus::peak_memory_bytes() / double(1 << 30));
-      std::fflush(stderr);
-    };
-  if (long_run) {
-    std::fprintf(stderr, "fictus: solving a 3-D problem, N = %d: estimated %.2g GiB and %.2g s\n", spec.problem.N,
-                 fictus::estimated_peak_bytes(spec.problem, spec.options) / double(1 << 30), seconds);
-    std::fflush(stderr);
-  }
-  fictus::SurfaceSolution s = fictus::solve(spec.problem, spec.options, progress);
-  s.peak_memory_bytes = fictus::peak_memory_bytes();
-  for (const std::string& w : s.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
-  if (!s.newton.converged) throw NewtonFailure("solver.max_newton: Newton did not converge: " + s.newton.failure);
-  if (!command.quiet) {
-    const long active = long(std::count(s.newton.active.begin(), s.newton.active.end(), 1));
-    std::printf("3-D, N = %d (h = %.3g), %zu nodes, m = %d patches, variant %s, inner solver %s\n", s.grid.nx(),
-                s.grid.h(), s.grid.n_nodes(), s.gamma.m, fictus::to_string(s.options.variant),
-                fictus::to_string(s.options.inner));
-    std::printf("Newton: %d steps, converged, %ld active of %d; fast solves %zu\n", s.newton.iterations, active,
-                s.gamma.m, s.fast_solves);
-    if (s.nested_start && s.nested_start->skipped.empty())
-      std::printf("Newton started from the contact set of the N = %d solve (m = %d, %d Newton steps, %.2f s)\n",
-                  s.nested_start->N, s.nested_start->multipliers, s.nested_start->newton_steps,
-                  s.nested_start->seconds);
-    else if (s.nested_start)
-      std::printf("no nested start (%s)\n", s.nested_start->skipped.c_str());
-    if (s.flux_balance)
-      std::printf(
-          "flux balance: before it each patch's reading missed its share of the flux by %.2e (scatter), "
-          "a constant layer's by %.2e; the data's readings moved by %.2e\n",
-          s.flux_balance->scatter, s.flux_balance->mean, s.flux_balance->data_shift);
-    if (s.far_field) {
-      const fictus::FarFieldReport& a = s.far_field->assembly;
-      std::printf("Schur complement: %.1f%% of the pairs interpolated; the last %d Newton steps on the exact one\n",
-                  100 * a.far_pairs / (a.far_pairs + a.near_pairs), s.far_field->exact_steps);
-    }
-    std::printf("Signorini checks: min gap %.2e, min du/dn %.2e, max |complementarity| %.2e\n", s.signorini.min_gap,
-                s.signorini.min_normal_derivative, s.signorini.max_complementarity);
-    if (s.errors)
-      std::printf("relative errors: L2(omega) %.3e, H1(omega) %.3e (semi %.3e), L2(gamma) %.3e\n",
-                  s.errors->rel_l2_omega, s.errors->rel_h1_omega, s.errors->rel_h1semi_omega, s.errors->rel_l2_gamma);
-    std::printf("time %.3f s, peak memory %.1f MiB\n", s.timings.total, s.peak_memory_bytes / 1048576.0);
-  }
-  if (!spec.output.dir.empty()) {
-    std::vector<fictus::cli::OutputFile> files;
-    for (const std::string& file : spec.output.files) {
-      if (file == "results.json")
-        files.push_back(
-            {file, [&](std::ostream& out) { out << fictus::cli::solution_to_json(spec, s).dump(2) << "\n"; }});
-      else if (file == "points.csv")
-        files.push_back({file, [&](std::ostream& out) { out << fictus::cli::points_csv(s); }});
-      else if (file == "solution.vti")
-        files.push_back({file, [&](std::ostream& out) { fictus::cli::write_vti(out, spec.problem, s); }});
-      else if (file == "surface.vtp")
-        files.push_back({file, [&](std::ostream& out) { fictus::cli::write_surface_vtp(out, s); }});
-      if (file == "surface.vtp" && s.delta > 0)
-        files.push_back(
-            {"offset_surface.vtp", [&](std::ostream& out) { fictus::cli::write_offset_surface_vtp(out, s); }});
-    }
-    add_multiblock(files);
-    fictus::cli::write_output_set(spec.output.dir, files);
-    if (!command.quiet) std::printf("wrote %zu files to %s/\n", files.size(), spec.output.dir.c_str());
-  }
-  return 0;
-}
-
-int run_solve(const SolveCommand& command) {
-  const std::string& problem_path = command.problem_path;
-  const fictus::cli::OptionFlags& flags = command.flags;
-  if (!problem_path.empty()) {
-    const std::string text = fictus::read_problem_text(problem_path);
-    if (fictus::problem_dimension(text, problem_path) == 3) return run_solve_surface(text, command);
-  }
+/// --parameter NAME=VALUE, each checked.
+fictus::ParameterValues parameter_values(const std::vector<std::string>& given) {
   fictus::ParameterValues parameters;
-  for (const std::string& p : command.parameters) {
+  for (const std::string& p : given) {
     const std::size_t equals = p.find('=');
     std::size_t used = 0;
     double value = 0;
@@ -277,68 +193,109 @@ int run_solve(const SolveCommand& command) {
                                   p.substr(0, 60) + "\"");
     parameters[p.substr(0, equals)] = value;
   }
-  fictus::ProblemSpec spec = fictus::cli::problem_from(problem_path, flags, parameters);
+  return parameters;
+}
+
+/// The files of a run: results.json, points.csv, the VTK files (and Γ's in the smooth variant), and
+/// solution.vtm naming the VTK files.
+template <int dim>
+std::vector<fictus::cli::OutputFile> output_files(const fictus::BasicProblemSpec<dim>& spec,
+                                                  const fictus::BasicSolution<dim>& s, const json& input) {
+  const char* boundary_file = dim == 2 ? "curves.vtp" : "surface.vtp";
+  std::vector<fictus::cli::OutputFile> files;
+  for (const std::string& name : spec.output.files) {
+    if (name == "results.json")
+      files.push_back({name, [&](std::ostream& out) {
+                         out << fictus::cli::solution_to_json(spec.problem, s, input, spec.warnings).dump(2) << "\n";
+                       }});
+    else if (name == "points.csv")
+      files.push_back({name, [&](std::ostream& out) { out << fictus::cli::points_csv(s); }});
+    else if (name == "solution.vti")
+      files.push_back({name, [&](std::ostream& out) { fictus::cli::write_vti(out, spec.problem, s); }});
+    if (name != boundary_file) continue;
+    if constexpr (dim == 2) {
+      files.push_back({name, [&](std::ostream& out) { fictus::cli::write_curve_vtp(out, s); }});
+      if (s.delta > 0)
+        files.push_back({"offset_curve.vtp", [&](std::ostream& out) { fictus::cli::write_offset_curve_vtp(out, s); }});
+    } else {
+      files.push_back({name, [&](std::ostream& out) { fictus::cli::write_surface_vtp(out, s); }});
+      if (s.delta > 0)
+        files.push_back(
+            {"offset_surface.vtp", [&](std::ostream& out) { fictus::cli::write_offset_surface_vtp(out, s); }});
+    }
+  }
+  add_multiblock(files);
+  return files;
+}
+
+/// The problem a solve command names: the file (with --file and --resolution in a 3-D mesh problem)
+/// or the paper's problem, the flags applied; --out and --files.
+template <int dim>
+fictus::BasicProblemSpec<dim> solve_spec(std::string text, const SolveCommand& command) {
+  if (command.mesh_file.size() || command.mesh_resolution >= 0) {
+    if (dim != 3)
+      throw std::invalid_argument("--file: a mesh file is the geometry of a 3-D problem ([domain] dim = 3)");
+    text = fictus::with_mesh_overrides(text, command.problem_path, command.mesh_file, command.mesh_resolution);
+  }
+  fictus::BasicProblemSpec<dim> spec = fictus::cli::problem_from_text<dim>(text, command.problem_path, command.flags,
+                                                                           parameter_values(command.parameters));
   if (command.out_option->count() > 0) spec.output.dir = command.out;
   if (command.files_option->count() > 0) {
+    const std::vector<std::string>& names = fictus::output_file_names(dim);
     for (const std::string& f : command.files)
-      if (std::find(fictus::output_file_names().begin(), fictus::output_file_names().end(), f) ==
-          fictus::output_file_names().end())
-        throw std::invalid_argument("output.files: unknown file \"" + f +
-                                    "\" (results.json, points.csv, solution.vti, curves.vtp)");
+      if (std::find(names.begin(), names.end(), f) == names.end())
+        throw std::invalid_argument("output.files: unknown file \"" + f.substr(0, 40) + "\" (" + names[0] + ", " +
+                                    names[1] + ", " + names[2] + ", " + names[3] + ")" +
+                                    fictus::did_you_mean(f, names));
     spec.output.files = command.files;
   }
-  for (const std::string& w : spec.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
+  return spec;
+}
 
-  const fictus::Problem& problem = spec.problem;
+/// `fictus solve` in either dimension: the problem, the estimate before any work, the solve with
+/// progress lines on long runs, the summary and the output files.
+template <int dim>
+int run_solve_in(const std::string& text, const SolveCommand& command) {
+  const fictus::BasicProblemSpec<dim> spec = solve_spec<dim>(text, command);
+  for (const std::string& w : spec.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
   const json input = json::parse(spec.input_json);
   if (!spec.output.dir.empty()) fictus::cli::check_output_folder(spec.output.dir, spec.output.files);
-  fictus::check_memory(problem, spec.options);
-  const double seconds = fictus::estimated_seconds(problem, spec.options);
+  fictus::check_memory(spec.problem, spec.options);
+  const double seconds = fictus::estimated_seconds(spec.problem, spec.options);
   const bool long_run = seconds >= 2 && !command.quiet;
   if (long_run) {  // long runs say what is coming before the work starts
-    std::fprintf(stderr, "fictus: solving N = %d: estimated %.2g GiB and %.2g s\n", problem.N,
-                 fictus::estimated_peak_bytes(problem, spec.options) / double(1 << 30), seconds);
+    std::fprintf(stderr, "fictus: solving %sN = %d: estimated %.2g GiB and %.2g s\n", dim == 3 ? "a 3-D problem, " : "",
+                 spec.problem.N, fictus::estimated_peak_bytes(spec.problem, spec.options) / double(1 << 30), seconds);
     std::fflush(stderr);
   }
-  fictus::FictitiousDomainSolver solver(problem, spec.options);
-  if (long_run) print_progress_lines(solver);
-  fictus::Solution solution = solver.solve(problem, spec.options);
-  solution.peak_memory_bytes = fictus::peak_memory_bytes();
-  for (const std::string& w : solution.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
-  if (!solution.newton.converged) throw NewtonFailure(fictus::describe_newton_failure(solution));
-  if (!command.quiet) print_summary(solution);
-  if (!spec.output.dir.empty()) {
-    const fs::path dir = spec.output.dir;
-    std::vector<fictus::cli::OutputFile> files;
-    for (const std::string& name : spec.output.files) {
-      if (name == "results.json")
-        files.push_back({name, [&](std::ostream& out) {
-                           out << fictus::cli::solution_to_json(problem, solution, input).dump(2) << "\n";
-                         }});
-      else if (name == "points.csv")
-        files.push_back({name, [&](std::ostream& out) { out << fictus::cli::points_csv(solution); }});
-      else if (name == "solution.vti")
-        files.push_back({name, [&](std::ostream& out) { fictus::cli::write_vti(out, problem, solution); }});
-      else if (name == "curves.vtp")
-        files.push_back({name, [&](std::ostream& out) { fictus::cli::write_curve_vtp(out, solution); }});
-      if (name == "curves.vtp" && solution.delta > 0)
-        files.push_back(
-            {"offset_curve.vtp", [&](std::ostream& out) { fictus::cli::write_offset_curve_vtp(out, solution); }});
+  fictus::FictitiousDomainSolver<dim> solver(spec.problem, spec.options);
+  if (long_run) solver.set_progress(progress_lines());
+  fictus::BasicSolution<dim> s = solver.solve(spec.problem, spec.options, true, false);
+  s.peak_memory_bytes = fictus::peak_memory_bytes();
+  for (const std::string& w : s.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
+  if (!s.newton.converged) throw NewtonFailure(fictus::describe_newton_failure(s));
+  if (!command.quiet) print_summary(s);
+  if (spec.output.dir.empty()) return 0;
+  const std::vector<fictus::cli::OutputFile> files = output_files(spec, s, input);
+  fictus::cli::write_output_set(spec.output.dir, files);
+  if (!command.quiet) {
+    std::uintmax_t bytes = 0;
+    std::error_code error;
+    for (const auto& f : files) {
+      const std::uintmax_t size = fs::file_size(fs::path(spec.output.dir) / f.name, error);
+      if (!error) bytes += size;
     }
-    add_multiblock(files);
-    fictus::cli::write_output_set(dir, files);
-    if (!command.quiet) {
-      std::uintmax_t bytes = 0;
-      std::error_code error;
-      for (const std::string& name : spec.output.files) {
-        const std::uintmax_t size = fs::file_size(dir / name, error);
-        if (!error) bytes += size;
-      }
-      std::printf("wrote %zu files to %s/ (%.3g MiB; solution.vti is zlib-compressed)\n", spec.output.files.size(),
-                  spec.output.dir.c_str(), bytes / 1048576.0);
-    }
+    std::printf("wrote %zu files to %s/ (%.3g MiB; the VTK files are zlib-compressed)\n", files.size(),
+                spec.output.dir.c_str(), bytes / 1048576.0);
   }
   return 0;
+}
+
+int run_solve(const SolveCommand& command) {
+  const std::string text = command.problem_path.empty() ? "" : fictus::read_problem_text(command.problem_path);
+  if (!text.empty() && fictus::problem_dimension(text, command.problem_path) == 3)
+    return run_solve_in<3>(text, command);
+  return run_solve_in<2>(text, command);
 }
 
 /// Runs the plot script with an argument vector (no shell: any folder name is safe).
@@ -440,6 +397,10 @@ int main(int argc, char** argv) {
   solve.out_option = solve_cmd->add_option("--out", solve.out, "output.dir: folder for the output files (\"\": none)")
                          ->capture_default_str();
   solve_cmd->add_option("--dir", solve.out, "alias of --out")->group("");
+  solve_cmd->add_option("--file", solve.mesh_file,
+                        "geometry.file of a 3-D mesh problem: a .off, .stl, .obj or .ply file (relative to here)");
+  solve_cmd->add_option("--resolution", solve.mesh_resolution,
+                        "geometry.resolution of a 3-D mesh problem: lattice cells across the mesh (0: automatic)");
   solve_cmd
       ->add_option("--parameter", solve.parameters,
                    "NAME=VALUE: a value for an entry of the problem file's [parameters] (repeatable)")
@@ -447,8 +408,9 @@ int main(int argc, char** argv) {
   solve_cmd->add_flag("--quiet", solve.quiet, "print only warnings and errors (no estimate, progress or summary)");
   solve.files_option =
       solve_cmd
-          ->add_option("--files", solve.files,
-                       "output.files, comma-separated: results.json,points.csv,solution.vti,curves.vtp")
+          ->add_option(
+              "--files", solve.files,
+              "output.files, comma-separated: results.json,points.csv,solution.vti,curves.vtp (3-D: surface.vtp)")
           ->delimiter(',')
           ->allow_extra_args(false);
   const std::map<std::string, std::string> paper_note = {{"multipliers", "without a problem file: the paper's m"},
@@ -484,8 +446,10 @@ int main(int argc, char** argv) {
   sweep_cmd->add_option("problem", sweep_args.problem_path, "problem file (default: the paper's problem)");
   sweep_cmd->add_option("--g-scale", sweep_args.g_scale, "obstacle factors: a,b,c or start:stop:count");
   sweep_cmd->add_option("--rotate", sweep_args.rotate,
-                        "rotations of γ about its center [rad]: a,b,c or start:stop:count");
+                        "rotations of γ about its center [rad] (3-D: about --axis): a,b,c or start:stop:count");
   sweep_cmd->add_option("--move", sweep_args.move, "shifts of γ along x: a,b,c or start:stop:count");
+  sweep_cmd->add_option("--axis", sweep_args.axis,
+                        "3-D: the axis of --rotate through the centre of γ's bounding box: x, y or z (default z)");
   sweep_cmd->add_option("--parameter", sweep_args.parameter,
                         "NAME=LIST: values of a [parameters] entry of the problem file, e.g. a=0:0.2:11");
   sweep_cmd->add_option("--out", sweep_args.out, "write sweep.csv and sweep.json here (\"\": none)")
@@ -530,9 +494,12 @@ int main(int argc, char** argv) {
       } else if (as_json) {
         std::printf("%s\n", fictus::cli::options_schema_json().dump(1).c_str());
       } else {
-        for (const fictus::OptionSpec& s : fictus::option_specs())
-          std::printf("%-34s %-18s %s\n    %s\n", s.name().c_str(), fictus::option_text(s, s.default_value()).c_str(),
-                      s.rule.c_str(), s.meaning.c_str());
+        for (const fictus::OptionSpec& s : fictus::option_specs()) {
+          std::string dims;  // "2-D", "3-D" or "2-D, 3-D"
+          for (int d : s.dims) dims += (dims.empty() ? "" : ", ") + std::to_string(d) + "-D";
+          std::printf("%-34s %-10s default %s\n    %s\n    %s\n", s.name().c_str(), dims.c_str(),
+                      fictus::cli::plain(fictus::default_text(s)).c_str(), s.rule.c_str(), s.meaning.c_str());
+        }
       }
       return 0;
     }

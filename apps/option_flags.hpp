@@ -20,8 +20,15 @@ class OptionFlags {
   /// it names (e.g. the defaults that differ without a problem file).
   void add(CLI::App& command, const std::function<bool(const OptionSpec&)>& include,
            const std::map<std::string, std::string>& note = {});
-  /// Sets every option given on the command line into (problem, options); throws naming the key.
-  void apply(Problem& problem, SolverOptions& options) const;
+  /// Sets every option given on the command line into (domain, options); throws naming the key, and
+  /// refuses an option of the other dimension.
+  void apply(DomainSettings& domain, SolverOptions& options) const;
+  template <int dim>
+  void apply(BasicProblem<dim>& problem, SolverOptions& options) const {
+    DomainSettings domain = domain_of(problem);
+    apply(domain, options);
+    apply_domain(domain, problem);
+  }
   bool given(const std::string& key) const;
 
  private:
@@ -35,13 +42,18 @@ class OptionFlags {
   CLI::Option* no_condition_flag_ = nullptr;
 };
 
-/// The problem a command works on, with the flags applied and checked: the problem file at `path`
-/// (its [parameters] replaced by `parameters`), or without one the paper's problem with its m and δ
-/// unless the flags give them. `input` is set to what results.json echoes under "problem".
+/// The problem a command works on, with the flags applied and checked: the problem file's text (read
+/// once: a sweep's members, a file that may change or be a pipe), its [parameters] replaced by
+/// `parameters`, or without a file (2-D only) the paper's problem with its m and δ unless the flags
+/// give them. `shape` as in parse_problem.
+template <int dim>
+BasicProblemSpec<dim> problem_from_text(const std::string& text, const std::string& path, const OptionFlags& flags,
+                                        const ParameterValues& parameters = {},
+                                        std::shared_ptr<const typename BoundaryShape<dim>::type> shape = nullptr);
+/// The same for the 2-D problem file at `path`, or the paper's problem without one.
 ProblemSpec problem_from(const std::string& path, const OptionFlags& flags, const ParameterValues& parameters = {});
-/// The same from the file's text, read once (a sweep's members: the file may change or be a pipe).
-/// `curve` as in parse_problem_text.
-ProblemSpec problem_from_text(const std::string& text, const std::string& path, const OptionFlags& flags,
-                              const ParameterValues& parameters = {}, std::shared_ptr<const Curve> curve = nullptr);
+
+/// Markdown text as plain text for the terminal (without the backticks of `fictus options --markdown`).
+std::string plain(std::string text);
 
 }  // namespace fictus::cli

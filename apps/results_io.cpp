@@ -21,20 +21,28 @@ namespace fictus::cli {
 
 using nlohmann::json;
 
-json options_to_json(const Problem& problem, const SolverOptions& options) {
+template <int dim>
+json options_to_json(const BasicProblem<dim>& problem, const SolverOptions& options) {
   json j = json::object();
+  const DomainSettings domain = domain_of(problem);
   for (const OptionSpec& spec : option_specs())
-    std::visit([&](const auto& v) { j[spec.key] = v; }, spec.get(problem, options));
+    if (spec.applies_to(dim)) std::visit([&](const auto& v) { j[spec.key] = v; }, spec.get(domain, options));
   return j;
 }
+
+template json options_to_json(const BasicProblem<2>&, const SolverOptions&);
+template json options_to_json(const BasicProblem<3>&, const SolverOptions&);
 
 json options_schema_json() {
   static const char* const types[] = {"boolean", "integer", "number", "choice", "numbers"};
   json list = json::array();
   for (const OptionSpec& spec : option_specs()) {
     json j{{"section", spec.section}, {"key", spec.key},         {"type", types[int(spec.type)]},
-           {"rule", spec.rule},       {"meaning", spec.meaning}, {"aliases", spec.aliases}};
-    std::visit([&](const auto& v) { j["default"] = v; }, spec.default_value());
+           {"rule", spec.rule},       {"meaning", spec.meaning}, {"aliases", spec.aliases},
+           {"dims", spec.dims}};
+    std::visit([&](const auto& v) { j["default"] = v; }, spec.default_value(spec.applies_to(2) ? 2 : 3));
+    if (spec.applies_to(2) && spec.applies_to(3))
+      std::visit([&](const auto& v) { j["default_3d"] = v; }, spec.default_value(3));
     if (spec.type == OptionType::choice) j["choices"] = spec.choices;
     list.push_back(j);
   }
@@ -90,42 +98,105 @@ json errors_json(const ErrorNorms& e, const std::optional<PointErrors>& point_er
 
 }  // namespace
 
-json solution_to_json(const Problem& problem, const Solution& s, const json& input) {
+namespace {
+
+template <int dim>
+json grid_json(const Grid<dim>& g) {
+  json j = {{"N", g.nx()}, {"Ny", g.ny()}, {"h", g.h()}, {"n_nodes", g.n_nodes()}, {"n_unknowns", g.n_unknowns()}};
+  if constexpr (dim == 3) j["Nz"] = g.nz();
+  return j;
+}
+
+/// The boundary: its measure (length or area), the points' spacing, δ; 3-D: the triangles and a mesh's report.
+template <int dim>
+json boundary_json(const BasicProblem<dim>& problem, const BasicSolution<dim>& s) {
+  double measure = 0;
+  for (double w : s.weights()) measure += w;
+  json j = {{"measure", measure}, {"spacing", s.spacing()}, {"delta", s.delta}};
+  if constexpr (dim == 3) {
+    j["triangles"] = s.gamma.triangles.size();
+    if (const auto* mesh = dynamic_cast<const MeshSurface*>(problem.gamma.get()))
+      j["mesh"] = {{"vertices", mesh->mesh_vertices()},
+                   {"faces", mesh->mesh_faces()},
+                   {"resolution", mesh->resolution()},
+                   {"spacing", mesh->spacing()}};
+  }
+  return j;
+}
+
+template <int dim>
+json inner_json(const BasicSolution<dim>& s) {
+  json j = {{"solver", to_string(s.options.inner)},
+            {"fast_solves", s.fast_solves},
+            {"krylov_iterations", s.inner_iterations},
+            {"factorizations", s.factorizations}};
+  if (s.far_field) {
+    const FarFieldReport& a = s.far_field->assembly;
+    j["far_field"] = {{"far_fraction", a.far_pairs / (a.far_pairs + a.near_pairs)},
+                      {"far_blocks", a.far_blocks},
+                      {"near_blocks", a.near_blocks},
+                      {"exact_steps", s.far_field->exact_steps}};
+  }
+  return j;
+}
+
+json nested_start_json(const NestedStart& n) {
+  return n.skipped.empty() ? json{{"N", n.N},
+                                  {"multipliers", n.multipliers},
+                                  {"newton_steps", n.newton_steps},
+                                  {"active", n.active},
+                                  {"seconds", n.seconds}}
+                           : json{{"skipped", n.skipped}, {"seconds", n.seconds}};
+}
+
+}  // namespace
+
+template <int dim>
+json solution_to_json(const BasicProblem<dim>& problem, const BasicSolution<dim>& s, const json& input,
+                      const std::vector<std::string>& input_warnings) {
   json j;
   j["version"] = FICTUS_VERSION;
   j["commit"] = FICTUS_GIT_COMMIT;
+  j["dim"] = dim;
   j["problem"] = input;
   j["problem"]["name"] = problem.name;
   j["options"] = options_to_json(problem, s.options);
+  j["box"] = domain_of(problem).box;
+  j["grid"] = grid_json(s.grid);
+  j["multipliers"] = s.n_points();
+  j["boundary"] = boundary_json(problem, s);
   j["alpha"] = s.alpha;
-  j["grid"] = {{"N", s.grid.nx()},
-               {"Ny", s.grid.ny()},
-               {"h", s.grid.h()},
-               {"n_nodes", s.grid.n_nodes()},
-               {"n_unknowns", s.grid.n_unknowns()}};
-  j["multipliers"] = s.collocation.m;
-  j["curve"] = {{"length", s.collocation.length}, {"spacing", s.collocation.spacing}, {"delta", s.delta}};
   j["newton"] = newton_json(s.newton);
-  j["inner"] = {{"solver", to_string(s.options.inner)},
-                {"fast_solves", s.fast_solves},
-                {"krylov_iterations", s.inner_iterations}};
+  if (s.nested_start) j["newton"]["nested_start"] = nested_start_json(*s.nested_start);
+  j["inner"] = inner_json(s);
   j["timings"] = timings_json(s.timings);
   j["condition_number"] = s.condition_number ? json(*s.condition_number) : json(nullptr);
   j["signorini"] = signorini_json(s.signorini);
-  const ContactSummary contact = contact_summary(s);
-  j["contact"] = {{"points", contact.points},          {"measure", contact.measure}, {"force", contact.force},
-                  {"lambda_integral", contact.lambda}, {"min_gap", contact.min_gap}, {"max_gap", contact.max_gap}};
   if (s.check)
     j["signorini"]["check"] = {{"rule", s.check->rule},
                                {"min_normal_derivative", s.check->min_normal_derivative},
                                {"max_complementarity", s.check->max_complementarity},
                                {"max_difference", s.check->max_difference},
                                {"rms_difference", s.check->rms_difference}};
+  const ContactSummary contact = contact_summary(s);
+  j["contact"] = {{"points", contact.points},          {"measure", contact.measure}, {"force", contact.force},
+                  {"lambda_integral", contact.lambda}, {"min_gap", contact.min_gap}, {"max_gap", contact.max_gap}};
+  j["flux_balance"] = s.flux_balance ? json{{"scatter", s.flux_balance->scatter},
+                                            {"mean", s.flux_balance->mean},
+                                            {"data_shift", s.flux_balance->data_shift}}
+                                     : json(nullptr);
   if (s.errors) j["errors"] = errors_json(*s.errors, s.point_errors);
-  j["warnings"] = s.warnings;
+  std::vector<std::string> warnings = input_warnings;
+  warnings.insert(warnings.end(), s.warnings.begin(), s.warnings.end());
+  j["warnings"] = warnings;
   j["peak_memory_bytes"] = s.peak_memory_bytes;
   return j;
 }
+
+template json solution_to_json(const BasicProblem<2>&, const BasicSolution<2>&, const json&,
+                               const std::vector<std::string>&);
+template json solution_to_json(const BasicProblem<3>&, const BasicSolution<3>&, const json&,
+                               const std::vector<std::string>&);
 
 LevelResult level_result(const Solution& s) {
   LevelResult r;
@@ -233,24 +304,6 @@ void write_output_set(const fs::path& dir, const std::vector<OutputFile>& files)
   }
 }
 
-std::string points_csv(const Solution& s) {
-  std::ostringstream out;
-  out.precision(17);
-  // dudn_check: the independent check's ∂u/∂n (empty when there is none)
-  out << "i,s,x,y,nx,ny,g,u,dudn,lambda,contact,Gamma_x,Gamma_y,arc,dudn_check\n";
-  const bool check = s.check && int(s.check->normal_derivative.size()) == s.collocation.m;
-  for (int i = 0; i < s.collocation.m; ++i) {
-    const Point2 G = s.Gamma->position(s.collocation.t[i]);
-    out << i << ',' << s.collocation.s[i] << ',' << s.collocation.point[i].x << ',' << s.collocation.point[i].y << ','
-        << s.collocation.normal[i].x << ',' << s.collocation.normal[i].y << ',' << s.g[i] << ',' << s.trace[i] << ','
-        << s.normal_derivative[i] << ',' << s.lambda[i] << ',' << int(s.newton.active[i]) << ',' << G.x << ',' << G.y
-        << ',' << s.collocation.arc[i] << ',';
-    if (check) out << s.check->normal_derivative[i];
-    out << '\n';
-  }
-  return out.str();
-}
-
 std::string levels_csv(const std::vector<LevelResult>& rows) {
   std::ostringstream out;
   out.precision(10);
@@ -261,88 +314,41 @@ std::string levels_csv(const std::vector<LevelResult>& rows) {
   return out.str();
 }
 
-json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& s) {
-  json j;
-  j["version"] = FICTUS_VERSION;
-  j["commit"] = FICTUS_GIT_COMMIT;
-  j["dim"] = 3;
-  j["problem"] = json::parse(spec.input_json);
-  j["problem"]["name"] = spec.name;
-  const SolverOptions& o = s.options;
-  j["options"] = {{"variant", to_string(o.variant)},
-                  {"multipliers", o.multipliers},
-                  {"offset", o.offset},
-                  {"normal_derivative", to_string(o.normal_derivative)},
-                  {"normal_shift", o.normal_shift},
-                  {"schur", to_string(o.inner)},
-                  {"far_field", o.far_field},
-                  {"nested_start", o.nested_start},
-                  {"flux_balance", o.flux_balance},
-                  {"rho", o.rho},
-                  {"newton_tolerance", o.newton_tolerance},
-                  {"threads", o.threads},
-                  {"boundary", to_string(spec.problem.boundary)},
-                  {"c", spec.problem.c}};
-  j["grid"] = {{"N", s.grid.nx()}, {"Ny", s.grid.ny()},           {"Nz", s.grid.nz()},
-               {"h", s.grid.h()},  {"n_nodes", s.grid.n_nodes()}, {"n_unknowns", s.grid.n_unknowns()}};
-  if (const auto* mesh = dynamic_cast<const MeshSurface*>(spec.problem.gamma.get()))
-    j["mesh"] = {{"vertices", mesh->mesh_vertices()},
-                 {"faces", mesh->mesh_faces()},
-                 {"resolution", mesh->resolution()},
-                 {"spacing", mesh->spacing()},
-                 {"warnings", spec.warnings}};
-  j["multipliers"] = s.gamma.m;
-  double area = 0;
-  for (double a : s.gamma.area) area += a;
-  j["surface"] = {{"area", area}, {"triangles", s.gamma.triangles.size()}, {"delta", s.delta}};
-  j["alpha"] = s.alpha;
-  j["newton"] = newton_json(s.newton);
-  if (s.nested_start) {
-    const SurfaceSolution::NestedStart& n = *s.nested_start;
-    j["newton"]["nested_start"] = n.skipped.empty() ? json{{"N", n.N},
-                                                           {"multipliers", n.multipliers},
-                                                           {"newton_steps", n.newton_steps},
-                                                           {"active", n.active},
-                                                           {"seconds", n.seconds}}
-                                                    : json{{"skipped", n.skipped}, {"seconds", n.seconds}};
-  }
-  j["inner"] = {{"solver", to_string(s.options.inner)},
-                {"fast_solves", s.fast_solves},
-                {"krylov_iterations", s.inner_iterations},
-                {"factorizations", s.factorizations}};
-  if (s.flux_balance)
-    j["flux_balance"] = {{"scatter", s.flux_balance->scatter},
-                         {"mean", s.flux_balance->mean},
-                         {"data_shift", s.flux_balance->data_shift}};
-  if (s.far_field) {
-    const FarFieldReport& a = s.far_field->assembly;
-    j["inner"]["far_field"] = {{"far_fraction", a.far_pairs / (a.far_pairs + a.near_pairs)},
-                               {"far_blocks", a.far_blocks},
-                               {"near_blocks", a.near_blocks},
-                               {"exact_steps", s.far_field->exact_steps}};
-  }
-  j["signorini"] = signorini_json(s.signorini);
-  const ContactSummary contact = contact_summary(s);
-  j["contact"] = {{"points", contact.points},          {"area", contact.measure},    {"force", contact.force},
-                  {"lambda_integral", contact.lambda}, {"min_gap", contact.min_gap}, {"max_gap", contact.max_gap}};
-  if (s.errors) j["errors"] = errors_json(*s.errors, s.point_errors);
-  j["timings"] = timings_json(s.timings);
-  j["warnings"] = s.warnings;
-  j["peak_memory_bytes"] = s.peak_memory_bytes;
-  return j;
-}
-
-std::string points_csv(const SurfaceSolution& s) {
+template <int dim>
+std::string points_csv(const BasicSolution<dim>& s) {
+  static const char* axis[] = {"x", "y", "z"};
   std::ostringstream out;
   out.precision(17);
-  out << "patch,x,y,z,nx,ny,nz,area,u,g,dudn,lambda,contact\n";
-  for (int p = 0; p < s.gamma.m; ++p) {
-    const Point3 x = s.gamma.point[p], n = s.gamma.normal[p];
-    out << p << ',' << x.x << ',' << x.y << ',' << x.z << ',' << n.x << ',' << n.y << ',' << n.z << ','
-        << s.gamma.area[p] << ',' << s.trace[p] << ',' << s.g[p] << ',' << s.normal_derivative[p] << ',' << s.lambda[p]
-        << ',' << int(s.newton.active[p]) << '\n';
+  // s: the arc length (2-D); weight: the part of γ the point owns (an arc or a patch area); Gamma_*: the
+  // point of Γ carrying λ; dudn_check: the independent check's ∂u/∂n (empty when there is none)
+  out << "i" << (dim == 2 ? ",s" : "");
+  for (int d = 0; d < dim; ++d) out << ',' << axis[d];
+  for (int d = 0; d < dim; ++d) out << ",n" << axis[d];
+  out << ",weight,g,u,dudn,lambda,contact";
+  for (int d = 0; d < dim; ++d) out << ",Gamma_" << axis[d];
+  out << ",dudn_check\n";
+  const bool check = s.check && int(s.check->normal_derivative.size()) == s.n_points();
+  for (int i = 0; i < s.n_points(); ++i) {
+    Point<dim> G;
+    if constexpr (dim == 2)
+      G = s.Gamma->position(s.collocation.t[i]);
+    else
+      G = s.Gamma.point[i];
+    out << i;
+    if constexpr (dim == 2) out << ',' << s.collocation.s[i];
+    for (int d = 0; d < dim; ++d) out << ',' << s.points()[i][d];
+    for (int d = 0; d < dim; ++d) out << ',' << s.normals()[i][d];
+    out << ',' << s.weights()[i] << ',' << s.g[i] << ',' << s.trace[i] << ',' << s.normal_derivative[i] << ','
+        << s.lambda[i] << ',' << int(s.newton.active[i]);
+    for (int d = 0; d < dim; ++d) out << ',' << G[d];
+    out << ',';
+    if (check) out << s.check->normal_derivative[i];
+    out << '\n';
   }
   return out.str();
 }
+
+template std::string points_csv(const BasicSolution<2>&);
+template std::string points_csv(const BasicSolution<3>&);
 
 }  // namespace fictus::cli

@@ -15,14 +15,19 @@
 
 namespace fictus::cli {
 
-/// Every option of options.hpp in effect, by key (results.json's `options`).
-nlohmann::json options_to_json(const Problem& problem, const SolverOptions& options);
+/// Every option of options.hpp in effect that applies to the problem's dimension, by key
+/// (results.json's `options`: with the problem file's [geometry] and [data], enough to solve it again).
+template <int dim>
+nlohmann::json options_to_json(const BasicProblem<dim>& problem, const SolverOptions& options);
 /// The option descriptions (`fictus options --json`).
 nlohmann::json options_schema_json();
-/// results.json: `input` is what the problem was made from (the file's geometry and data), echoed
-/// under "problem" beside its name.
-nlohmann::json solution_to_json(const Problem& problem, const Solution& solution,
-                                const nlohmann::json& input = nlohmann::json::object());
+/// results.json, the same keys in both dimensions (docs/results.md): `input` is what the problem was
+/// made from (the file's geometry and data), echoed under "problem" beside its name; `input_warnings`
+/// (the reader's) go first in "warnings".
+template <int dim>
+nlohmann::json solution_to_json(const BasicProblem<dim>& problem, const BasicSolution<dim>& solution,
+                                const nlohmann::json& input = nlohmann::json::object(),
+                                const std::vector<std::string>& input_warnings = {});
 LevelResult level_result(const Solution& solution);
 
 /// Newton did not converge (exit code 2): the message names the setting (describe_newton_failure).
@@ -53,11 +58,9 @@ void check_output_folder(const std::filesystem::path& dir, const std::vector<std
 /// folders this call made removed: `dir` is as it was. Throws OutputError "output: …".
 void write_output_set(const std::filesystem::path& dir, const std::vector<OutputFile>& files);
 
-std::string points_csv(const Solution& solution);
+/// points.csv: one row per point of γ, the same columns in both dimensions (docs/usage.md).
+template <int dim>
+std::string points_csv(const BasicSolution<dim>& solution);
 std::string levels_csv(const std::vector<LevelResult>& rows);
-
-/// 3-D: results.json (with "dim": 3; keys of docs/results.md) and points.csv (one row per patch).
-nlohmann::json solution_to_json(const SurfaceProblemSpec& spec, const SurfaceSolution& solution);
-std::string points_csv(const SurfaceSolution& solution);
 
 }  // namespace fictus::cli

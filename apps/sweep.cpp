@@ -14,6 +14,7 @@
 #include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/io/process.hpp"
 #include "fictus/shapes.hpp"
+#include "fictus/surface.hpp"
 #include "results_io.hpp"
 
 namespace fictus::cli {
@@ -58,7 +59,8 @@ struct Family {
   bool changes_load = false;  // a new u₀ per member
 };
 
-Family family_of(const SweepArguments& args, const ProblemSpec& base) {
+template <int dim>
+Family family_of(const SweepArguments& args, const BasicProblemSpec<dim>& base) {
   const int kinds = !args.g_scale.empty() + !args.rotate.empty() + !args.move.empty() + !args.parameter.empty();
   if (kinds != 1) throw std::invalid_argument("sweep: give exactly one of --g-scale, --rotate, --move, --parameter");
   Family f;
@@ -104,68 +106,122 @@ Family family_of(const SweepArguments& args, const ProblemSpec& base) {
   return f;
 }
 
+/// The axis of a 3-D rotation: x, y or z.
+int axis_of(const std::string& axis) {
+  if (axis.empty()) return 2;  // z
+  if (axis == "x" || axis == "y" || axis == "z") return axis[0] - 'x';
+  throw std::invalid_argument("--axis: expected x, y or z, got \"" + axis.substr(0, 40) + "\"");
+}
+
 /// Member k of the family: the base problem changed by one value.
-Problem member(const Family& family, const ProblemSpec& base, const SweepArguments& args, const std::string& text,
-               const OptionFlags& flags, double v) {
-  Problem problem = base.problem;
+template <int dim>
+BasicProblem<dim> member(const Family& family, const BasicProblemSpec<dim>& base, const SweepArguments& args,
+                         const std::string& text, const OptionFlags& flags, double v) {
+  BasicProblem<dim> problem = base.problem;
   if (family.kind == "g_scale") {
-    if (problem.g) problem.g = [g = base.problem.g, v](double x, double y) { return v * g(x, y); };
-    if (problem.g_along_curve)
-      problem.g_along_curve = [g = base.problem.g_along_curve, v](double x, double y, double s) {
-        return v * g(x, y, s);
-      };
-  } else if (family.kind == "rotate") {
-    problem.gamma = std::make_shared<TransformedCurve>(base.problem.gamma, v, Point2{0, 0});
-  } else if (family.kind == "move") {
-    problem.gamma = std::make_shared<TransformedCurve>(base.problem.gamma, 0.0, Point2{v, 0});
-    if (base.g_about) problem.g_along_curve = base.g_about(problem.gamma->center());  // phi about the moved center
+    if constexpr (dim == 2) {
+      if (problem.g) problem.g = [g = base.problem.g, v](double x, double y) { return v * g(x, y); };
+      if (problem.g_along_curve)
+        problem.g_along_curve = [g = base.problem.g_along_curve, v](double x, double y, double s) {
+          return v * g(x, y, s);
+        };
+    } else {
+      problem.g = [g = base.problem.g, v](double x, double y, double z) { return v * g(x, y, z); };
+    }
+  } else if (family.kind == "rotate" || family.kind == "move") {
+    const double angle = family.kind == "rotate" ? v : 0.0, shift = family.kind == "move" ? v : 0.0;
+    if constexpr (dim == 2) {
+      problem.gamma = std::make_shared<TransformedCurve>(base.problem.gamma, angle, Point2{shift, 0});
+      if (base.g_about) problem.g_along_curve = base.g_about(problem.gamma->center());  // phi about the moved center
+    } else {
+      problem.gamma =
+          std::make_shared<TransformedSurface>(base.problem.gamma, axis_of(args.axis), angle, Point3{shift, 0, 0});
+    }
   } else {
-    // The base curve unless the parameter is in the geometry: the same rows and Schur blocks, and
+    // The base boundary unless the parameter is in the geometry: the same rows and Schur blocks, and
     // the geometry is not read and checked again.
-    problem = problem_from_text(text, args.problem_path, flags, {{family.name, v}},
-                                family.moves_curve ? nullptr : base.problem.gamma)
-                  .problem;
+    std::shared_ptr<const typename BoundaryShape<dim>::type> keep;
+    if (!family.moves_curve) keep = base.problem.gamma;
+    problem = problem_from_text<dim>(text, args.problem_path, flags, {{family.name, v}}, keep).problem;
   }
   if (family.kind != "parameter") problem.exact = nullptr;  // the exact solution is the base problem's
   return problem;
 }
 
-}  // namespace
+const char* const columns =
+    "converged,newton_steps,multipliers,contact_points,contact_measure,contact_force,lambda_integral,min_gap,max_gap,"
+    "min_normal_derivative,max_complementarity,seconds";
 
-int run_sweep(const SweepArguments& args, const OptionFlags& flags) {
-  const std::string text = args.problem_path.empty() ? "" : read_problem_text(args.problem_path);
-  const ProblemSpec base = problem_from_text(text, args.problem_path, flags);
+/// One member's line of sweep.csv and its row of sweep.json.
+template <int dim>
+void record(const Family& family, double v, const BasicSolution<dim>& s, double seconds, std::ostringstream& csv,
+            nlohmann::json& rows) {
+  const ContactSummary c = contact_summary(s);
+  std::printf("%-12.6g %5d %7ld %11.4e %11.4e %11.3e %11.3e %9.4f%s\n", v, s.newton.iterations, c.points, c.measure,
+              c.force, c.min_gap, c.max_gap, seconds, s.newton.converged ? "" : "  NOT converged");
+  csv << v << ',' << s.newton.converged << ',' << s.newton.iterations << ',' << s.n_points() << ',' << c.points << ','
+      << c.measure << ',' << c.force << ',' << c.lambda << ',' << c.min_gap << ',' << c.max_gap << ','
+      << s.signorini.min_normal_derivative << ',' << s.signorini.max_complementarity << ',' << seconds << '\n';
+  rows.push_back({{family.name, v},
+                  {"converged", s.newton.converged},
+                  {"newton_steps", s.newton.iterations},
+                  {"multipliers", s.n_points()},
+                  {"contact_points", c.points},
+                  {"contact_measure", c.measure},
+                  {"contact_force", c.force},
+                  {"lambda_integral", c.lambda},
+                  {"min_gap", c.min_gap},
+                  {"max_gap", c.max_gap},
+                  {"min_normal_derivative", s.signorini.min_normal_derivative},
+                  {"max_complementarity", s.signorini.max_complementarity},
+                  {"seconds", seconds}});
+}
+
+/// The first member that did not converge, as the failure's one line (exit code 2).
+[[noreturn]] void fail_sweep(const Family& family, double value, std::string line, int failures) {
+  std::ostringstream at;  // after the key of the failure: "solver.max_newton: at rotate = 0 (…): …"
+  at.precision(12);
+  at << "at " << family.name << " = " << value << " (" << failures << " of " << family.values.size()
+     << " did not converge; converged = 0 in sweep.csv): ";
+  const std::size_t key_end = line.find(": ");
+  line.insert(key_end == std::string::npos ? 0 : key_end + 2, at.str());
+  throw NewtonFailure(line);
+}
+
+template <int dim>
+int run_sweep_in(const std::string& text, const SweepArguments& args, const OptionFlags& flags) {
+  if (dim == 2 && !args.axis.empty())
+    throw std::invalid_argument("--axis: applies to 3-D sweeps only (this one is 2-D)");
+  if (!args.axis.empty() && args.rotate.empty())
+    throw std::invalid_argument("--axis: the axis of --rotate; give --rotate");
+  const BasicProblemSpec<dim> base = problem_from_text<dim>(text, args.problem_path, flags);
   const Family family = family_of(args, base);
   for (const std::string& w : base.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
   if (!args.out.empty()) check_output_folder(args.out, {"sweep.csv", "sweep.json"});
   SolverOptions options = base.options;
-  options.condition_number = false;  // not a column of the sweep
+  if constexpr (dim == 2) options.condition_number = false;  // not a column of the sweep
   check_memory(base.problem, options);
   const auto setup_start = std::chrono::steady_clock::now();
-  FictitiousDomainSolver solver(base.problem, options);
+  FictitiousDomainSolver<dim> solver(base.problem, options);
   // The base problem first: its own errors (a smooth variant on a polygon, Γ leaving the box) are
   // not a member's. For an obstacle family its rows and blocks serve every member.
-  solver.solve(base.problem, options, false);
+  const BasicSolution<dim> first = solver.solve(base.problem, options, false);
+  for (const std::string& w : first.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
   const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
-
   std::ostringstream csv;
   csv.precision(12);
-  csv << family.name
-      << ",converged,newton_steps,multipliers,contact_points,contact_measure,contact_force,lambda_integral,min_gap,max_"
-         "gap,"
-         "min_normal_derivative,max_complementarity,seconds\n";
+  csv << family.name << ',' << columns << '\n';
   nlohmann::json rows = nlohmann::json::array();
   std::printf("%-12s %5s %7s %11s %11s %11s %11s %9s\n", family.name.substr(0, 12).c_str(), "it0", "contact", "measure",
               "force", "min gap", "max gap", "time[s]");
   double total = 0;
   int failures = 0;
   std::optional<std::pair<double, std::string>> first_failure;
-  for (std::size_t k = 0; k < family.values.size(); ++k) {
-    const double v = family.values[k];
+  for (const double v : family.values) {
     const auto start = std::chrono::steady_clock::now();
-    Solution s(solver.grid());
+    BasicSolution<dim> s(solver.grid());
     try {
-      const Problem problem = member(family, base, args, text, flags, v);
+      const BasicProblem<dim> problem = member(family, base, args, text, flags, v);
       if (family.changes_load) solver.replace_load(problem);
       s = solver.solve(problem, options, false);  // boundary quantities only
     } catch (const std::invalid_argument& e) {
@@ -178,55 +234,38 @@ int run_sweep(const SweepArguments& args, const OptionFlags& flags) {
     total += seconds;
     failures += !s.newton.converged;
     if (!s.newton.converged && !first_failure) first_failure = std::pair{v, describe_newton_failure(s)};
-    const ContactSummary c = contact_summary(s);
-    std::printf("%-12.6g %5d %7ld %11.4e %11.4e %11.3e %11.3e %9.4f%s\n", v, s.newton.iterations, c.points, c.measure,
-                c.force, c.min_gap, c.max_gap, seconds, s.newton.converged ? "" : "  NOT converged");
-    csv << v << ',' << s.newton.converged << ',' << s.newton.iterations << ',' << s.collocation.m << ',' << c.points
-        << ',' << c.measure << ',' << c.force << ',' << c.lambda << ',' << c.min_gap << ',' << c.max_gap << ','
-        << s.signorini.min_normal_derivative << ',' << s.signorini.max_complementarity << ',' << seconds << '\n';
-    rows.push_back({{family.name, v},
-                    {"converged", s.newton.converged},
-                    {"newton_steps", s.newton.iterations},
-                    {"multipliers", s.collocation.m},
-                    {"contact_points", c.points},
-                    {"contact_measure", c.measure},
-                    {"contact_force", c.force},
-                    {"lambda_integral", c.lambda},
-                    {"min_gap", c.min_gap},
-                    {"max_gap", c.max_gap},
-                    {"min_normal_derivative", s.signorini.min_normal_derivative},
-                    {"max_complementarity", s.signorini.max_complementarity},
-                    {"seconds", seconds}});
+    record(family, v, s, seconds, csv, rows);
   }
   std::printf("grid setup and the base problem %.3f s; then %.4f s per problem (%s), %.1f problems per second\n", setup,
               total / family.values.size(),
               family.changes_load  ? "new u0 and Newton"
-              : family.moves_curve ? "new curve rows, Schur blocks and Newton"
+              : family.moves_curve ? "new boundary rows, Schur blocks and Newton"
                                    : "Newton only",
               family.values.size() / total);
   if (!args.out.empty()) {
     nlohmann::json j{{"version", FICTUS_VERSION},
                      {"commit", FICTUS_GIT_COMMIT},
+                     {"dim", dim},
                      {"problem", nlohmann::json::parse(base.input_json)},
                      {"options", options_to_json(base.problem, options)},
                      {"sweep", {{"kind", family.kind}, {"name", family.name}, {"values", family.values}}},
                      {"rows", rows}};
+    if (family.kind == "rotate" && dim == 3) j["sweep"]["axis"] = std::string(1, char('x' + axis_of(args.axis)));
     j["problem"]["name"] = base.problem.name;
     write_output_set(args.out, {{"sweep.csv", [&](std::ostream& out) { out << csv.str(); }},
                                 {"sweep.json", [&](std::ostream& out) { out << j.dump(2) << '\n'; }}});
     std::printf("wrote sweep.csv and sweep.json to %s/\n", args.out.c_str());
   }
-  if (first_failure) {
-    std::ostringstream at;  // after the key of the failure: "solver.max_newton: at rotate = 0 (…): …"
-    at.precision(12);
-    at << "at " << family.name << " = " << first_failure->first << " (" << failures << " of " << family.values.size()
-       << " did not converge; converged = 0 in sweep.csv): ";
-    std::string line = first_failure->second;
-    const std::size_t key_end = line.find(": ");
-    line.insert(key_end == std::string::npos ? 0 : key_end + 2, at.str());
-    throw NewtonFailure(line);
-  }
+  if (first_failure) fail_sweep(family, first_failure->first, first_failure->second, failures);
   return 0;
+}
+
+}  // namespace
+
+int run_sweep(const SweepArguments& args, const OptionFlags& flags) {
+  const std::string text = args.problem_path.empty() ? "" : read_problem_text(args.problem_path);
+  if (!text.empty() && problem_dimension(text, args.problem_path) == 3) return run_sweep_in<3>(text, args, flags);
+  return run_sweep_in<2>(text, args, flags);
 }
 
 }  // namespace fictus::cli

@@ -1,5 +1,5 @@
 // The Python module `fictus`: Problem (from a dict, TOML text, keyword arguments or the paper),
-// Problem.solve() → Solution with numpy arrays; SurfaceProblem / SurfaceSolution for 3-D. No numerics here: everything
+// Problem.solve() → Solution with numpy arrays, in 2-D or 3-D. No numerics here: everything
 // calls the library.
 #include <pybind11/pybind11.h>
 
@@ -10,5 +10,4 @@ PYBIND11_MODULE(fictus, m) {
   m.attr("__version__") = FICTUS_PY_VERSION;
   fictus::python::bind_problem(m);
   fictus::python::bind_solution(m);
-  fictus::python::bind_surface(m);
 }

@@ -1,5 +1,6 @@
-// fictus.Solution: the grid field û as a 2-D numpy array with its coordinates, the per-point
-// quantities on γ (views of the solver's arrays, no copies), iterations, timings, errors, options.
+// fictus.Solution, one class for both dimensions: the grid field û as a numpy array with its
+// coordinates, the per-point quantities on γ (views of the solver's arrays, no copies), Newton's
+// report, checks, timings, errors and the options in effect. SurfaceSolution is its 3-D name.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -7,10 +8,11 @@
 #include <algorithm>
 #include <memory>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 #include "bindings.hpp"
 #include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/io/process.hpp"
 #include "fictus/options.hpp"
 #include "python_problem.hpp"
 
@@ -18,34 +20,25 @@ namespace py = pybind11;
 
 namespace fictus::python {
 
-PySolution PyProblem::solve(bool field) {
-  const auto errors = std::make_shared<CallbackErrors>();  // this solve's own slot
-  const Problem problem = bound(errors);
-  check_memory(problem, spec.options);
-  std::shared_ptr<const Solution> solution;
-  try {
-    FictitiousDomainSolver solver(problem, spec.options);
-    // Ctrl-C: Python's handler runs in PyErr_CheckSignals (this thread, under the GIL) and leaves
-    // KeyboardInterrupt set; the solve stops at its next check.
-    solver.set_interrupt_check([errors] { return errors->interrupt_requested(); });
-    py::gil_scoped_release release;
-    solution = std::make_shared<const Solution>(solver.solve(problem, spec.options, field));
-  } catch (const Interrupted&) {
-    if (!PyErr_Occurred()) PyErr_SetNone(PyExc_KeyboardInterrupt);
-    throw py::error_already_set();
-  } catch (const std::invalid_argument&) {
-    errors->raise_if_any();  // a NaN from a failed callable: report the callable, not the NaN
-    throw;
-  }
-  errors->raise_if_any();
-  std::const_pointer_cast<Solution>(solution)->peak_memory_bytes = peak_memory_bytes();
-  if (!solution->newton.converged) throw std::runtime_error(describe_newton_failure(*solution));
-  return PySolution(solution, problem);
+py::object solution_object(PySolution s) {
+  if (s.dim == 3) return py::cast(PySurfaceSolution{std::move(s)});
+  return py::cast(std::move(s));
 }
 
 namespace {
 
-/// A 1-D view of a vector owned by the Solution object `owner` (no copy).
+/// `f(solution)` on the solution of either dimension (f is generic over BasicSolution<dim>).
+template <class F>
+decltype(auto) on(const PySolution& p, F&& f) {
+  if (p.dim == 2) return f(*p.s2);
+  return f(*p.s3);
+}
+
+template <class F>
+decltype(auto) on(py::handle self, F&& f) {
+  return on(self.cast<const PySolution&>(), std::forward<F>(f));
+}
+
 py::array_t<double> read_only(py::array_t<double> a) {
   py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
   return a;
@@ -56,165 +49,273 @@ py::array_t<double> view(const std::vector<double>& v, py::handle owner) {
   return read_only(py::array_t<double>({py::ssize_t(v.size())}, {py::ssize_t(sizeof(double))}, v.data(), owner));
 }
 
-/// An (n, 2) view of interleaved pairs owned by `owner` (no copy).
-py::array_t<double> pairs_view(const std::vector<double>& v, py::handle owner) {
-  return read_only(py::array_t<double>({py::ssize_t(v.size() / 2), py::ssize_t(2)},
-                                       {py::ssize_t(2 * sizeof(double)), py::ssize_t(sizeof(double))}, v.data(),
+/// A read-only (n, dim) view of interleaved coordinates owned by `owner` (no copy).
+py::array_t<double> rows_view(const std::vector<double>& v, int dim, py::handle owner) {
+  return read_only(py::array_t<double>({py::ssize_t(v.size() / std::size_t(dim)), py::ssize_t(dim)},
+                                       {py::ssize_t(dim * sizeof(double)), py::ssize_t(sizeof(double))}, v.data(),
                                        owner));
 }
 
-/// Every option of options.hpp in effect, by key (as results.json's `options`).
-py::dict options_dict(const Problem& problem, const SolverOptions& o) {
+/// The node coordinates along axis d (0: x, 1: y, 2: z).
+template <int dim>
+py::array_t<double> axis(const Grid<dim>& g, int d) {
+  py::array_t<double> x(g.n(d) + 1);
+  for (int i = 0; i <= g.n(d); ++i) x.mutable_data()[i] = g.coordinate(d, i);
+  return x;
+}
+
+/// û at every node, indexed [j, i] in 2-D and [k, j, i] in 3-D (zero on a Dirichlet boundary).
+template <int dim>
+py::array_t<double> field(const BasicSolution<dim>& s) {
+  if (s.u.empty()) throw std::invalid_argument("u: the field was not computed (solve(field=True))");
+  const Grid<dim>& g = s.grid;
+  std::vector<py::ssize_t> shape;
+  for (int d = dim - 1; d >= 0; --d) shape.push_back(g.n(d) + 1);
+  py::array_t<double> u(shape);
+  double* out = u.mutable_data();
+  std::size_t nodes = 1;
+  for (int d = 0; d < dim; ++d) nodes *= std::size_t(g.n(d) + 1);
+  for (std::size_t flat = 0; flat < nodes; ++flat) {  // row-major over ((z,) y, x): x fastest
+    typename Grid<dim>::Index node;
+    std::size_t rest = flat;
+    for (int d = 0; d < dim; ++d) node[d] = int(rest % std::size_t(g.n(d) + 1)), rest /= std::size_t(g.n(d) + 1);
+    out[flat] = g.has_unknown(node) ? s.u[g.index(node)] : 0.0;
+  }
+  return u;
+}
+
+/// The points of Γ carrying λ (= the points of γ in the non-smooth variant), (m, dim).
+py::array_t<double> gamma_points(const PySolution& p) {
+  const int m = on(p, [](const auto& s) { return s.n_points(); });
+  py::array_t<double> a({py::ssize_t(m), py::ssize_t(p.dim)});
+  auto r = a.mutable_unchecked<2>();
+  if (p.dim == 2) {
+    const Solution& s = *p.s2;
+    for (int i = 0; i < m; ++i) {
+      const Point2 q = s.Gamma->position(s.collocation.t[i]);
+      r(i, 0) = q.x, r(i, 1) = q.y;
+    }
+  } else {
+    const SurfaceSolution& s = *p.s3;
+    for (int i = 0; i < m; ++i)
+      for (int d = 0; d < 3; ++d) r(i, d) = s.Gamma.point[i][d];
+  }
+  return a;
+}
+
+template <int dim>
+py::dict signorini(const BasicSolution<dim>& s) {
+  py::dict d;
+  d["min_gap"] = s.signorini.min_gap;
+  d["min_normal_derivative"] = s.signorini.min_normal_derivative;
+  d["max_complementarity"] = s.signorini.max_complementarity;
+  if (const auto& k = s.check) {
+    py::dict check;
+    check["rule"] = k->rule;
+    check["min_normal_derivative"] = k->min_normal_derivative;
+    check["max_complementarity"] = k->max_complementarity;
+    check["max_difference"] = k->max_difference;
+    check["rms_difference"] = k->rms_difference;
+    d["check"] = check;
+  }
+  return d;
+}
+
+template <int dim>
+py::dict contact(const BasicSolution<dim>& s) {
+  const ContactSummary c = contact_summary(s);
+  py::dict d;
+  d["points"] = c.points;
+  d["measure"] = c.measure;
+  d["force"] = c.force;
+  d["lambda_integral"] = c.lambda;
+  d["min_gap"] = c.min_gap;
+  d["max_gap"] = c.max_gap;
+  return d;
+}
+
+template <int dim>
+py::object errors(const BasicSolution<dim>& s) {
+  if (!s.errors) return py::none();
+  const ErrorNorms& e = *s.errors;
+  py::dict d;
+  d["l2_omega"] = e.l2_omega, d["h1_omega"] = e.h1_omega, d["h1semi_omega"] = e.h1semi_omega;
+  d["l2_gamma"] = e.l2_gamma, d["rel_l2_omega"] = e.rel_l2_omega;
+  d["rel_h1_omega"] = e.rel_h1_omega, d["rel_h1semi_omega"] = e.rel_h1semi_omega;
+  d["rel_l2_gamma"] = e.rel_l2_gamma;
+  if (const auto& pe = s.point_errors) {
+    d["max_trace_at_points"] = pe->max_trace;
+    d["max_normal_derivative_at_points"] = pe->max_normal_derivative;
+  }
+  return d;
+}
+
+template <int dim>
+py::object nested_start(const BasicSolution<dim>& s) {
+  const auto& n = s.nested_start;
+  if (!n) return py::none();
+  py::dict d;
+  if (n->skipped.empty())
+    d["N"] = n->N, d["multipliers"] = n->multipliers, d["newton_steps"] = n->newton_steps, d["active"] = n->active;
+  else
+    d["skipped"] = n->skipped;
+  d["seconds"] = n->seconds;
+  return d;
+}
+
+template <int dim>
+py::object flux_balance(const BasicSolution<dim>& s) {
+  const auto& b = s.flux_balance;
+  if (!b) return py::none();
+  py::dict d;
+  d["scatter"] = b->scatter, d["mean"] = b->mean, d["data_shift"] = b->data_shift;
+  return d;
+}
+
+/// The options in effect that apply to this dimension, by key (as results.json's `options`).
+py::dict options(const PySolution& p) {
+  const SolverOptions& o = on(p, [](const auto& s) -> const SolverOptions& { return s.options; });
   py::dict d;
   for (const OptionSpec& spec : option_specs())
-    std::visit([&](const auto& v) { d[py::str(spec.key)] = py::cast(v); }, spec.get(problem, o));
+    if (spec.applies_to(p.dim))
+      std::visit([&](const auto& v) { d[py::str(spec.key)] = py::cast(v); }, spec.get(p.domain, o));
   return d;
+}
+
+/// Raised for what one dimension has and the other not (x.s in 3-D, x.area in 2-D).
+[[noreturn]] void only_in(int dim, const std::string& what, const std::string& instead) {
+  throw py::attribute_error(what + ": exists in " + std::to_string(dim) + "-D solutions only; " + instead);
 }
 
 }  // namespace
 
 void bind_solution(py::module_& m) {
-  py::class_<PySolution>(m, "Solution", "The result of Problem.solve(); arrays are numpy arrays.")
-      .def_property_readonly("u",
-                             [](const PySolution& p) {
-                               // û at all (ny+1) × (nx+1) nodes, row j = y_j (zero on a Dirichlet boundary).
-                               const Solution& s = p.s();
-                               if (s.u.empty())
-                                 throw std::invalid_argument("u: the field was not computed (solve(field=True))");
-                               const Grid2& g = s.grid;
-                               py::array_t<double> u({g.ny() + 1, g.nx() + 1});
-                               auto a = u.mutable_unchecked<2>();
-                               for (int j = 0; j <= g.ny(); ++j)
-                                 for (int i = 0; i <= g.nx(); ++i)
-                                   a(j, i) = g.has_unknown(i, j) ? s.u[g.index(i, j)] : 0.0;
-                               return u;
-                             })
+  py::class_<PySolution>(m, "Solution", R"doc(The result of Problem.solve(), in 2-D or 3-D; arrays are numpy arrays.
+
+    u: û at every node, indexed [j, i] (2-D) or [k, j, i] (3-D); x, y, z / axes: the node coordinates.
+    points, normals (m, dim): the points of γ the values belong to; weights: the part of γ each owns
+    (an arc length in 2-D, a patch area in 3-D); g, u_gamma (B_γû), dudn (C_γû), lambda_, contact.
+)doc")
+      .def_property_readonly("dim", [](const PySolution& p) { return p.dim; })
+      .def_property_readonly(
+          "u", [](const PySolution& p) { return on(p, [](const auto& s) { return field(s); }); },
+          "û at every node, indexed [j, i] = (y, x) in 2-D and [k, j, i] = (z, y, x) in 3-D (zero on a Dirichlet "
+          "boundary)")
+      .def_property_readonly(
+          "axes",
+          [](const PySolution& p) {
+            py::list axes;
+            for (int d = 0; d < p.dim; ++d) axes.append(on(p, [d](const auto& s) { return axis(s.grid, d); }));
+            return py::tuple(axes);
+          },
+          "the node coordinates along each axis: (x, y) or (x, y, z)")
       .def_property_readonly("x",
-                             [](const PySolution& p) {
-                               const Grid2& g = p.s().grid;
-                               py::array_t<double> x(g.nx() + 1);
-                               for (int i = 0; i <= g.nx(); ++i) x.mutable_data()[i] = g.x(i);
-                               return x;
-                             })
+                             [](const PySolution& p) { return on(p, [](const auto& s) { return axis(s.grid, 0); }); })
       .def_property_readonly("y",
+                             [](const PySolution& p) { return on(p, [](const auto& s) { return axis(s.grid, 1); }); })
+      .def_property_readonly("z",
                              [](const PySolution& p) {
-                               const Grid2& g = p.s().grid;
-                               py::array_t<double> y(g.ny() + 1);
-                               for (int j = 0; j <= g.ny(); ++j) y.mutable_data()[j] = g.y(j);
-                               return y;
+                               if (p.dim != 3) only_in(3, "z", "a 2-D grid has x and y");
+                               return axis(p.s3->grid, 2);
                              })
-      .def_property_readonly("points",
-                             [](py::object self) { return pairs_view(self.cast<const PySolution&>().points(), self); })
+      .def_property_readonly(
+          "points",
+          [](py::object self) {
+            return rows_view(self.cast<const PySolution&>().points, self.cast<const PySolution&>().dim, self);
+          },
+          "the point of γ each value belongs to, (m, dim): a collocation point (2-D) or a patch's point (3-D)")
       .def_property_readonly("normals",
-                             [](py::object self) { return pairs_view(self.cast<const PySolution&>().normals(), self); })
+                             [](py::object self) {
+                               const PySolution& p = self.cast<const PySolution&>();
+                               return rows_view(p.normals, p.dim, self);
+                             })
       .def_property_readonly(
-          "s", [](py::object self) { return view(self.cast<const PySolution&>().s().collocation.s, self); },
-          "arc length of each collocation point")
-      .def_property_readonly("g", [](py::object self) { return view(self.cast<const PySolution&>().s().g, self); })
+          "weights", [](py::object self) { return on(self, [&](const auto& s) { return view(s.weights(), self); }); },
+          "the part of γ each point owns: an arc length (2-D) or a patch area (3-D)")
       .def_property_readonly(
-          "u_gamma", [](py::object self) { return view(self.cast<const PySolution&>().s().trace, self); },
-          "B_γû at the collocation points")
+          "s",
+          [](py::object self) {
+            const PySolution& p = self.cast<const PySolution&>();
+            if (p.dim != 2) only_in(2, "s", "a surface's points have weights (patch areas)");
+            return view(p.s2->collocation.s, self);
+          },
+          "the arc length of each collocation point (2-D)")
       .def_property_readonly(
-          "dudn", [](py::object self) { return view(self.cast<const PySolution&>().s().normal_derivative, self); },
-          "C_γû at the collocation points")
+          "area",
+          [](py::object self) {
+            const PySolution& p = self.cast<const PySolution&>();
+            if (p.dim != 3) only_in(3, "area", "a curve's points have s (arc length) and weights (arcs)");
+            return view(p.s3->gamma.area, self);
+          },
+          "the area of each patch (3-D; the same as weights)")
+      .def_property_readonly("g",
+                             [](py::object self) { return on(self, [&](const auto& s) { return view(s.g, self); }); })
       .def_property_readonly(
-          "lambda_", [](py::object self) { return view(self.cast<const PySolution&>().s().lambda, self); },
+          "u_gamma", [](py::object self) { return on(self, [&](const auto& s) { return view(s.trace, self); }); },
+          "B_γû at the points")
+      .def_property_readonly(
+          "dudn",
+          [](py::object self) { return on(self, [&](const auto& s) { return view(s.normal_derivative, self); }); },
+          "C_γû at the points")
+      .def_property_readonly(
+          "lambda_", [](py::object self) { return on(self, [&](const auto& s) { return view(s.lambda, self); }); },
           "the multipliers (controls on Γ in the smooth variant)")
       .def_property_readonly("contact",
                              [](const PySolution& p) {
-                               const auto& c = p.contact_flags();
-                               py::array_t<bool> a(py::ssize_t(c.size()));
-                               for (std::size_t i = 0; i < c.size(); ++i) a.mutable_data()[i] = c[i];
+                               const auto& active = on(
+                                   p, [](const auto& s) -> const auto& { return s.newton.active; });
+                               py::array_t<bool> a(py::ssize_t(active.size()));
+                               for (std::size_t i = 0; i < active.size(); ++i) a.mutable_data()[i] = active[i] == 1;
                                return a;
                              })
+      .def_property_readonly("gamma_points", &gamma_points,
+                             "the points of Γ carrying λ (= points in the non-smooth variant)")
       .def_property_readonly(
-          "gamma_points",
-          [](const PySolution& p) {
-            const Solution& s = p.s();
-            py::array_t<double> a({py::ssize_t(s.collocation.m), py::ssize_t(2)});
-            auto r = a.mutable_unchecked<2>();
-            for (int i = 0; i < s.collocation.m; ++i) {
-              const Point2 q = s.Gamma->position(s.collocation.t[i]);
-              r(i, 0) = q.x, r(i, 1) = q.y;
-            }
-            return a;
-          },
-          "the points of Γ carrying λ (= points in the non-smooth variant)")
-      .def_property_readonly("iterations", [](const PySolution& p) { return p.s().newton.iterations; })
-      .def_property_readonly("converged", [](const PySolution& p) { return p.s().newton.converged; })
-      .def_property_readonly("fast_solves", [](const PySolution& p) { return p.s().fast_solves; })
-      .def_property_readonly("multipliers", [](const PySolution& p) { return p.s().collocation.m; })
-      .def_property_readonly("delta", [](const PySolution& p) { return p.s().delta; })
-      .def_property_readonly("condition_number", [](const PySolution& p) { return p.s().condition_number; })
-      .def_property_readonly("peak_memory_bytes", [](const PySolution& p) { return p.s().peak_memory_bytes; })
-      .def_property_readonly("warnings", [](const PySolution& p) { return p.s().warnings; })
+          "iterations", [](const PySolution& p) { return on(p, [](const auto& s) { return s.newton.iterations; }); })
+      .def_property_readonly(
+          "converged", [](const PySolution& p) { return on(p, [](const auto& s) { return s.newton.converged; }); })
+      .def_property_readonly("fast_solves",
+                             [](const PySolution& p) { return on(p, [](const auto& s) { return s.fast_solves; }); })
+      .def_property_readonly("multipliers",
+                             [](const PySolution& p) { return on(p, [](const auto& s) { return s.n_points(); }); })
+      .def_property_readonly("delta", [](const PySolution& p) { return on(p, [](const auto& s) { return s.delta; }); })
+      .def_property_readonly(
+          "condition_number",
+          [](const PySolution& p) { return on(p, [](const auto& s) { return s.condition_number; }); })
+      .def_property_readonly(
+          "peak_memory_bytes",
+          [](const PySolution& p) { return on(p, [](const auto& s) { return s.peak_memory_bytes; }); })
+      .def_property_readonly("warnings",
+                             [](const PySolution& p) { return on(p, [](const auto& s) { return s.warnings; }); })
       .def_property_readonly("timings",
                              [](const PySolution& p) {
+                               const Timings& t = on(p, [](const auto& s) -> const Timings& { return s.timings; });
                                py::dict d;
-                               for (const auto& [phase, seconds] : p.s().timings.phases) d[py::str(phase)] = seconds;
-                               d["total"] = p.s().timings.total;
+                               for (const auto& [phase, seconds] : t.phases) d[py::str(phase)] = seconds;
+                               d["total"] = t.total;
                                return d;
                              })
+      .def_property_readonly("nested_start",
+                             [](const PySolution& p) { return on(p, [](const auto& s) { return nested_start(s); }); })
+      .def_property_readonly("flux_balance",
+                             [](const PySolution& p) { return on(p, [](const auto& s) { return flux_balance(s); }); })
       .def_property_readonly("signorini",
-                             [](const PySolution& p) {
-                               const SignoriniCheck& c = p.s().signorini;
-                               py::dict d;
-                               d["min_gap"] = c.min_gap;
-                               d["min_normal_derivative"] = c.min_normal_derivative;
-                               d["max_complementarity"] = c.max_complementarity;
-                               if (const auto& k = p.s().check) {
-                                 py::dict check;
-                                 check["rule"] = k->rule;
-                                 check["min_normal_derivative"] = k->min_normal_derivative;
-                                 check["max_complementarity"] = k->max_complementarity;
-                                 check["max_difference"] = k->max_difference;
-                                 check["rms_difference"] = k->rms_difference;
-                                 d["check"] = check;
-                               }
-                               return d;
-                             })
+                             [](const PySolution& p) { return on(p, [](const auto& s) { return signorini(s); }); })
       .def_property_readonly("contact_summary",
-                             [](const PySolution& p) {
-                               const ContactSummary c = contact_summary(p.s());
-                               py::dict d;
-                               d["points"] = c.points;
-                               d["measure"] = c.measure;
-                               d["force"] = c.force;
-                               d["lambda_integral"] = c.lambda;
-                               d["min_gap"] = c.min_gap;
-                               d["max_gap"] = c.max_gap;
-                               return d;
-                             })
+                             [](const PySolution& p) { return on(p, [](const auto& s) { return contact(s); }); })
       .def_property_readonly("errors",
-                             [](const PySolution& p) -> py::object {
-                               if (!p.s().errors) return py::none();
-                               const ErrorNorms& e = *p.s().errors;
-                               py::dict d;
-                               d["l2_omega"] = e.l2_omega, d["h1_omega"] = e.h1_omega,
-                               d["h1semi_omega"] = e.h1semi_omega;
-                               d["l2_gamma"] = e.l2_gamma, d["rel_l2_omega"] = e.rel_l2_omega;
-                               d["rel_h1_omega"] = e.rel_h1_omega, d["rel_h1semi_omega"] = e.rel_h1semi_omega;
-                               d["rel_l2_gamma"] = e.rel_l2_gamma;
-                               if (const auto& pe = p.s().point_errors) {
-                                 d["max_trace_at_points"] = pe->max_trace;
-                                 d["max_normal_derivative_at_points"] = pe->max_normal_derivative;
-                               }
-                               return d;
-                             })
-      .def_property_readonly("options",
-                             [](const PySolution& p) {
-                               py::dict d = options_dict(p.problem(), p.s().options);
-                               d["N"] = p.problem().N;
-                               d["c"] = p.problem().c;
-                               d["boundary"] = p.problem().boundary == Boundary::periodic ? "periodic" : "dirichlet";
-                               return d;
-                             })
+                             [](const PySolution& p) { return on(p, [](const auto& s) { return errors(s); }); })
+      .def_property_readonly("options", &options, "the options in effect that apply to this dimension, by key")
       .def("__repr__", [](const PySolution& p) {
-        const Solution& s = p.s();
-        return "<fictus.Solution N=" + std::to_string(s.grid.nx()) + " m=" + std::to_string(s.collocation.m) +
-               " newton=" + std::to_string(s.newton.iterations) +
-               " active=" + std::to_string(std::count(s.newton.active.begin(), s.newton.active.end(), 1)) + ">";
+        return on(p, [&](const auto& s) {
+          return std::string(p.dim == 2 ? "<fictus.Solution" : "<fictus.SurfaceSolution") +
+                 " N=" + std::to_string(s.grid.n(0)) + " m=" + std::to_string(s.n_points()) +
+                 " newton=" + std::to_string(s.newton.iterations) +
+                 " active=" + std::to_string(std::count(s.newton.active.begin(), s.newton.active.end(), 1)) + ">";
+        });
       });
+
+  py::class_<PySurfaceSolution, PySolution>(m, "SurfaceSolution", "The Solution of a 3-D problem.");
 }
 
 }  // namespace fictus::python

@@ -106,10 +106,7 @@ struct FictitiousDomainSolver<dim>::State {
 
 template <int dim>
 FictitiousDomainSolver<dim>::FictitiousDomainSolver(const BasicProblem<dim>& problem, const SolverOptions& options) {
-  if constexpr (dim == 2)
-    validate_options(problem, options);
-  else
-    options.validate();
+  validate_options(problem, options);
   if (!problem.f && !problem.f_vectorized) throw std::invalid_argument("data.f: not given");
   if (!(problem.c >= 0) || !std::isfinite(problem.c)) throw std::invalid_argument("data.c: must be finite and >= 0");
   const Grid<dim> grid(problem.box, problem.N, problem.boundary);

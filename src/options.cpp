@@ -44,9 +44,9 @@ OptionSpec member(std::string section, std::string key, OptionType type, T Owner
   spec.key = std::move(key);
   spec.type = type;
   spec.meaning = std::move(meaning);
-  spec.get = [field](const Problem& p, const SolverOptions& o) -> OptionValue {
+  spec.get = [field](const DomainSettings& p, const SolverOptions& o) -> OptionValue {
     const Owner* owner;
-    if constexpr (std::is_same_v<Owner, Problem>)
+    if constexpr (std::is_same_v<Owner, DomainSettings>)
       owner = &p, (void)o;
     else
       owner = &o, (void)p;
@@ -55,9 +55,9 @@ OptionSpec member(std::string section, std::string key, OptionType type, T Owner
     else
       return owner->*field;
   };
-  spec.set = [field](Problem& p, SolverOptions& o, const OptionValue& v) {
+  spec.set = [field](DomainSettings& p, SolverOptions& o, const OptionValue& v) {
     Owner* owner;
-    if constexpr (std::is_same_v<Owner, Problem>)
+    if constexpr (std::is_same_v<Owner, DomainSettings>)
       owner = &p, (void)o;
     else
       owner = &o, (void)p;
@@ -73,7 +73,7 @@ OptionSpec integer(std::string section, std::string key, int SolverOptions::*fie
                    std::string meaning) {
   OptionSpec s = member(std::move(section), std::move(key), OptionType::integer, field, std::move(meaning));
   s.rule = "in " + std::to_string(lo) + " … " + std::to_string(hi);
-  s.violation = [lo, hi](const OptionValue& v) {
+  s.violation = [lo, hi](const OptionValue& v, int) {
     const std::int64_t i = std::get<std::int64_t>(v);
     return i < lo || i > hi
                ? "must be in " + std::to_string(lo) + " … " + std::to_string(hi) + ", got " + std::to_string(i)
@@ -93,7 +93,7 @@ OptionSpec number(std::string section, std::string key, double Owner::*field, do
   else
     s.rule = std::string("in ") + (open_low ? "(" : "[") + lo_text + ", " + hi_text + (open_high ? ")" : "]");
   const std::string rule = s.rule;
-  s.violation = [=](const OptionValue& v) {
+  s.violation = [=](const OptionValue& v, int) {
     const double x = std::get<double>(v);
     const bool ok = std::isfinite(x) && (open_low ? x > lo : x >= lo) && (open_high ? x < hi : x <= hi);
     return ok ? std::string() : "must be " + rule + ", got " + format_number(x);
@@ -111,9 +111,9 @@ OptionSpec choice(std::string section, std::string key, Enum Owner::*field, std:
   s.type = OptionType::choice;
   s.meaning = std::move(meaning);
   s.choices = names;
-  s.get = [=](const Problem& p, const SolverOptions& o) -> OptionValue {
+  s.get = [=](const DomainSettings& p, const SolverOptions& o) -> OptionValue {
     Enum e;
-    if constexpr (std::is_same_v<Owner, Problem>)
+    if constexpr (std::is_same_v<Owner, DomainSettings>)
       e = p.*field, (void)o;
     else
       e = o.*field, (void)p;
@@ -121,14 +121,14 @@ OptionSpec choice(std::string section, std::string key, Enum Owner::*field, std:
       if (values[k] == e) return names[k];
     return std::string("?");
   };
-  s.set = [=](Problem& p, SolverOptions& o, const OptionValue& v) {
+  s.set = [=](DomainSettings& p, SolverOptions& o, const OptionValue& v) {
     const auto k = std::size_t(std::find(names.begin(), names.end(), std::get<std::string>(v)) - names.begin());
-    if constexpr (std::is_same_v<Owner, Problem>)
+    if constexpr (std::is_same_v<Owner, DomainSettings>)
       p.*field = values[k], (void)o;
     else
       o.*field = values[k], (void)p;
   };
-  s.violation = [](const OptionValue&) { return std::string(); };  // the names are checked by checked()
+  s.violation = [](const OptionValue&, int) { return std::string(); };  // the names are checked by checked()
   std::vector<std::string> canonical;  // the first name of each value; later ones are other spellings
   for (std::size_t k = 0; k < names.size(); ++k)
     if (std::find(values.begin(), values.begin() + k, values[k]) == values.begin() + k) canonical.push_back(names[k]);
@@ -136,48 +136,63 @@ OptionSpec choice(std::string section, std::string key, Enum Owner::*field, std:
   return s;
 }
 
-std::vector<OptionSpec> make_specs() {
-  std::vector<OptionSpec> specs;
-  // [domain]
+/// [domain]: the box, N and the boundary conditions.
+void domain_specs(std::vector<OptionSpec>& specs) {
+  {
+    OptionSpec dim;
+    dim.section = "domain", dim.key = "dim", dim.type = OptionType::integer;
+    dim.meaning = "2: a curve in a rectangle; 3: a surface in a box (from the problem file: it sets the other keys)";
+    dim.rule = "2 or 3";
+    dim.get = [](const DomainSettings& d, const SolverOptions&) -> OptionValue { return std::int64_t(d.dim); };
+    dim.set = [](DomainSettings& d, SolverOptions&, const OptionValue& v) { d.dim = int(std::get<std::int64_t>(v)); };
+    dim.violation = [](const OptionValue& v, int) {
+      const std::int64_t n = std::get<std::int64_t>(v);
+      return n == 2 || n == 3 ? std::string() : "expected 2 or 3, got " + std::to_string(n);
+    };
+    specs.push_back(dim);
+  }
   {
     OptionSpec box;
-    box.section = "domain", box.key = "box", box.type = OptionType::numbers, box.count = 4;
-    box.meaning = "Ω = [x0, x1] × [y0, y1]";
-    box.rule = "finite, x0 < x1, y0 < y1";
-    box.get = [](const Problem& p, const SolverOptions&) -> OptionValue {
-      return std::vector<double>{p.box.lower.x, p.box.upper.x, p.box.lower.y, p.box.upper.y};
-    };
-    box.set = [](Problem& p, SolverOptions&, const OptionValue& v) {
-      const auto& b = std::get<std::vector<double>>(v);
-      p.box = Box2{{b[0], b[2]}, {b[1], b[3]}};
-    };
-    box.violation = [](const OptionValue& v) {
+    box.section = "domain", box.key = "box", box.type = OptionType::numbers, box.count = 0;  // 2·dim
+    box.meaning = "Ω = [x0, x1] × [y0, y1] (× [z0, z1]), in bounds order";
+    box.rule = "[x0, x1, y0, y1] or [x0, x1, y0, y1, z0, z1]: finite, x0 < x1, y0 < y1, z0 < z1";
+    box.get = [](const DomainSettings& d, const SolverOptions&) -> OptionValue { return d.box; };
+    box.set = [](DomainSettings& d, SolverOptions&, const OptionValue& v) { d.box = std::get<std::vector<double>>(v); };
+    box.violation = [](const OptionValue& v, int dim) {
       const auto& b = std::get<std::vector<double>>(v);
       for (double x : b)
         if (!std::isfinite(x) || std::abs(x) > 1e12) return std::string("must be finite numbers of magnitude <= 1e12");
-      if (b[0] < b[1] && b[2] < b[3]) return std::string();
-      return "the box is [x0, x1, y0, y1] (bounds order, as VTK and matplotlib's extent) with x0 < x1 and y0 < y1, "
-             "got [" +
-             format_number(b[0]) + ", " + format_number(b[1]) + ", " + format_number(b[2]) + ", " +
-             format_number(b[3]) + "]";
+      bool ordered = true;
+      for (int d = 0; d < dim; ++d) ordered = ordered && b[2 * d] < b[2 * d + 1];
+      if (ordered) return std::string();
+      std::string given;
+      for (double x : b) given += (given.empty() ? "" : ", ") + format_number(x);
+      return std::string(dim == 2 ? "the box is [x0, x1, y0, y1]" : "the box is [x0, x1, y0, y1, z0, z1]") +
+             " (bounds order, as VTK and matplotlib's extent) with x0 < x1" +
+             (dim == 2 ? " and y0 < y1" : ", y0 < y1 and z0 < z1") + ", got [" + given + "]";
     };
     specs.push_back(box);
   }
   {
-    OptionSpec N = member(std::string("domain"), std::string("N"), OptionType::integer, &Problem::N,
-                          "cells along x; h = (x1 − x0)/N, and (y1 − y0)/h must be whole");
-    N.rule = "in 8 … 1048576; even for a periodic box";
-    N.violation = [](const OptionValue& v) {
-      const std::int64_t n = std::get<std::int64_t>(v);
-      return n < 8 || n > 1048576 ? "need 8 <= N <= 1048576, got " + std::to_string(n) : std::string();
+    OptionSpec N = member(std::string("domain"), std::string("N"), OptionType::integer, &DomainSettings::N,
+                          "cells along x; h = (x1 − x0)/N, and the other sides must hold whole cells of h");
+    N.rule = "8 … 1048576 in 2-D, 8 … 1024 in 3-D; even for a periodic box";
+    N.violation = [](const OptionValue& v, int dim) {
+      const std::int64_t n = std::get<std::int64_t>(v), most = dim == 2 ? 1048576 : 1024;
+      return n < 8 || n > most ? "need 8 <= N <= " + std::to_string(most) + " in " + std::to_string(dim) + "-D, got " +
+                                     std::to_string(n)
+                               : std::string();
     };
     specs.push_back(N);
   }
-  specs.push_back(choice(std::string("domain"), std::string("boundary"), &Problem::boundary,
+  specs.push_back(choice(std::string("domain"), std::string("boundary"), &DomainSettings::boundary,
                          {to_string(Boundary::dirichlet), to_string(Boundary::periodic)},
                          {Boundary::dirichlet, Boundary::periodic},
                          "conditions on ∂Ω: u = 0, or periodic (even cell counts; c = 0 allowed)"));
-  // [formulation]
+}
+
+/// [formulation]: the variant, m, δ, ρ and the traces.
+void formulation_specs(std::vector<OptionSpec>& specs) {
   specs.push_back(
       choice(std::string("formulation"), std::string("variant"), &SolverOptions::variant,
              {to_string(Variant::automatic), to_string(Variant::smooth), to_string(Variant::nonsmooth), "non-smooth"},
@@ -186,8 +201,10 @@ std::vector<OptionSpec> make_specs() {
              "automatic: smooth where γ has a continuous normal, nonsmooth where it has corners"));
   {
     OptionSpec m = integer("formulation", "multipliers", &SolverOptions::multipliers, 0, 1000000,
-                           "m; 0 = the default rule m = max(8, round(L/(c·h))), c = 8 (smooth) or 12 (non-smooth); "
-                           "a given m needs 8 <= m <= L/(2h)");
+                           "m, the points (2-D) or patches (3-D) on γ; 0 = the default rule: spacing s = c·h, m = "
+                           "max(8, round(L/s)) on a curve of length L, c = 8 (smooth) or 12 (non-smooth), "
+                           "max(8, round(A/s²)) on a surface of area A, c = 8 (smooth) or 4 (non-smooth); a given m "
+                           "needs 8 <= m and s >= 2h");
     m.aliases = {"m"};
     specs.push_back(m);
   }
@@ -208,15 +225,21 @@ std::vector<OptionSpec> make_specs() {
   {
     OptionSpec b = member(std::string("formulation"), std::string("flux_balance"), OptionType::boolean,
                           &SolverOptions::flux_balance,
-                          "3-D non-smooth, reconstructed traces (not a periodic box with c = 0): correct the "
+                          "non-smooth, reconstructed traces (not a periodic box with c = 0): correct the "
                           "readings ∂u/∂n so that each patch's multiplier and the data move their area-weighted "
                           "sum over γ by the discrete field's flux c∫_ω u − ∫_ω f");
     b.rule = "true or false";
-    b.violation = [](const OptionValue&) { return std::string(); };
+    b.violation = [](const OptionValue&, int) { return std::string(); };
+    b.dims = {3};
     specs.push_back(b);
   }
+}
+
+/// [data] c and the first half of [solver]: the Schur complement, GMRES, Newton, threads.
+void data_and_solver_specs(std::vector<OptionSpec>& specs) {
   // [data]
-  specs.push_back(number("data", "c", &Problem::c, 0.0, false, 1e12, false, "reaction coefficient of −Δu + c·u = f"));
+  specs.push_back(
+      number("data", "c", &DomainSettings::c, 0.0, false, 1e12, false, "reaction coefficient of −Δu + c·u = f"));
   // [solver]
   specs.push_back(
       choice(std::string("solver"), std::string("schur"), &SolverOptions::inner,
@@ -242,13 +265,13 @@ std::vector<OptionSpec> make_specs() {
     OptionSpec start;
     start.section = "solver", start.key = "start", start.type = OptionType::choice, start.choices = {"all", "zero"};
     start.meaning = "Newton start: all (every point active) or zero (λ = 0)";
-    start.get = [](const Problem&, const SolverOptions& o) -> OptionValue {
+    start.get = [](const DomainSettings&, const SolverOptions& o) -> OptionValue {
       return std::string(o.start_all_active ? "all" : "zero");
     };
-    start.set = [](Problem&, SolverOptions& o, const OptionValue& v) {
+    start.set = [](DomainSettings&, SolverOptions& o, const OptionValue& v) {
       o.start_all_active = std::get<std::string>(v) == "all";
     };
-    start.violation = [](const OptionValue&) { return std::string(); };
+    start.violation = [](const OptionValue&, int) { return std::string(); };
     specs.push_back(start);
   }
   {
@@ -256,7 +279,7 @@ std::vector<OptionSpec> make_specs() {
                           "threads for the transforms, loops and dense algebra; 0 = the machine's "
                           "(OMP_NUM_THREADS when set, else the hardware threads)");
     t.rule = "in 0 … 4 × the hardware threads";
-    t.violation = [](const OptionValue& v) {
+    t.violation = [](const OptionValue& v, int) {
       const std::int64_t n = std::get<std::int64_t>(v);
       return n < 0 || n > max_threads() ? "must be in 0 … " + std::to_string(max_threads()) +
                                               " (4 × the hardware threads), got " + std::to_string(n)
@@ -264,6 +287,10 @@ std::vector<OptionSpec> make_specs() {
     };
     specs.push_back(t);
   }
+}
+
+/// The rest of [solver]: memory, quadrature, the far field, the nested start, the condition number.
+void more_solver_specs(std::vector<OptionSpec>& specs) {
   specs.push_back(number("solver", "max_memory", &SolverOptions::max_memory, 0.0, false, 1e6, false,
                          "GiB a solve may use (checked against an estimate before any grid array is made); "
                          "0 = the memory available when the solve starts"));
@@ -274,23 +301,36 @@ std::vector<OptionSpec> make_specs() {
   {
     OptionSpec f =
         member(std::string("solver"), std::string("far_field"), OptionType::boolean, &SolverOptions::far_field,
-               "3-D green: interpolate the far pairs of the Schur complement and finish Newton on the "
-               "exact one (false: assemble every pair exactly)");
+               "green: interpolate the far pairs of the Schur complement and finish Newton on the exact "
+               "one (false: assemble every pair exactly)");
     f.rule = "true or false";
-    f.violation = [](const OptionValue&) { return std::string(); };
+    f.violation = [](const OptionValue&, int) { return std::string(); };
+    f.dims = {3};
     specs.push_back(f);
   }
-  specs.push_back(integer("solver", "nested_start", &SolverOptions::nested_start, 0, 1048576,
-                          "3-D: from this N on, Newton starts from the active set of the same problem solved "
-                          "on the grid of N/2 (0: never)"));
   {
-    OptionSpec c =
-        member(std::string("solver"), std::string("condition_number"), OptionType::boolean,
-               &SolverOptions::condition_number, "compute cond(S) of the final Newton matrix (2-D, green only)");
+    OptionSpec n = integer("solver", "nested_start", &SolverOptions::nested_start, 0, 1048576,
+                           "from this N on, Newton starts from the active set of the same problem solved on the "
+                           "grid of N/2 (0: never)");
+    n.dims = {3};
+    specs.push_back(n);
+  }
+  {
+    OptionSpec c = member(std::string("solver"), std::string("condition_number"), OptionType::boolean,
+                          &SolverOptions::condition_number, "compute cond(S) of the final Newton matrix (green only)");
     c.rule = "true or false";
-    c.violation = [](const OptionValue&) { return std::string(); };
+    c.violation = [](const OptionValue&, int) { return std::string(); };
+    c.dims = {2};
     specs.push_back(c);
   }
+}
+
+std::vector<OptionSpec> make_specs() {
+  std::vector<OptionSpec> specs;
+  domain_specs(specs);
+  formulation_specs(specs);
+  data_and_solver_specs(specs);
+  more_solver_specs(specs);
   for (OptionSpec& s : specs)
     if (s.type == OptionType::choice && s.rule.empty()) s.rule = quoted_list(s.choices);
   return specs;
@@ -383,9 +423,52 @@ const OptionSpec* find_option(std::string_view key) {
   return nullptr;
 }
 
-OptionValue OptionSpec::default_value() const { return get(Problem{}, SolverOptions{}); }
+bool OptionSpec::applies_to(int dim) const { return std::find(dims.begin(), dims.end(), dim) != dims.end(); }
 
-OptionValue checked(const OptionSpec& spec, OptionValue value) {
+OptionValue OptionSpec::default_value(int dim) const {
+  if (key == "dim") return std::int64_t(2);  // a problem without domain.dim is 2-D
+  return get(DomainSettings(dim), SolverOptions{});
+}
+
+DomainSettings::DomainSettings(int d) : dim(d), N(d == 3 ? 64 : 256) {
+  for (int k = 0; k < d; ++k) box.push_back(0.0), box.push_back(1.0);
+}
+
+template <int dim>
+DomainSettings domain_of(const BasicProblem<dim>& p) {
+  DomainSettings d(dim);
+  for (int k = 0; k < dim; ++k)
+    d.box[std::size_t(2 * k)] = p.box.lower[k], d.box[std::size_t(2 * k + 1)] = p.box.upper[k];
+  d.N = p.N;
+  d.boundary = p.boundary;
+  d.c = p.c;
+  return d;
+}
+
+template <int dim>
+void apply_domain(const DomainSettings& d, BasicProblem<dim>& p) {
+  if (d.dim != dim || d.box.size() != std::size_t(2 * dim))
+    throw std::invalid_argument("domain.dim: a " + std::to_string(d.dim) + "-D domain for a " + std::to_string(dim) +
+                                "-D problem");
+  for (int k = 0; k < dim; ++k)
+    p.box.lower[k] = d.box[std::size_t(2 * k)], p.box.upper[k] = d.box[std::size_t(2 * k + 1)];
+  p.N = d.N;
+  p.boundary = d.boundary;
+  p.c = d.c;
+}
+
+template DomainSettings domain_of(const BasicProblem<2>&);
+template DomainSettings domain_of(const BasicProblem<3>&);
+template void apply_domain(const DomainSettings&, BasicProblem<2>&);
+template void apply_domain(const DomainSettings&, BasicProblem<3>&);
+
+void check_applies(const OptionSpec& spec, int dim) {
+  if (!spec.applies_to(dim))
+    fail(spec, "applies to " + std::to_string(spec.dims.front()) + "-D problems only (this one is " +
+                   std::to_string(dim) + "-D)");
+}
+
+OptionValue checked(const OptionSpec& spec, OptionValue value, int dim) {
   if (spec.type == OptionType::number && std::holds_alternative<std::int64_t>(value))
     value = double(std::get<std::int64_t>(value));
   const bool right_type = (spec.type == OptionType::boolean && std::holds_alternative<bool>(value)) ||
@@ -404,15 +487,18 @@ OptionValue checked(const OptionSpec& spec, OptionValue value) {
   }
   if (spec.type == OptionType::numbers) {
     const auto& list = std::get<std::vector<double>>(value);
-    if (list.size() != spec.count) fail(spec, "expected an array of " + std::to_string(spec.count) + " numbers");
+    const std::size_t count = spec.count > 0 ? spec.count : std::size_t(2 * dim);
+    if (list.size() != count)
+      fail(spec, "expected an array of " + std::to_string(count) + " numbers" +
+                     (spec.count > 0 ? std::string() : " in " + std::to_string(dim) + "-D"));
     for (double x : list)
       if (!std::isfinite(x)) fail(spec, "must be finite (NaN or Inf given)");
   }
-  if (const std::string reason = spec.violation(value); !reason.empty()) fail(spec, reason);
+  if (const std::string reason = spec.violation(value, dim); !reason.empty()) fail(spec, reason);
   return value;
 }
 
-OptionValue parse_option_text(const OptionSpec& spec, const std::string& text) {
+OptionValue parse_option_text(const OptionSpec& spec, const std::string& text, int dim) {
   auto as_number = [&](const std::string& t) {
     std::size_t used = 0;
     double v = 0;
@@ -426,8 +512,8 @@ OptionValue parse_option_text(const OptionSpec& spec, const std::string& text) {
   };
   switch (spec.type) {
     case OptionType::boolean:
-      if (text == "true" || text == "1" || text == "yes") return checked(spec, true);
-      if (text == "false" || text == "0" || text == "no") return checked(spec, false);
+      if (text == "true" || text == "1" || text == "yes") return checked(spec, true, dim);
+      if (text == "false" || text == "0" || text == "no") return checked(spec, false, dim);
       fail(spec, "expected true or false, got \"" + text.substr(0, 40) + "\"");
     case OptionType::integer: {
       std::size_t used = 0;
@@ -438,25 +524,35 @@ OptionValue parse_option_text(const OptionSpec& spec, const std::string& text) {
         used = 0;
       }
       if (used == 0 || used != text.size()) fail(spec, "expected an integer, got \"" + text.substr(0, 40) + "\"");
-      return checked(spec, std::int64_t(v));
+      return checked(spec, std::int64_t(v), dim);
     }
     case OptionType::number:
-      return checked(spec, as_number(text));
+      return checked(spec, as_number(text), dim);
     case OptionType::choice:
-      return checked(spec, text);
+      return checked(spec, text, dim);
     case OptionType::numbers: {
       std::vector<double> list;
       std::stringstream in(text);
       for (std::string part; std::getline(in, part, ',');) list.push_back(as_number(part));
-      return checked(spec, list);
+      return checked(spec, list, dim);
     }
   }
   fail(spec, "unknown type");
 }
 
-void set_option(const OptionSpec& spec, Problem& problem, SolverOptions& options, OptionValue value) {
-  spec.set(problem, options, checked(spec, std::move(value)));
+void set_option(const OptionSpec& spec, DomainSettings& domain, SolverOptions& options, OptionValue value) {
+  spec.set(domain, options, checked(spec, std::move(value), domain.dim));
 }
+
+template <int dim>
+void set_option(const OptionSpec& spec, BasicProblem<dim>& problem, SolverOptions& options, OptionValue value) {
+  DomainSettings domain = domain_of(problem);
+  set_option(spec, domain, options, std::move(value));
+  apply_domain(domain, problem);
+}
+
+template void set_option(const OptionSpec&, BasicProblem<2>&, SolverOptions&, OptionValue);
+template void set_option(const OptionSpec&, BasicProblem<3>&, SolverOptions&, OptionValue);
 
 std::string option_text(const OptionSpec& spec, const OptionValue& value) {
   (void)spec;
@@ -481,14 +577,47 @@ std::string option_text(const OptionSpec& spec, const OptionValue& value) {
 }
 
 void SolverOptions::validate() const {
-  const Problem defaults;  // the solver options do not read it
+  const DomainSettings defaults;  // the solver options do not read it
   for (const OptionSpec& spec : option_specs())
     if (spec.section == "formulation" || spec.section == "solver") checked(spec, spec.get(defaults, *this));
 }
 
-void validate_options(const Problem& problem, const SolverOptions& options) {
-  for (const OptionSpec& spec : option_specs()) checked(spec, spec.get(problem, options));
-  (void)Grid2(problem.box, problem.N, problem.boundary);  // the box must hold whole cells; periodic: even counts
+void validate_options(const DomainSettings& domain, const SolverOptions& options) {
+  if (domain.dim != 2 && domain.dim != 3) throw std::invalid_argument("domain.dim: expected 2 or 3");
+  const DomainSettings default_domain;
+  const SolverOptions default_options;
+  for (const OptionSpec& spec : option_specs()) {
+    if (spec.applies_to(domain.dim))
+      checked(spec, spec.get(domain, options), domain.dim);
+    else if (spec.get(domain, options) != spec.get(default_domain, default_options))
+      check_applies(spec, domain.dim);  // set away from its default where it means nothing: refused
+  }
+  // The box must hold whole cells; periodic: even counts.
+  if (domain.dim == 2) {
+    BasicProblem<2> p;
+    apply_domain(domain, p);
+    (void)Grid2(p.box, p.N, p.boundary);
+  } else {
+    BasicProblem<3> p;
+    apply_domain(domain, p);
+    (void)Grid3(p.box, p.N, p.boundary);
+  }
+}
+
+template <int dim>
+void validate_options(const BasicProblem<dim>& problem, const SolverOptions& options) {
+  validate_options(domain_of(problem), options);
+}
+
+template void validate_options(const BasicProblem<2>&, const SolverOptions&);
+template void validate_options(const BasicProblem<3>&, const SolverOptions&);
+
+std::string default_text(const OptionSpec& spec) {
+  if (!spec.applies_to(2)) return "`" + option_text(spec, spec.default_value(3)) + "`";
+  const std::string two = option_text(spec, spec.default_value(2));
+  if (!spec.applies_to(3)) return "`" + two + "`";
+  const std::string three = option_text(spec, spec.default_value(3));
+  return two == three ? "`" + two + "`" : "`" + two + "` (2-D), `" + three + "` (3-D)";
 }
 
 std::string options_markdown() {
@@ -498,9 +627,10 @@ std::string options_markdown() {
     if (s.section != section) {
       section = s.section;
       text += (text.empty() ? "" : "\n") + std::string("[") + section +
-              "]\n\n| key | default | allowed | meaning |\n|---|---|---|---|\n";
+              "]\n\n| key | dimensions | default | allowed | meaning |\n|---|---|---|---|---|\n";
     }
-    text += "| `" + s.key + "` | `" + option_text(s, s.default_value()) + "` | " + s.rule + " | " + s.meaning + " |\n";
+    const std::string dims = s.applies_to(2) && s.applies_to(3) ? "2, 3" : s.applies_to(2) ? "2" : "3";
+    text += "| `" + s.key + "` | " + dims + " | " + default_text(s) + " | " + s.rule + " | " + s.meaning + " |\n";
   }
   return text;
 }

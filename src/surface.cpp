@@ -113,4 +113,59 @@ Box3 Torus::bounds() const {
   return box;
 }
 
+TransformedSurface::TransformedSurface(std::shared_ptr<const Surface> base, int axis, double angle, Point3 shift)
+    : base_(std::move(base)), axis_(axis), cos_(std::cos(angle)), sin_(std::sin(angle)), shift_(shift) {
+  if (!base_) throw std::invalid_argument("geometry: no surface given");
+  if (axis < 0 || axis > 2) throw std::invalid_argument("--axis: expected x, y or z");
+  const Box3 b = base_->bounds();
+  center_ = 0.5 * (b.lower + b.upper);
+}
+
+Point3 TransformedSurface::rotate(const Point3& v) const {  // in the plane of the two other axes
+  const int i = (axis_ + 1) % 3, j = (axis_ + 2) % 3;
+  Point3 r = v;
+  r[i] = cos_ * v[i] - sin_ * v[j];
+  r[j] = sin_ * v[i] + cos_ * v[j];
+  return r;
+}
+
+Point3 TransformedSurface::unrotate(const Point3& v) const {
+  const int i = (axis_ + 1) % 3, j = (axis_ + 2) % 3;
+  Point3 r = v;
+  r[i] = cos_ * v[i] + sin_ * v[j];
+  r[j] = -sin_ * v[i] + cos_ * v[j];
+  return r;
+}
+
+Matrix3 TransformedSurface::level_hessian(const Point3& p) const {
+  const Matrix3 H = base_->level_hessian(back(p));
+  Matrix3 HRt, out;                                   // H Rᵀ by rows, then R (H Rᵀ) by columns
+  for (int r = 0; r < 3; ++r) HRt[r] = rotate(H[r]);  // row r of H Rᵀ is R·(row r of H)
+  for (int c = 0; c < 3; ++c) {
+    const Point3 column = rotate({HRt[0][c], HRt[1][c], HRt[2][c]});
+    for (int r = 0; r < 3; ++r) out[r][c] = column[r];
+  }
+  return out;
+}
+
+PatchedSurface TransformedSurface::patches(int m, double edge) const {
+  PatchedSurface s = base_->patches(m, edge);
+  for (Triangle3& t : s.triangles) t = {forward(t.a), forward(t.b), forward(t.c)};
+  for (Point3& p : s.point) p = forward(p);
+  for (Point3& n : s.normal) n = rotate(n);
+  return s;
+}
+
+Box3 TransformedSurface::bounds() const {
+  const Box3 b = base_->bounds();
+  Box3 out{forward(b.lower), forward(b.lower)};
+  for (int corner = 0; corner < 8; ++corner) {
+    const Point3 p = forward(
+        {corner & 1 ? b.upper.x : b.lower.x, corner & 2 ? b.upper.y : b.lower.y, corner & 4 ? b.upper.z : b.lower.z});
+    for (int d = 0; d < 3; ++d)
+      out.lower[d] = std::min(out.lower[d], p[d]), out.upper[d] = std::max(out.upper[d], p[d]);
+  }
+  return out;
+}
+
 }  // namespace fictus

@@ -2,6 +2,7 @@
 // What a solve returns, one type for both dimensions: the field û on the grid, the values at the m
 // points of γ (λ, g, B_γû, C_γû, contact flags), Newton's report, checks, errors and timings. The
 // points are a curve's collocation points in 2-D and a surface's patches in 3-D (SolutionBoundary).
+#include <cmath>
 #include <cstddef>
 #include <memory>
 #include <optional>
@@ -88,6 +89,7 @@ struct SolutionBoundary<2> {
   const std::vector<Point2>& points() const { return collocation.point; }
   const std::vector<Point2>& normals() const { return collocation.normal; }
   const std::vector<double>& weights() const { return collocation.arc; }  // the length of γ each point owns
+  double spacing() const { return collocation.spacing; }                  // s = L/m
 };
 
 template <>
@@ -98,6 +100,11 @@ struct SolutionBoundary<3> {
   const std::vector<Point3>& points() const { return gamma.point; }
   const std::vector<Point3>& normals() const { return gamma.normal; }
   const std::vector<double>& weights() const { return gamma.area; }  // the area of γ each point owns
+  double spacing() const {                                           // s = √(A/m)
+    double area = 0;
+    for (double a : gamma.area) area += a;
+    return gamma.m > 0 ? std::sqrt(area / gamma.m) : 0.0;
+  }
 };
 
 template <int dim>

@@ -107,4 +107,30 @@ class ImplicitSurface final : public Surface {
   double scale_ = 1, area_ = 0, reach_ = 0;
 };
 
+/// γ rotated by `angle` about the axis `axis` (0: x, 1: y, 2: z) through the centre of its bounds,
+/// then moved by `shift` (a sweep's members): level(x) = level₀(c + Rᵀ(x − shift − c)).
+class TransformedSurface final : public Surface {
+ public:
+  TransformedSurface(std::shared_ptr<const Surface> base, int axis, double angle, Point3 shift);
+  double level(const Point3& p) const override { return base_->level(back(p)); }
+  Point3 level_gradient(const Point3& p) const override { return rotate(base_->level_gradient(back(p))); }
+  Matrix3 level_hessian(const Point3& p) const override;
+  /// The base's patches, rotated and moved.
+  PatchedSurface patches(int m, double edge) const override;
+  double area() const override { return base_->area(); }
+  /// The box of the base's bounds' corners, rotated and moved.
+  Box3 bounds() const override;
+  double reach() const override { return base_->reach(); }
+
+ private:
+  Point3 rotate(const Point3& v) const;    // R v
+  Point3 unrotate(const Point3& v) const;  // Rᵀ v
+  Point3 back(const Point3& p) const { return center_ + unrotate(p - shift_ - center_); }
+  Point3 forward(const Point3& p) const { return center_ + rotate(p - center_) + shift_; }
+  std::shared_ptr<const Surface> base_;
+  int axis_;
+  double cos_, sin_;
+  Point3 center_, shift_;
+};
+
 }  // namespace fictus

@@ -451,3 +451,52 @@ def test_ctrl_c_stops_a_3d_solve():
     assert fictus.SurfaceProblem(domain=dict(N=32), geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.2),
                                  formulation=dict(variant="nonsmooth"),
                                  data=dict(f="-1", g="0.2 * (x - 0.5)")).solve().iterations > 0
+
+
+def test_one_problem_and_solution_type_in_both_dimensions(tmp_path, monkeypatch):
+    """fictus.Problem takes 2-D and 3-D descriptions; Solution has the same attributes in both."""
+    circle = fictus.Problem(domain=dict(N=64), geometry=dict(shape="circle", center=[0.5, 0.5], radius=0.25),
+                            formulation=dict(variant="nonsmooth"), data=dict(f="-1", g="0.1 * x")).solve()
+    sphere = fictus.Problem(domain=dict(dim=3, N=32), formulation=dict(variant="nonsmooth"),
+                            geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.25),
+                            data=dict(f="-1", g="0.1 * x")).solve()
+    assert type(circle) is fictus.Solution and isinstance(sphere, fictus.Solution)
+    assert isinstance(sphere, fictus.SurfaceSolution) and (circle.dim, sphere.dim) == (2, 3)
+    for s, measure in ((circle, 2 * np.pi * 0.25), (sphere, 4 * np.pi * 0.25 ** 2)):
+        m = s.multipliers
+        assert s.points.shape == s.normals.shape == s.gamma_points.shape == (m, s.dim)
+        assert s.u.ndim == s.dim and len(s.axes) == s.dim and s.u.shape == tuple(len(a) for a in s.axes[::-1])
+        assert abs(s.weights.sum() - measure) < 0.02 * measure  # arcs or patch areas cover γ
+        assert s.contact_summary["points"] == int(s.contact.sum()) > 0
+        assert s.options["dim"] == s.dim and len(s.options["box"]) == 2 * s.dim
+        assert s.options["N"] == s.u.shape[0] - 1
+    assert "condition_number" in circle.options and "condition_number" not in sphere.options
+    assert "flux_balance" in sphere.options and "flux_balance" not in circle.options
+    np.testing.assert_array_equal(sphere.area, sphere.weights)
+    with pytest.raises(AttributeError, match="^s: exists in 2-D solutions only"):
+        sphere.s
+    with pytest.raises(AttributeError, match="^z: exists in 3-D solutions only"):
+        circle.z
+    # an option of the other dimension is refused, never ignored
+    with pytest.raises(ValueError, match=r"^solver.condition_number: applies to 2-D problems only \(this one is 3-D\)"):
+        fictus.Problem(domain=dict(dim=3), condition_number=True,
+                       geometry=dict(shape="sphere", center=[0.5, 0.5, 0.5], radius=0.25), data=dict(f="1", g="0"))
+    with pytest.raises(ValueError, match=r"^formulation.flux_balance: applies to 3-D problems only"):
+        fictus.Problem(flux_balance=False, geometry=dict(shape="circle", center=[0.5, 0.5], radius=0.25),
+                       data=dict(f="1", g="0"))
+    # a file with a mesh named relative to it, read from another folder
+    folder = tmp_path / "case"
+    folder.mkdir()
+    vertices, faces = fictus.icosphere(3, [0.5, 0.5, 0.5], 0.25)
+    with open(folder / "ball.off", "w") as handle:
+        handle.write(f"OFF\n{len(vertices)} {len(faces)} 0\n")
+        handle.writelines(f"{x!r} {y!r} {z!r}\n" for x, y, z in vertices)
+        handle.writelines(f"3 {a} {b} {c}\n" for a, b, c in faces)
+    with open(folder / "ball.toml", "w") as handle:
+        handle.write('[domain]\ndim = 3\nN = 32\n[geometry]\nshape = "mesh"\nfile = "ball.off"\n'
+                     '[formulation]\nvariant = "nonsmooth"\n[data]\nf = "-1"\ng = "0.1 * x"\n')
+    monkeypatch.chdir(tmp_path)
+    p = fictus.Problem.from_file(str(folder / "ball.toml"))
+    assert type(p) is fictus.Problem and p.dim == 3 and p.N == 32
+    mesh = p.solve()
+    assert mesh.dim == 3 and mesh.converged and 0 < mesh.contact.sum() < mesh.multipliers

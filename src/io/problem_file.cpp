@@ -91,11 +91,15 @@ class TableReader {
     if (!n->is_array()) fail(key(k), std::string("expected an array, got ") + type_name(*n));
     return n->as_array();
   }
-  /// The schema's options of this section that the table gives, set into (problem, options).
-  void read_options(Problem& problem, SolverOptions& options) {
+  /// The schema's options of this section that the table gives, set into (domain, options); an option
+  /// of the other dimension is refused.
+  void read_options(DomainSettings& domain, SolverOptions& options) {
     for (const OptionSpec& spec : option_specs())
       if (spec.section == name_)
-        if (const toml::node* n = node(spec.key)) set_option(spec, problem, options, value_of(spec, *n));
+        if (const toml::node* n = node(spec.key)) {
+          check_applies(spec, domain.dim);
+          set_option(spec, domain, options, value_of(spec, *n));
+        }
   }
   /// Throws for the first key that was never read.
   void finish() const {
@@ -173,7 +177,7 @@ struct ExpressionMaker {
 
 /// [parameters]: named numbers for the expressions, the file's values replaced by `overrides`.
 std::map<std::string, double> read_parameters(const toml::table* table, const ParameterValues& overrides) {
-  static const std::set<std::string> variables = {"x", "y", "t", "phi", "s"};
+  static const std::set<std::string> variables = {"x", "y", "z", "t", "phi", "s"};
   std::map<std::string, double> values;
   if (table)
     for (const auto& [k, node] : *table) {
@@ -262,11 +266,6 @@ std::shared_ptr<const Curve> read_geometry(TableReader& g, const ExpressionMaker
 
 }  // namespace
 
-const std::vector<std::string>& output_file_names() {
-  static const std::vector<std::string> names = {"results.json", "points.csv", "solution.vti", "curves.vtp"};
-  return names;
-}
-
 namespace {
 
 toml::table parse_toml(const std::string& text, const std::string& source) {
@@ -291,232 +290,240 @@ int problem_dimension(const std::string& text, const std::string& source) {
   return int(*value);
 }
 
-SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std::string& source,
-                                              std::shared_ptr<const Surface> mesh) {
-  const toml::table root = parse_toml(text, source);
-  for (const auto& [k, v] : root) {
-    const std::string name(k.str());
-    if (name != "domain" && name != "geometry" && name != "formulation" && name != "data" && name != "solver" &&
-        name != "output")
-      fail(name, "unknown section of a 3-D problem (domain, geometry, formulation, data, solver, output)" +
-                     did_you_mean(name, {"domain", "geometry", "formulation", "data", "solver", "output"}));
-  }
-  SurfaceProblemSpec spec;
-  SurfaceProblem& p = spec.problem;
-  SolverOptions& o = spec.options;
-  Problem plane;  // the schema's options are read into a 2-D problem; its N, boundary and c are taken over
-  plane.N = 64;
+const std::vector<std::string>& output_file_names(int dim) {
+  static const std::vector<std::string> curves = {"results.json", "points.csv", "solution.vti", "curves.vtp"};
+  static const std::vector<std::string> surfaces = {"results.json", "points.csv", "solution.vti", "surface.vtp"};
+  return dim == 3 ? surfaces : curves;
+}
 
-  TableReader domain(subtable(root, "domain"), "domain");
-  domain.number("dim", 3);
-  const double N = domain.number("N", 64);
-  if (N != std::floor(N) || N < 8 || N > 1024) fail("domain.N", "expected a whole number of cells, 8 <= N <= 1024");
-  p.N = int(N);
-  const std::string boundary = domain.string("boundary", "dirichlet");
-  if (boundary != "dirichlet" && boundary != "periodic") fail("domain.boundary", "expected dirichlet or periodic");
-  p.boundary = boundary == "dirichlet" ? Boundary::dirichlet : Boundary::periodic;
-  const auto box = domain.numbers("box", 6, {0, 0, 0, 1, 1, 1});
-  for (int d = 0; d < 3; ++d) {
-    if (!(box[d + 3] > box[d])) fail("domain.box", "expected [x0, y0, z0, x1, y1, z1] with x0 < x1, y0 < y1, z0 < z1");
-    p.box.lower[d] = box[d], p.box.upper[d] = box[d + 3];
-  }
-  domain.finish();
+const std::vector<std::string>& surface_output_file_names() { return output_file_names(3); }
 
-  const toml::table* geometry_table = subtable(root, "geometry");
-  if (!geometry_table) fail("geometry", "missing section [geometry]");
-  TableReader geometry(geometry_table, "geometry");
+namespace {
+
+/// A mesh file named relative to the problem file's folder when `source` names a file.
+std::filesystem::path mesh_path(const std::string& file, const std::string& source) {
+  std::filesystem::path path = file;
+  std::error_code error;
+  if (path.is_relative() && std::filesystem::is_regular_file(source, error))
+    path = std::filesystem::path(source).parent_path() / path;
+  return path;
+}
+
+/// [geometry] of a 3-D problem: a sphere, an ellipsoid, a torus, an implicit surface, or a mesh (built
+/// by `build_mesh`, which the caller runs once every other key has been read: it can take seconds).
+std::shared_ptr<const Surface> read_surface(TableReader& geometry, const ExpressionMaker& expression,
+                                            const std::string& source, std::shared_ptr<const Surface> given,
+                                            std::function<std::shared_ptr<const Surface>()>& build_mesh,
+                                            std::vector<std::string>& warnings) {
   const std::string shape = geometry.required_string("shape");
   if (shape == "implicit") {
-    const Expression level(geometry.required_string("level"), {"x", "y", "z"}, "geometry.level");
-    const auto b = geometry.required_numbers("bounds", 6);
-    p.gamma = std::make_shared<ImplicitSurface>(
+    const Expression level = expression(geometry.required_string("level"), {"x", "y", "z"}, "geometry.level");
+    const auto b = geometry.required_numbers("bounds", 6);  // bounds order, as domain.box
+    if (!(b[0] < b[1] && b[2] < b[3] && b[4] < b[5]))
+      throw std::invalid_argument(
+          "geometry.bounds: the bounds are [x0, x1, y0, y1, z0, z1] (bounds order, as domain.box) with x0 < x1, "
+          "y0 < y1 and z0 < z1");
+    return std::make_shared<ImplicitSurface>(
         [level](double x, double y, double z) {
           return level({x, y, z});
         },
-        Box3{{b[0], b[1], b[2]}, {b[3], b[4], b[5]}});
+        Box3{{b[0], b[2], b[4]}, {b[1], b[3], b[5]}});
   }
-  // A mesh is built last, once every other key has been read (building it can take seconds).
-  std::function<void()> build_mesh;
   if (shape == "mesh") {
     const double resolution = geometry.number("resolution", automatic_mesh_resolution);
     check_mesh_resolution(resolution);
-    if (geometry.has("file")) {
-      std::filesystem::path file = geometry.string("file", "");
-      std::error_code error;
-      if (file.is_relative() && std::filesystem::is_regular_file(source, error))
-        file = std::filesystem::path(source).parent_path() / file;
-      build_mesh = [&spec, &p, file, resolution] {
-        const auto surface = std::make_shared<MeshSurface>(read_polygon_soup(file.string(), "geometry.file"),
-                                                           int(resolution), "geometry.file");
-        for (const std::string& w : surface->warnings()) spec.warnings.push_back("geometry.file: " + w);
-        p.gamma = surface;
-      };
-    } else if (mesh) {
-      p.gamma = std::move(mesh);
-    } else {
-      fail("geometry.file", "missing (a .off, .stl, .obj or .ply file)");
-    }
+    if (given) return given;
+    geometry.require("file");
+    const std::filesystem::path file = mesh_path(geometry.string("file", ""), source);
+    build_mesh = [file, resolution, &warnings] {
+      const auto surface = std::make_shared<MeshSurface>(read_polygon_soup(file.string(), "geometry.file"),
+                                                         int(resolution), "geometry.file");
+      for (const std::string& w : surface->warnings()) warnings.push_back("geometry.file: " + w);
+      return surface;
+    };
+    return nullptr;
   }
-  const bool centered = shape != "implicit" && shape != "mesh";
-  const auto center = centered ? geometry.required_numbers("center", 3) : std::vector<double>(3, 0.0);
-  Point3 axes;
-  if (!centered) {
-  } else if (shape == "torus") {
+  if (shape != "sphere" && shape != "ellipsoid" && shape != "torus")
+    fail("geometry.shape", "unknown 3-D shape \"" + shape.substr(0, 40) +
+                               "\" (sphere, ellipsoid, torus, implicit, mesh)" +
+                               did_you_mean(shape, {"sphere", "ellipsoid", "torus", "implicit", "mesh"}));
+  const auto c = geometry.required_numbers("center", 3);
+  const Point3 center{c[0], c[1], c[2]};
+  if (shape == "torus") {
     geometry.require("major_radius");
     geometry.require("minor_radius");
     const double R = geometry.number("major_radius", 0.0), r = geometry.number("minor_radius", 0.0);
     if (!(r > 0 && R > r)) fail("geometry.minor_radius", "need 0 < minor_radius < major_radius");
-    p.gamma = std::make_shared<Torus>(Point3{center[0], center[1], center[2]}, R, r);
-  } else if (shape == "sphere") {
+    return std::make_shared<Torus>(center, R, r);
+  }
+  if (shape == "sphere") {
     geometry.require("radius");
     const double r = geometry.number("radius", 0.0);
     if (!(r > 0)) fail("geometry.radius", "must be positive");
-    axes = {r, r, r};
-  } else if (shape == "ellipsoid") {
-    const auto a = geometry.required_numbers("semi_axes", 3);
-    axes = {a[0], a[1], a[2]};
+    return std::make_shared<Ellipsoid>(center, Point3{r, r, r});
+  }
+  const auto a = geometry.required_numbers("semi_axes", 3);
+  return std::make_shared<Ellipsoid>(center, Point3{a[0], a[1], a[2]});
+}
+
+/// [data]: c (through the schema), f, g and the exact solution as expressions in x, y (, z); in 2-D g
+/// may also name phi (the polar angle about γ's center) and s (the arc length along γ).
+template <int dim>
+void read_data(TableReader& data, const ExpressionMaker& expression, DomainSettings& domain,
+               BasicProblemSpec<dim>& spec) {
+  BasicProblem<dim>& p = spec.problem;
+  data.read_options(domain, spec.options);
+  if constexpr (dim == 2) {
+    const Expression f = expression(data.required_string("f"), {"x", "y"}, "data.f");
+    p.f = [f](double x, double y) { return f({x, y}); };
+    const Expression g = expression(data.required_string("g"), {"x", "y", "phi", "s"}, "data.g");
+    spec.g_about = [g](Point2 center) -> std::function<double(double, double, double)> {
+      return [g, center](double x, double y, double s) { return g({x, y, std::atan2(y - center.y, x - center.x), s}); };
+    };
+    p.g_along_curve = spec.g_about(p.gamma->center());
+    if (data.has("exact")) {
+      const Expression exact = expression(data.string("exact", ""), {"x", "y"}, "data.exact");
+      p.exact = [exact](double x, double y) { return exact({x, y}); };
+    }
   } else {
-    fail("geometry.shape",
-         "unknown 3-D shape \"" + shape.substr(0, 40) + "\" (sphere, ellipsoid, torus, implicit, mesh)");
-  }
-  if (shape == "sphere" || shape == "ellipsoid")
-    p.gamma = std::make_shared<Ellipsoid>(Point3{center[0], center[1], center[2]}, axes);
-  geometry.finish();
-
-  TableReader formulation(subtable(root, "formulation"), "formulation");
-  formulation.read_options(plane, o);
-  formulation.finish();
-
-  TableReader data(subtable(root, "data"), "data");
-  p.c = data.number("c", 1.0);
-  if (p.c < 0 || p.c > 1e12) fail("data.c", "expected 0 <= c <= 1e12");
-  const Expression f(data.required_string("f"), {"x", "y", "z"}, "data.f");
-  p.f = [f](double x, double y, double z) { return f({x, y, z}); };
-  const Expression g(data.required_string("g"), {"x", "y", "z"}, "data.g");
-  p.g = [g](double x, double y, double z) { return g({x, y, z}); };
-  if (data.has("exact")) {
-    const Expression exact(data.string("exact", ""), {"x", "y", "z"}, "data.exact");
-    p.exact = [exact](double x, double y, double z) { return exact({x, y, z}); };
-  }
-  data.finish();
-
-  TableReader solver(subtable(root, "solver"), "solver");
-  solver.read_options(plane, o);
-  solver.finish();
-  o.validate();
-
-  TableReader output(subtable(root, "output"), "output");
-  spec.output.dir = output.string("dir", spec.output.dir);
-  spec.output.files = surface_output_file_names();
-  if (const toml::array* files = output.array("files")) {
-    spec.output.files.clear();
-    for (const toml::node& file : *files) {
-      const auto name = file.value<std::string>();
-      const auto& names = surface_output_file_names();
-      if (!name || std::find(names.begin(), names.end(), *name) == names.end())
-        fail("output.files", "expected names from results.json, points.csv, solution.vti, surface.vtp");
-      spec.output.files.push_back(*name);
+    const Expression f = expression(data.required_string("f"), {"x", "y", "z"}, "data.f");
+    p.f = [f](double x, double y, double z) { return f({x, y, z}); };
+    const Expression g = expression(data.required_string("g"), {"x", "y", "z"}, "data.g");
+    p.g = [g](double x, double y, double z) { return g({x, y, z}); };
+    if (data.has("exact")) {
+      const Expression exact = expression(data.string("exact", ""), {"x", "y", "z"}, "data.exact");
+      p.exact = [exact](double x, double y, double z) { return exact({x, y, z}); };
     }
   }
-  output.finish();
-  toml::table echo;
-  echo.insert("geometry", *geometry_table);
-  if (const toml::table* d = subtable(root, "data")) echo.insert("data", *d);
-  std::ostringstream json;
-  json << toml::json_formatter{echo};
-  spec.input_json = json.str();
-  spec.name = source;
-  if (build_mesh) build_mesh();
-  return spec;
-}
-
-const std::vector<std::string>& surface_output_file_names() {
-  static const std::vector<std::string> names = {"results.json", "points.csv", "solution.vti", "surface.vtp"};
-  return names;
-}
-
-ProblemSpec parse_problem_text(const std::string& text, const std::string& source, const ParameterValues& parameters,
-                               std::shared_ptr<const Curve> curve) {
-  toml::table root = parse_toml(text, source);
-  for (const auto& [k, v] : root) {
-    const std::string name(k.str());
-    if (name != "domain" && name != "geometry" && name != "formulation" && name != "data" && name != "solver" &&
-        name != "output" && name != "parameters")
-      fail(name,
-           "unknown section (domain, geometry, formulation, data, solver, output, parameters)" +
-               did_you_mean(name, {"domain", "geometry", "formulation", "data", "solver", "output", "parameters"}));
-  }
-  ProblemSpec spec;
-  spec.parameters = read_parameters(subtable(root, "parameters"), parameters);
-  ExpressionMaker expression{{spec.parameters.begin(), spec.parameters.end()}, &spec.parameter_uses};
-  Problem& p = spec.problem;
-  SolverOptions& o = spec.options;
-
-  TableReader domain(subtable(root, "domain"), "domain");
-  if (domain.number("dim", 2) != 2) fail("domain.dim", "a 3-D problem (dim = 3) is read by read_surface_problem");
-  domain.read_options(p, o);
-  domain.finish();
-
-  const toml::table* geometry_table = subtable(root, "geometry");
-  if (!geometry_table) fail("geometry", "missing section [geometry]");
-  TableReader geometry(geometry_table, "geometry");
-  if (curve) {
-    p.gamma = std::move(curve);
-  } else {
-    p.gamma = read_geometry(geometry, expression, spec.warnings);
-    geometry.finish();
-  }
-
-  TableReader formulation(subtable(root, "formulation"), "formulation");
-  formulation.read_options(p, o);
-  formulation.finish();
-
-  TableReader data(subtable(root, "data"), "data");
-  data.read_options(p, o);
-  const Expression f = expression(data.required_string("f"), {"x", "y"}, "data.f");
-  p.f = [f](double x, double y) { return f({x, y}); };
-  const Expression g = expression(data.required_string("g"), {"x", "y", "phi", "s"}, "data.g");
-  spec.g_about = [g](Point2 center) -> std::function<double(double, double, double)> {
-    return [g, center](double x, double y, double s) { return g({x, y, std::atan2(y - center.y, x - center.x), s}); };
-  };
-  p.g_along_curve = spec.g_about(p.gamma->center());
-  if (data.has("exact")) {
-    const Expression exact = expression(data.string("exact", ""), {"x", "y"}, "data.exact");
-    p.exact = [exact](double x, double y) { return exact({x, y}); };
-  }
   data.finish();
+}
 
-  TableReader solver(subtable(root, "solver"), "solver");
-  solver.read_options(p, o);
-  solver.finish();
-  validate_options(p, o);
-
-  TableReader output(subtable(root, "output"), "output");
-  spec.output.dir = output.string("dir", spec.output.dir);
+/// [output]: the folder and the files (the names of the dimension).
+OutputOptions read_output(TableReader& output, int dim) {
+  OutputOptions out;
+  out.dir = output.string("dir", out.dir);
+  const std::vector<std::string>& names = output_file_names(dim);
+  out.files = names;
   if (const toml::array* files = output.array("files")) {
-    spec.output.files.clear();
+    out.files.clear();
     for (const toml::node& f : *files) {
       const auto name = f.value<std::string>();
-      if (!name ||
-          std::find(output_file_names().begin(), output_file_names().end(), *name) == output_file_names().end())
-        fail("output.files", "expected names from results.json, points.csv, solution.vti, curves.vtp");
-      spec.output.files.push_back(*name);
+      if (!name || std::find(names.begin(), names.end(), *name) == names.end())
+        fail("output.files", "expected names from " + names[0] + ", " + names[1] + ", " + names[2] + ", " + names[3]);
+      out.files.push_back(*name);
     }
   }
   output.finish();
-  p.name = source;
+  return out;
+}
+
+/// results.json's echo of the file: [geometry] (a mesh file as an absolute path), [data], [parameters].
+std::string echo_json(const toml::table& root, const toml::table& geometry_table, const std::string& source,
+                      const std::map<std::string, double>& parameters) {
   toml::table echo;
-  echo.insert("geometry", *geometry_table);
+  toml::table geometry = geometry_table;
+  if (const auto* file = geometry.get_as<std::string>("file"))
+    geometry.insert_or_assign("file",
+                              std::filesystem::absolute(mesh_path(file->get(), source)).lexically_normal().string());
+  echo.insert("geometry", geometry);
   if (const toml::table* d = subtable(root, "data")) echo.insert("data", *d);
-  if (!spec.parameters.empty()) {
+  if (!parameters.empty()) {
     toml::table in_effect;
-    for (const auto& [name, value] : spec.parameters) in_effect.insert(name, value);
+    for (const auto& [name, value] : parameters) in_effect.insert(name, value);
     echo.insert("parameters", in_effect);
   }
   std::ostringstream json;
   json << toml::json_formatter{echo};
-  spec.input_json = json.str();
+  return json.str();
+}
+
+const std::vector<std::string> sections = {"domain", "geometry", "formulation", "data",
+                                           "solver", "output",   "parameters"};
+
+}  // namespace
+
+std::string with_mesh_overrides(const std::string& text, const std::string& source, const std::string& file,
+                                double resolution) {
+  toml::table root = parse_toml(text, source);
+  toml::node* node = root.get("geometry");
+  if (!node || !node->is_table()) fail("geometry", "missing section [geometry]");
+  toml::table& geometry = *node->as_table();
+  const auto* shape = geometry.get_as<std::string>("shape");
+  if (!shape || shape->get() != "mesh") fail("--file", "--file and --resolution need geometry.shape = \"mesh\"");
+  if (!file.empty()) geometry.insert_or_assign("file", std::filesystem::absolute(file).lexically_normal().string());
+  if (resolution >= 0) {
+    check_mesh_resolution(resolution);
+    geometry.insert_or_assign("resolution", std::int64_t(resolution));
+  }
+  std::ostringstream out;
+  out << root;
+  return out.str();
+}
+
+template <int dim>
+BasicProblemSpec<dim> parse_problem(const std::string& text, const std::string& source,
+                                    const ParameterValues& parameters,
+                                    std::shared_ptr<const typename BoundaryShape<dim>::type> shape) {
+  const toml::table root = parse_toml(text, source);
+  for (const auto& [k, v] : root)
+    if (std::find(sections.begin(), sections.end(), std::string(k.str())) == sections.end())
+      fail(std::string(k.str()), "unknown section (domain, geometry, formulation, data, solver, output, parameters)" +
+                                     did_you_mean(k.str(), sections));
+  if (problem_dimension(text, source) != dim)
+    fail("domain.dim", "a " + std::to_string(problem_dimension(text, source)) + "-D problem read as a " +
+                           std::to_string(dim) + "-D one");
+  BasicProblemSpec<dim> spec;
+  spec.parameters = read_parameters(subtable(root, "parameters"), parameters);
+  ExpressionMaker expression{{spec.parameters.begin(), spec.parameters.end()}, &spec.parameter_uses};
+  BasicProblem<dim>& p = spec.problem;
+  DomainSettings domain(dim);
+  TableReader domain_table(subtable(root, "domain"), "domain");
+  domain_table.read_options(domain, spec.options);
+  domain_table.finish();
+
+  const toml::table* geometry_table = subtable(root, "geometry");
+  if (!geometry_table) fail("geometry", "missing section [geometry]");
+  TableReader geometry(geometry_table, "geometry");
+  std::function<std::shared_ptr<const Surface>()> build_mesh;
+  if constexpr (dim == 2) {
+    p.gamma = shape ? shape : read_geometry(geometry, expression, spec.warnings);
+  } else {
+    p.gamma = read_surface(geometry, expression, source, shape, build_mesh, spec.warnings);
+  }
+  if (!(dim == 2 && shape)) geometry.finish();
+
+  TableReader formulation(subtable(root, "formulation"), "formulation");
+  formulation.read_options(domain, spec.options);
+  formulation.finish();
+  TableReader data(subtable(root, "data"), "data");
+  read_data<dim>(data, expression, domain, spec);
+  TableReader solver(subtable(root, "solver"), "solver");
+  solver.read_options(domain, spec.options);
+  solver.finish();
+  validate_options(domain, spec.options);
+  apply_domain(domain, p);
+  TableReader output(subtable(root, "output"), "output");
+  spec.output = read_output(output, dim);
+  p.name = source;
+  spec.input_json = echo_json(root, *geometry_table, source, spec.parameters);
+  if constexpr (dim == 3)
+    if (build_mesh) p.gamma = build_mesh();
   return spec;
+}
+
+template BasicProblemSpec<2> parse_problem(const std::string&, const std::string&, const ParameterValues&,
+                                           std::shared_ptr<const Curve>);
+template BasicProblemSpec<3> parse_problem(const std::string&, const std::string&, const ParameterValues&,
+                                           std::shared_ptr<const Surface>);
+
+ProblemSpec parse_problem_text(const std::string& text, const std::string& source, const ParameterValues& parameters,
+                               std::shared_ptr<const Curve> curve) {
+  return parse_problem<2>(text, source, parameters, std::move(curve));
+}
+
+SurfaceProblemSpec parse_surface_problem_text(const std::string& text, const std::string& source,
+                                              std::shared_ptr<const Surface> mesh, const ParameterValues& parameters) {
+  return parse_problem<3>(text, source, parameters, std::move(mesh));
 }
 
 std::string read_problem_text(const std::string& path) {

@@ -32,9 +32,12 @@ def main():
     with open(os.path.join(folder, "points.csv")) as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == m, (len(rows), m)
-    assert list(rows[0].keys()) == "patch x y z nx ny nz area u g dudn lambda contact".split(), rows[0].keys()
+    header = "i x y z nx ny nz weight g u dudn lambda contact Gamma_x Gamma_y Gamma_z dudn_check"
+    assert list(rows[0].keys()) == header.split(), rows[0].keys()
     assert sum(int(row["contact"]) for row in rows) == r["contact"]["points"]
-    assert abs(sum(float(row["area"]) for row in rows) - r["surface"]["area"]) < 1e-9
+    assert abs(sum(float(row["weight"]) for row in rows) - r["boundary"]["measure"]) < 1e-9
+    force = sum(float(row["dudn"]) * float(row["weight"]) for row in rows if row["contact"] == "1")
+    assert abs(force - r["contact"]["force"]) <= 1e-9 * abs(r["contact"]["force"]), (force, r["contact"])
 
     image = vtkXMLImageDataReader()
     image.SetFileName(os.path.join(folder, "solution.vti"))
@@ -72,7 +75,7 @@ def main():
         assert per_cell.min() - 1e-12 <= at_points.min() and at_points.max() <= per_cell.max() + 1e-12, name
     gap = vtk_to_numpy(cells.GetArray("gap"))
     assert abs(gap - (vtk_to_numpy(cells.GetArray("u")) - vtk_to_numpy(cells.GetArray("g")))).max() < 1e-15
-    smooth = r["surface"]["delta"] > 0
+    smooth = r["boundary"]["delta"] > 0
     assert (cells.GetArray("lambda") is None) == smooth  # λ lives on Γ in the smooth variant
     if smooth:
         offset = vtkXMLPolyDataReader()

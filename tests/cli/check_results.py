@@ -8,7 +8,7 @@ import sys
 REQUIRED = {
     "version": str, "options": dict, "grid": dict, "multipliers": int, "newton": dict,
     "inner": dict, "timings": dict, "signorini": dict, "errors": dict, "peak_memory_bytes": int,
-    "contact": dict,
+    "contact": dict, "dim": int, "box": list, "boundary": dict, "alpha": float, "warnings": list,
 }
 
 
@@ -44,12 +44,12 @@ def main(folder):
         assert math.isfinite(value) and 0 < value < 1, f"errors.{key} = {value}"
     with open(f"{folder}/points.csv") as handle:
         rows = handle.read().strip().splitlines()
-    assert rows[0] == "i,s,x,y,nx,ny,g,u,dudn,lambda,contact,Gamma_x,Gamma_y,arc,dudn_check"
+    assert rows[0] == "i,s,x,y,nx,ny,weight,g,u,dudn,lambda,contact,Gamma_x,Gamma_y,dudn_check"
     columns = [row.split(",") for row in rows[1:]]
-    arcs = [float(c[13]) for c in columns]
-    assert math.isclose(sum(arcs), results["curve"]["length"], rel_tol=1e-9), (sum(arcs), results["curve"])
-    force = sum(float(c[8]) * float(c[13]) for c in columns if c[10] == "1")
-    measure = sum(float(c[13]) for c in columns if c[10] == "1")
+    arcs = [float(c[6]) for c in columns]
+    assert math.isclose(sum(arcs), results["boundary"]["measure"], rel_tol=1e-9), (sum(arcs), results["boundary"])
+    force = sum(float(c[9]) * float(c[6]) for c in columns if c[11] == "1")
+    measure = sum(float(c[6]) for c in columns if c[11] == "1")
     assert math.isclose(force, contact["force"], rel_tol=1e-9), (force, contact["force"])
     assert math.isclose(measure, contact["measure"], rel_tol=1e-9), (measure, contact["measure"])
     assert len(rows) == results["multipliers"] + 1

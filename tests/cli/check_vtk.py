@@ -49,7 +49,7 @@ def main(folder):
     reader.Update()
     poly = reader.GetOutput()
     m = results["multipliers"]
-    smooth = results["curve"]["delta"] > 0
+    smooth = results["boundary"]["delta"] > 0
     assert poly.GetNumberOfPoints() == m and poly.GetNumberOfLines() == 1  # γ alone
     data = poly.GetPointData()
     contact = vtk_to_numpy(data.GetArray("contact"))

@@ -1,6 +1,7 @@
 """Walks every option of `fictus options --json` through the four ways in: a problem file, a
-command-line flag (its name is the key), results.json's `options` and the Python keyword, and checks
-that the same value arrives each way. A new option without a walk value below fails the test.
+command-line flag (its name is the key), results.json's `options` and the Python keyword, in every
+dimension it applies to, and checks that the same value arrives each way, and that results.json and
+Python list exactly the options of the dimension. A new option without a walk value below fails the test.
 
 Usage: option_walk.py FICTUS_EXE OUT_DIR   (PYTHONPATH must hold the fictus module)
 """
@@ -14,20 +15,30 @@ import fictus
 
 exe, out = sys.argv[1], sys.argv[2]
 
-BASE = {
-    "domain": {"N": 64},
-    "geometry": {"shape": "circle", "center": [0.5, 0.5], "radius": 0.25},
-    "data": {"f": "1", "g": "0"},
-    "formulation": {"variant": "nonsmooth"},
-    "solver": {},
+BASES = {
+    2: {
+        "domain": {"N": 64},
+        "geometry": {"shape": "circle", "center": [0.5, 0.5], "radius": 0.25},
+        "data": {"f": "1", "g": "0"},
+        "formulation": {"variant": "nonsmooth"},
+        "solver": {},
+    },
+    3: {
+        "domain": {"dim": 3, "N": 24},
+        "geometry": {"shape": "sphere", "center": [0.5, 0.5, 0.5], "radius": 0.25},
+        "data": {"f": "1", "g": "0"},
+        "formulation": {"variant": "nonsmooth"},
+        "solver": {},
+    },
 }
-# A valid value other than the default for every option, chosen so that N = 64 solves quickly.
+# A valid value other than the default for every option and dimension, chosen so that the small
+# grids above solve quickly. `dim` is walked by the bases themselves (it says which reader a file needs).
 WALK = {
-    "box": [-0.5, 1.5, -0.5, 1.5],
-    "N": 72,
+    "box": {2: [-0.5, 1.5, -0.5, 1.5], 3: [-0.25, 1.25, -0.25, 1.25, -0.25, 1.25]},
+    "N": {2: 72, 3: 28},
     "boundary": "periodic",
     "variant": "smooth",
-    "multipliers": 24,
+    "multipliers": {2: 24, 3: 40},
     "offset": 2.0,
     "rho": 0.5,
     "normal_derivative": "shifted",
@@ -45,9 +56,14 @@ WALK = {
     "error_quadrature": 4,
     "far_field": False,
     "flux_balance": False,
-    "nested_start": 96,
+    "nested_start": 28,
     "condition_number": False,
 }
+
+
+def walk_value(key, dim):
+    value = WALK[key]
+    return value[dim] if isinstance(value, dict) else value
 
 
 def toml_value(v):
@@ -81,7 +97,7 @@ def same(a, b):
     return a == b
 
 
-def solve_cli(name, config, flags=()):
+def solve_cli(name, config, flags, keys):
     folder = os.path.join(out, name)
     path = os.path.join(out, name + ".toml")
     with open(path, "w") as f:
@@ -98,30 +114,40 @@ def solve_cli(name, config, flags=()):
 
 os.makedirs(out, exist_ok=True)
 schema = json.loads(subprocess.run([exe, "options", "--json"], capture_output=True, text=True, check=True).stdout)
-keys = [o["key"] for o in schema]
-missing = sorted(set(keys) - set(WALK))
+missing = sorted(set(o["key"] for o in schema) - set(WALK) - {"dim"})
 assert not missing, f"options without a walk value: {missing}"
 failures = []
-for option in schema:
-    key, section, value = option["key"], option["section"], WALK[option["key"]]
-    unchanged = BASE.get(section, {}).get(key, option["default"])
-    assert not same(value, unchanged), f"{key}: the walk value is what arrives without it"
-    config = json.loads(json.dumps(BASE))
-    config.setdefault(section, {})[key] = value
-    arrived = {
-        "file": solve_cli(f"file_{key}", config)[key],
-        "flag": solve_cli(f"flag_{key}", BASE, ["--" + key, flag_value(value)])[key],
-    }
-    python = {s: {k: v for k, v in keys.items() if k != key} for s, keys in BASE.items()}
-    solution = fictus.Problem(**python, **{key: value}).solve(field=False)  # the flat keyword
-    assert set(solution.options) == set(keys), f"Python's options {sorted(solution.options)} are not the schema's"
-    arrived["python"] = solution.options[key]
-    for way, got in arrived.items():
-        if not same(got, value):
-            failures.append(f"{key} by {way}: gave {value!r}, arrived {got!r}")
-    print(f"{section}.{key:24s} {value!r:28} file/flag/python: "
-          + ", ".join(repr(arrived[w]) for w in ("file", "flag", "python")))
+walked = 0
+for dim, base in BASES.items():
+    keys = [o["key"] for o in schema if dim in o["dims"]]
+    for option in schema:
+        key, section = option["key"], option["section"]
+        if dim not in option["dims"] or key == "dim":
+            continue
+        value = walk_value(key, dim)
+        default = option.get("default_3d", option["default"]) if dim == 3 else option["default"]
+        unchanged = base.get(section, {}).get(key, default)
+        assert not same(value, unchanged), f"{key} ({dim}-D): the walk value is what arrives without it"
+        config = json.loads(json.dumps(base))
+        config.setdefault(section, {})[key] = value
+        arrived = {
+            "file": solve_cli(f"file_{dim}d_{key}", config, (), keys)[key],
+            "flag": solve_cli(f"flag_{dim}d_{key}", base, ["--" + key, flag_value(value)], keys)[key],
+        }
+        python = {s: {k: v for k, v in ks.items() if k != key} for s, ks in base.items()}
+        solution = fictus.Problem(**python, **{key: value}).solve(field=False)  # the flat keyword
+        assert solution.dim == dim and set(solution.options) == set(keys), \
+            f"Python's options {sorted(solution.options)} are not the schema's for {dim}-D"
+        assert solution.options["dim"] == dim
+        arrived["python"] = solution.options[key]
+        for way, got in arrived.items():
+            if not same(got, value):
+                failures.append(f"{key} ({dim}-D) by {way}: gave {value!r}, arrived {got!r}")
+        walked += 1
+        print(f"{dim}-D {section}.{key:24s} {value!r:36} file/flag/python: "
+              + ", ".join(repr(arrived[w]) for w in ("file", "flag", "python")))
 if failures:
     print("\n".join(failures))
     sys.exit(1)
-print(f"all {len(schema)} options arrive unchanged by file, flag, results.json and Python")
+print(f"all {len(schema)} options ({walked} option-dimension pairs) arrive unchanged by file, flag, results.json "
+      "and Python")

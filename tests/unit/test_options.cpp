@@ -34,11 +34,59 @@ TEST(Options, KeysAndAliasesAreUniqueAndFlagSafe) {
 }
 
 TEST(Options, DefaultsObeyTheirRules) {
-  fictus::Problem p;
   fictus::SolverOptions o;
-  EXPECT_NO_THROW(fictus::validate_options(p, o));
-  for (const fictus::OptionSpec& s : fictus::option_specs())
-    EXPECT_NO_THROW(fictus::checked(s, s.default_value())) << s.key;
+  EXPECT_NO_THROW(fictus::validate_options(fictus::Problem{}, o));
+  EXPECT_NO_THROW(fictus::validate_options(fictus::SurfaceProblem{}, o));
+  for (int dim : {2, 3})
+    for (const fictus::OptionSpec& s : fictus::option_specs())
+      if (s.applies_to(dim)) EXPECT_NO_THROW(fictus::checked(s, s.default_value(dim), dim)) << s.key << " " << dim;
+}
+
+TEST(Options, OneSchemaKnowsTheDimension) {
+  const fictus::OptionSpec& N = *fictus::find_option("N");
+  const fictus::OptionSpec& box = *fictus::find_option("box");
+  EXPECT_EQ(std::get<std::int64_t>(N.default_value(2)), 256);
+  EXPECT_EQ(std::get<std::int64_t>(N.default_value(3)), 64);
+  EXPECT_EQ(std::get<std::vector<double>>(box.default_value(3)), (std::vector<double>{0, 1, 0, 1, 0, 1}));
+  EXPECT_EQ(fictus::default_text(N), "`256` (2-D), `64` (3-D)");
+  // One box order in both dimensions, and one message for N's range.
+  auto text_error = [](const char* key, const char* text, int dim) {
+    return error_of([&] { fictus::parse_option_text(*fictus::find_option(key), text, dim); });
+  };
+  EXPECT_EQ(text_error("box", "0,1,0,1,0,1", 3), "");
+  EXPECT_NE(text_error("box", "0,0,0,1,1,1", 3).find("domain.box: the box is [x0, x1, y0, y1, z0, z1] (bounds order"),
+            std::string::npos);
+  EXPECT_NE(text_error("box", "0,1,0,1", 3).find("domain.box: expected an array of 6 numbers in 3-D"),
+            std::string::npos);
+  EXPECT_NE(text_error("N", "2048", 3).find("domain.N: need 8 <= N <= 1024 in 3-D, got 2048"), std::string::npos);
+  EXPECT_NE(text_error("N", "4", 2).find("domain.N: need 8 <= N <= 1048576 in 2-D, got 4"), std::string::npos);
+  // An option of the other dimension is refused, never ignored: by name, and when set in a problem.
+  EXPECT_EQ(error_of([] { fictus::check_applies(*fictus::find_option("condition_number"), 3); }),
+            "solver.condition_number: applies to 2-D problems only (this one is 3-D)");
+  EXPECT_EQ(error_of([] { fictus::check_applies(*fictus::find_option("flux_balance"), 2); }),
+            "formulation.flux_balance: applies to 3-D problems only (this one is 2-D)");
+  fictus::SolverOptions o;
+  o.condition_number = false;
+  EXPECT_EQ(error_of([&] { fictus::validate_options(fictus::SurfaceProblem{}, o); }),
+            "solver.condition_number: applies to 2-D problems only (this one is 3-D)");
+  EXPECT_EQ(error_of([&] { fictus::validate_options(fictus::Problem{}, o); }), "");
+  o = {};
+  o.nested_start = 0;
+  EXPECT_EQ(error_of([&] { fictus::validate_options(fictus::Problem{}, o); }),
+            "solver.nested_start: applies to 3-D problems only (this one is 2-D)");
+  // The domain of a problem and back, in bounds order.
+  fictus::SurfaceProblem q;
+  q.box = fictus::Box3{{-1, -2, -3}, {1, 2, 3}};
+  q.N = 48;
+  const fictus::DomainSettings d = fictus::domain_of(q);
+  EXPECT_EQ(d.dim, 3);
+  EXPECT_EQ(d.box, (std::vector<double>{-1, 1, -2, 2, -3, 3}));
+  fictus::SurfaceProblem back;
+  fictus::apply_domain(d, back);
+  EXPECT_EQ(back.box.lower.z, -3.0);
+  EXPECT_EQ(back.N, 48);
+  fictus::Problem flat;
+  EXPECT_NE(error_of([&] { fictus::apply_domain(d, flat); }).find("domain.dim"), std::string::npos);
 }
 
 TEST(Options, BadValuesAreRejectedNamingTheKey) {
@@ -89,7 +137,8 @@ TEST(Options, TextAndTypedValuesSetTheSameOption) {
   fictus::set_option(*fictus::find_option("variant"), p, o,
                      fictus::parse_option_text(*fictus::find_option("variant"), "non-smooth"));
   EXPECT_EQ(o.variant, fictus::Variant::nonsmooth);
-  EXPECT_EQ(std::get<std::string>(fictus::find_option("variant")->get(p, o)), "nonsmooth");  // the canonical name
+  EXPECT_EQ(std::get<std::string>(fictus::find_option("variant")->get(fictus::domain_of(p), o)),
+            "nonsmooth");  // the canonical name
   fictus::set_option(*fictus::find_option("box"), p, o,
                      fictus::parse_option_text(*fictus::find_option("box"), "-1,2,0,3"));
   EXPECT_EQ(p.box.lower.x, -1.0);
