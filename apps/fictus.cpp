@@ -19,12 +19,12 @@
 #include <string>
 #include <vector>
 
-#include "fictus/convergence_table.hpp"
-#include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/io/problem_file.hpp"
 #include "fictus/io/process.hpp"
-#include "fictus/options.hpp"
-#include "fictus/paper_problem.hpp"
+#include "fictus/solve/convergence_table.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/options.hpp"
+#include "fictus/solve/paper_problem.hpp"
 #include "option_flags.hpp"
 #include "results_io.hpp"
 #include "sweep.hpp"

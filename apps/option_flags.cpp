@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "fictus/paper_problem.hpp"
+#include "fictus/solve/paper_problem.hpp"
 
 namespace fictus::cli {
 

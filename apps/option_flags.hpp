@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "fictus/io/problem_file.hpp"
-#include "fictus/options.hpp"
+#include "fictus/solve/options.hpp"
 
 namespace fictus::cli {
 

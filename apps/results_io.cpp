@@ -14,8 +14,8 @@
 #include <stdexcept>
 #include <variant>
 
-#include "fictus/mesh_surface.hpp"
-#include "fictus/options.hpp"
+#include "fictus/boundary/mesh_surface.hpp"
+#include "fictus/solve/options.hpp"
 
 namespace fictus::cli {
 

@@ -9,9 +9,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "fictus/convergence_table.hpp"
-#include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/io/problem_file.hpp"
+#include "fictus/solve/convergence_table.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
 
 namespace fictus::cli {
 

@@ -11,10 +11,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/boundary/shapes.hpp"
+#include "fictus/boundary/surface.hpp"
 #include "fictus/io/process.hpp"
-#include "fictus/shapes.hpp"
-#include "fictus/surface.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
 #include "results_io.hpp"
 
 namespace fictus::cli {

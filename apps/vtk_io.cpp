@@ -15,7 +15,7 @@
 #include <tuple>
 #include <vector>
 
-#include "fictus/curve_grid_intersection.hpp"
+#include "fictus/boundary/curve_grid_intersection.hpp"
 
 namespace fictus::cli {
 

@@ -15,10 +15,10 @@
 #include <utility>
 #include <vector>
 
-#include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/omega_quadrature.hpp"
-#include "fictus/surface.hpp"
-#include "fictus/surface_discretization.hpp"
+#include "fictus/boundary/omega_quadrature.hpp"
+#include "fictus/boundary/surface.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/surface_discretization.hpp"
 
 namespace fictus::cli {
 

@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "fictus/dst_solver.hpp"
-#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/grid/dst_solver.hpp"
 #include "fictus/io/process.hpp"
-#include "fictus/paper_problem.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/paper_problem.hpp"
 #include "report.hpp"
 
 namespace {

@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "fictus/collocation.hpp"
-#include "fictus/convergence_table.hpp"
-#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/boundary/collocation.hpp"
 #include "fictus/io/problem_file.hpp"
+#include "fictus/solve/convergence_table.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
 #include "manufactured_solutions.hpp"
 #include "reference_comparison.hpp"
 

@@ -17,12 +17,12 @@
 #include <stdexcept>
 
 #include "bindings.hpp"
-#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/boundary/mesh_surface.hpp"
 #include "fictus/io/problem_file.hpp"
 #include "fictus/io/process.hpp"
-#include "fictus/mesh_surface.hpp"
-#include "fictus/options.hpp"
-#include "fictus/paper_problem.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/options.hpp"
+#include "fictus/solve/paper_problem.hpp"
 #include "python_problem.hpp"
 
 namespace py = pybind11;

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/io/problem_file.hpp"
-#include "fictus/options.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/options.hpp"
 
 namespace fictus::python {
 

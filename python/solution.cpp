@@ -12,8 +12,8 @@
 #include <utility>
 
 #include "bindings.hpp"
-#include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/options.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/options.hpp"
 #include "python_problem.hpp"
 
 namespace py = pybind11;

@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
-#include "fictus/options.hpp"
+#include "fictus/solve/options.hpp"
 
 namespace fictus {
 

@@ -14,11 +14,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "fictus/boundary/mesh_surface.hpp"
+#include "fictus/boundary/shapes.hpp"
+#include "fictus/boundary/surface.hpp"
 #include "fictus/io/expression.hpp"
-#include "fictus/mesh_surface.hpp"
-#include "fictus/options.hpp"
-#include "fictus/shapes.hpp"
-#include "fictus/surface.hpp"
+#include "fictus/solve/options.hpp"
 
 namespace fictus {
 

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
 
 namespace fictus {
 

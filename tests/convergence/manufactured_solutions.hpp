@@ -6,9 +6,9 @@
 #include <memory>
 #include <string>
 
-#include "fictus/problem.hpp"
+#include "fictus/solve/problem.hpp"
 #include "fictus/io/expression.hpp"
-#include "fictus/shapes.hpp"
+#include "fictus/boundary/shapes.hpp"
 
 namespace manufactured {
 

@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/omega_quadrature.hpp"
-#include "fictus/surface.hpp"
-#include "fictus/surface_discretization.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/boundary/omega_quadrature.hpp"
+#include "fictus/boundary/surface.hpp"
+#include "fictus/solve/surface_discretization.hpp"
 
 namespace manufactured3d {
 

@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "fictus/convergence_table.hpp"
-#include "fictus/error_norms.hpp"
-#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/grid/quadrature.hpp"
 #include "fictus/io/expression.hpp"
-#include "fictus/quadrature.hpp"
+#include "fictus/solve/convergence_table.hpp"
+#include "fictus/solve/error_norms.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
 
 namespace reference {
 

@@ -7,9 +7,9 @@
 
 #include <iostream>
 
-#include "fictus/convergence_table.hpp"
-#include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/paper_problem.hpp"
+#include "fictus/solve/convergence_table.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/paper_problem.hpp"
 #include "manufactured_solutions.hpp"
 
 namespace {

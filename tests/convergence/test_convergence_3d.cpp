@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "fictus/convergence_table.hpp"
-#include "fictus/execution.hpp"
-#include "fictus/load_vector.hpp"
-#include "fictus/mesh_surface.hpp"
+#include "fictus/boundary/mesh_surface.hpp"
+#include "fictus/grid/execution.hpp"
+#include "fictus/grid/load_vector.hpp"
+#include "fictus/solve/convergence_table.hpp"
 #include "manufactured_solutions_3d.hpp"
 
 namespace {

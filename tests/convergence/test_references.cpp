@@ -10,8 +10,8 @@
 #include <iostream>
 #include <sstream>
 
+#include "fictus/boundary/trace_operators.hpp"
 #include "fictus/io/problem_file.hpp"
-#include "fictus/trace_operators.hpp"
 #include "reference_comparison.hpp"
 
 namespace {

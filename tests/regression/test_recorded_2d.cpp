@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "fictus/fictitious_domain_solver.hpp"
 #include "fictus/io/problem_file.hpp"
-#include "fictus/paper_problem.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/paper_problem.hpp"
 #include "recorded.hpp"
 
 namespace {

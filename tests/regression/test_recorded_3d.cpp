@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "fictus/fictitious_domain_solver.hpp"
+#include "fictus/boundary/omega_quadrature.hpp"
+#include "fictus/boundary/surface.hpp"
 #include "fictus/io/problem_file.hpp"
-#include "fictus/omega_quadrature.hpp"
-#include "fictus/surface.hpp"
-#include "fictus/surface_discretization.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/surface_discretization.hpp"
 #include "recorded.hpp"
 
 namespace {

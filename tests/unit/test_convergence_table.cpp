@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "fictus/convergence_table.hpp"
-#include "fictus/paper_problem.hpp"
+#include "fictus/solve/convergence_table.hpp"
+#include "fictus/solve/paper_problem.hpp"
 
 namespace {
 

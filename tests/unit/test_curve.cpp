@@ -4,10 +4,10 @@
 #include <cmath>
 #include <numbers>
 
-#include "fictus/collocation.hpp"
-#include "fictus/curve.hpp"
-#include "fictus/paper_problem.hpp"
-#include "fictus/shapes.hpp"
+#include "fictus/boundary/collocation.hpp"
+#include "fictus/boundary/curve.hpp"
+#include "fictus/boundary/shapes.hpp"
+#include "fictus/solve/paper_problem.hpp"
 
 namespace {
 

@@ -1,5 +1,5 @@
 // The dense LU by LAPACK (dense_lu.hpp) against Eigen's.
-#include "fictus/dense_lu.hpp"
+#include "fictus/solve/dense_lu.hpp"
 
 #include <gtest/gtest.h>
 

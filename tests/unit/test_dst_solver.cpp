@@ -4,7 +4,7 @@
 #include <Eigen/Sparse>
 #include <random>
 
-#include "fictus/dst_solver.hpp"
+#include "fictus/grid/dst_solver.hpp"
 
 namespace {
 

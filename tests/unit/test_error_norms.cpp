@@ -7,10 +7,10 @@
 #include <memory>
 #include <numbers>
 
-#include "fictus/curve.hpp"
-#include "fictus/curve_grid_intersection.hpp"
-#include "fictus/error_norms.hpp"
-#include "fictus/q1_element.hpp"
+#include "fictus/boundary/curve.hpp"
+#include "fictus/boundary/curve_grid_intersection.hpp"
+#include "fictus/grid/q1_element.hpp"
+#include "fictus/solve/error_norms.hpp"
 
 namespace {
 

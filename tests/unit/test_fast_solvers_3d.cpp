@@ -6,8 +6,8 @@
 #include <Eigen/Sparse>
 #include <random>
 
-#include "fictus/dst_solver.hpp"
-#include "fictus/green_table.hpp"
+#include "fictus/grid/dst_solver.hpp"
+#include "fictus/grid/green_table.hpp"
 
 namespace {
 

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <thread>
 
-#include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/paper_problem.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/paper_problem.hpp"
 
 namespace {
 

@@ -3,7 +3,7 @@
 
 #include <random>
 
-#include "fictus/gmres.hpp"
+#include "fictus/solve/gmres.hpp"
 
 namespace {
 

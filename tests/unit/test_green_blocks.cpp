@@ -5,14 +5,14 @@
 #include <algorithm>
 #include <ostream>
 
-#include "fictus/fast_solver.hpp"
-#include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/omega_quadrature.hpp"
-#include "fictus/schur_complement.hpp"
-#include "fictus/surface.hpp"
-#include "fictus/surface_discretization.hpp"
-#include "fictus/surface_integrals.hpp"
-#include "fictus/trace_operators.hpp"
+#include "fictus/boundary/omega_quadrature.hpp"
+#include "fictus/boundary/surface.hpp"
+#include "fictus/boundary/surface_integrals.hpp"
+#include "fictus/boundary/trace_operators.hpp"
+#include "fictus/grid/fast_solver.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/schur_complement.hpp"
+#include "fictus/solve/surface_discretization.hpp"
 
 namespace {
 

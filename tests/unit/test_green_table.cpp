@@ -5,8 +5,8 @@
 #include <cmath>
 #include <vector>
 
-#include "fictus/dst_solver.hpp"
-#include "fictus/green_table.hpp"
+#include "fictus/grid/dst_solver.hpp"
+#include "fictus/grid/green_table.hpp"
 
 namespace {
 

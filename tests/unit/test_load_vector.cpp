@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "fictus/load_vector.hpp"
+#include "fictus/grid/load_vector.hpp"
 
 namespace {
 

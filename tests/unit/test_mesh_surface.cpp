@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "fictus/mesh_surface.hpp"
+#include "fictus/boundary/mesh_surface.hpp"
 
 namespace {
 

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "fictus/options.hpp"
+#include "fictus/solve/options.hpp"
 
 namespace {
 

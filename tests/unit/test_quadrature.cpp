@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "fictus/curve_grid_intersection.hpp"
+#include "fictus/boundary/curve_grid_intersection.hpp"
 
 namespace {
 

@@ -6,8 +6,8 @@
 #include <array>
 #include <cmath>
 
-#include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/paper_problem.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/paper_problem.hpp"
 
 namespace {
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "fictus/shapes.hpp"
+#include "fictus/boundary/shapes.hpp"
 
 namespace {
 

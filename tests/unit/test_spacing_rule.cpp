@@ -7,8 +7,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "fictus/collocation.hpp"
-#include "fictus/spacing_rule.hpp"
+#include "fictus/boundary/collocation.hpp"
+#include "fictus/solve/spacing_rule.hpp"
 
 namespace {
 

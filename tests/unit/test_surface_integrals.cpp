@@ -7,7 +7,7 @@
 #include <functional>
 #include <random>
 
-#include "fictus/surface_integrals.hpp"
+#include "fictus/boundary/surface_integrals.hpp"
 
 namespace {
 

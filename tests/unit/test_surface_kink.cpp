@@ -10,14 +10,14 @@
 
 #include <Eigen/Core>
 
-#include "fictus/fast_solver.hpp"
-#include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/omega_quadrature.hpp"
-#include "fictus/surface.hpp"
-#include "fictus/surface_discretization.hpp"
-#include "fictus/surface_integrals.hpp"
-#include "fictus/surface_kink.hpp"
-#include "fictus/trace_operators.hpp"
+#include "fictus/boundary/omega_quadrature.hpp"
+#include "fictus/boundary/surface.hpp"
+#include "fictus/boundary/surface_integrals.hpp"
+#include "fictus/boundary/surface_kink.hpp"
+#include "fictus/boundary/trace_operators.hpp"
+#include "fictus/grid/fast_solver.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/surface_discretization.hpp"
 
 namespace {
 

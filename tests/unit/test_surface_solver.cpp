@@ -6,11 +6,11 @@
 #include <numbers>
 #include <random>
 
-#include "fictus/fictitious_domain_solver.hpp"
-#include "fictus/omega_quadrature.hpp"
-#include "fictus/surface.hpp"
-#include "fictus/surface_discretization.hpp"
-#include "fictus/trace_operators.hpp"
+#include "fictus/boundary/omega_quadrature.hpp"
+#include "fictus/boundary/surface.hpp"
+#include "fictus/boundary/trace_operators.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/surface_discretization.hpp"
 
 namespace {
 

@@ -7,10 +7,10 @@
 #include <numbers>
 #include <set>
 
-#include "fictus/collocation.hpp"
-#include "fictus/kink_correction.hpp"
-#include "fictus/shapes.hpp"
-#include "fictus/trace_operators.hpp"
+#include "fictus/boundary/collocation.hpp"
+#include "fictus/boundary/kink_correction.hpp"
+#include "fictus/boundary/shapes.hpp"
+#include "fictus/boundary/trace_operators.hpp"
 
 namespace {
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "fictus/problem.hpp"
+#include "fictus/solve/problem.hpp"
 
 namespace fictus {
 

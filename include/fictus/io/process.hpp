@@ -2,7 +2,7 @@
 // What the operating system says about this process (Linux /proc), for reports.
 #include <cstddef>
 
-#include "fictus/problem.hpp"
+#include "fictus/solve/problem.hpp"
 
 namespace fictus {
 

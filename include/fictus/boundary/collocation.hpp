@@ -1,0 +1,52 @@
+#pragma once
+// m collocation points on γ. Point i sits at the middle of arc i (in the measure that spaces them) and
+// owns that arc; the arcs are
+// equal in arc length (spacing s = L/m), or equal in a placement measure ∫ w(t)|p′(t)| dt: the
+// smooth variant's, w = max(1, 1 + δκ), makes the arcs of Γ (their normal offsets at distance δ) equal
+// wherever γ is convex (docs/math.md, "Placement of the points"). An arc may wrap past t = 0: then
+// arc_begin > arc_end.
+#include <vector>
+
+#include "fictus/boundary/curve.hpp"
+
+namespace fictus {
+
+struct Collocation {
+  int m = 0;
+  double length = 0.0;   // L = |γ|
+  double spacing = 0.0;  // s = L/m, the mean length of the arcs
+  double phase = 0.5;
+  std::vector<double> s;                   // arc length of point i
+  std::vector<double> arc;                 // length of the arc of γ point i owns (L/m without placement)
+  std::vector<double> t;                   // parameter of point i
+  std::vector<double> arc_begin, arc_end;  // parameters bounding arc i, arc_begin[0] = 0
+  std::vector<Point2> point, normal;       // x_i and the outward unit normal n_i
+
+  int n_points() const { return m; }
+};
+
+/// The points of arcs equal in `placement` (nullptr: in arc length), point i at the placement
+/// measure's (i + phase)·W/m.
+Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase = 0.5,
+                             const ArcLengthTable* placement = nullptr);
+
+/// The smooth variant's placement measure for Γ at distance δ: speed |p′(t)|·max(1, 1 + δκ(t)), the
+/// speed of the offset curve where γ is convex and of γ itself where it is concave.
+ArcLengthTable offset_placement(const Curve& curve, double delta);
+
+/// The phase (among 32 candidates, ½ first) that keeps the points farthest from the curve's corners.
+double phase_off_corners(const Curve& curve, const ArcLengthTable& arc_length, int m);
+
+/// Default spacing of the multipliers in cells, s = L/m ≈ c·h at every N (docs/math.md, "Rules for m
+/// and δ": the contact ends are resolved to s, so s must shrink with h): 8 cells in
+/// the smooth variant, 12 in the non-smooth one (measured on fitted-mesh references).
+inline constexpr double default_spacing_cells_smooth = 8.0;
+inline constexpr double default_spacing_cells_nonsmooth = 12.0;
+
+/// The fewest multipliers a solve accepts (and the default rule gives).
+inline constexpr int minimum_multipliers = 8;
+
+/// Default number of multipliers: m = max(minimum_multipliers, round(L / (spacing_cells·h))).
+int default_multipliers(double curve_length, double h, double spacing_cells = default_spacing_cells_smooth);
+
+}  // namespace fictus

@@ -1,0 +1,61 @@
+#pragma once
+// Fast exact solvers for the Q1 matrix A = K + c·M on the whole box, any dimension:
+//   DstSolver<dim>       Dirichlet box, dim-dimensional sine transform (dst_solver.hpp);
+//   PeriodicSolver<dim>  periodic box, dim-dimensional real DFT; with c = 0, A is singular (the
+//                        constants) and solve_in_place applies the pseudo-inverse A⁺ (the mean of r
+//                        is discarded and the result has zero mean).
+// λ(p) comes from Q1Symbol. Solvers plan once in the constructor; solve_in_place() is const and
+// allocation-free.
+#include <complex>
+#include <memory>
+#include <vector>
+
+#include "fictus/grid/execution.hpp"
+#include "fictus/grid/grid.hpp"
+#include "fictus/grid/q1_symbol.hpp"
+
+namespace fictus {
+
+template <int dim>
+class FastSolver {
+ public:
+  virtual ~FastSolver() = default;
+  virtual const Grid<dim>& grid() const = 0;
+  virtual double c() const = 0;
+  /// Overwrites r (size n_unknowns) with A⁻¹r (A⁺r when singular()).
+  virtual void solve_in_place(GridVector& r) const = 0;
+  /// y = A x by the same transforms.
+  virtual void apply(const GridVector& x, GridVector& y) const = 0;
+  /// A has the constants as null space (periodic box with c = 0).
+  bool singular() const { return grid().periodic() && c() == 0.0; }
+};
+
+/// The solver for the grid's boundary conditions.
+template <int dim>
+std::unique_ptr<FastSolver<dim>> make_fast_solver(const Grid<dim>& grid, double c,
+                                                  const Execution& execution = Execution{});
+
+namespace detail {
+class RealDft;
+}
+
+template <int dim>
+class PeriodicSolver final : public FastSolver<dim> {
+ public:
+  PeriodicSolver(const Grid<dim>& grid, double c, const Execution& execution = Execution{});
+  ~PeriodicSolver() override;
+  const Grid<dim>& grid() const override { return grid_; }
+  double c() const override { return symbol_.c(); }
+  void solve_in_place(GridVector& r) const override;
+  void apply(const GridVector& x, GridVector& y) const override;
+
+ private:
+  void transform(GridVector& v, bool inverse) const;
+  Grid<dim> grid_;
+  Q1Symbol<dim> symbol_;
+  int threads_;
+  std::unique_ptr<detail::RealDft> dft_;
+  mutable AlignedVector<std::complex<double>> spectrum_;  // workspace: calls must not overlap
+};
+
+}  // namespace fictus

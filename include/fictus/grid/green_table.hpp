@@ -1,0 +1,92 @@
+#pragma once
+// Discrete Green's function of A = K + c·M (docs/math.md), any dimension.
+// Dirichlet box: G between nodes a and b is the sum over the 2^dim reflections
+//   G[a, b] = Σ_{σ ∈ {−,+}^dim} (−1)^{#+} T(a ∓ b),
+//   T(s) = 1/Π_d n_d · Σ_{p, 1 ≤ p_d ≤ n_d−1} Π_d cos(p_d π s_d / n_d) / λ(p),
+//   even and 2n-periodic in each s_d; the table holds Π_d [0, n_d]: ONE DCT-I (REDFT00) of size Π(n_d + 1).
+//   In 2-D: G[(i,j),(k,l)] = T(i−k, j−l) − T(i+k, j−l) − T(i−k, j+l) + T(i+k, j+l).
+// Periodic box (n_d even):
+//   G[a, b] = T(a − b),  T(s) = 1/Π n_d · Σ_{0 ≤ p_d < n_d} Π_d cos(2π p_d s_d / n_d) / λ(p),
+//   even and n-periodic; the table holds Π_d [0, n_d/2], one REDFT00 of size Π(n_d/2 + 1).
+//   With c = 0 the zero mode is dropped: G is the pseudo-inverse A⁺.
+// λ(p) comes from Q1Symbol. Built once per grid, boundary and c; lookups are const and thread-safe.
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "fictus/grid/execution.hpp"
+#include "fictus/grid/grid.hpp"
+
+namespace fictus {
+
+template <int dim>
+class GreenTable {
+ public:
+  using Index = typename Grid<dim>::Index;
+  GreenTable(const Grid<dim>& grid, double c, const Execution& execution = Execution{});
+
+  const Grid<dim>& grid() const { return grid_; }
+  double c() const { return c_; }
+  /// T(s) for any integer offsets s (folded into the table).
+  double T(const Index& s) const {
+    Index folded;
+    for (int d = 0; d < dim; ++d) folded[d] = fold(s[d], period_[d]);
+    return at(folded);
+  }
+  /// (A⁻¹)_{a,b} between nodes carrying unknowns (A⁺ for a singular periodic A), 0 ≤ a_d, b_d ≤ n_d
+  /// (so the offsets need one reflection, no division).
+  double G(const Index& a, const Index& b) const {
+    Index s;
+    if (periodic_) {
+      for (int d = 0; d < dim; ++d) s[d] = near_fold(a[d] - b[d], period_[d]);
+      return at(s);
+    }
+    double sum = 0.0;
+    for (int pattern = 0; pattern < (1 << dim); ++pattern) {
+      bool minus = false;
+      for (int d = 0; d < dim; ++d) {
+        const bool plus = (pattern >> d) & 1;
+        s[d] = near_fold(plus ? a[d] + b[d] : a[d] - b[d], period_[d]);
+        minus ^= plus;
+      }
+      sum += minus ? -at(s) : at(s);
+    }
+    return sum;
+  }
+  /// G between every node of the tensor grid a[0] × … × a[dim−1] (flat index p, first axis fastest)
+  /// and every node of the tensor grid b (flat index q), 0 ≤ a_d, b_d ≤ n_d: out[p + ld·q]. The same
+  /// sums as G(a, b), with each axis's reflections folded once per pair of coordinates rather than once
+  /// per pair of nodes (the far blocks' cores in the Schur assembly).
+  void G(const std::array<std::vector<int>, dim>& a, const std::array<std::vector<int>, dim>& b, double* out,
+         std::size_t ld) const;
+  /// out[u] = Σ_k G(a_u, b_k)·w_k (k in order) for the nodes a_u, u < n_a, and the weighted nodes
+  /// (b_k, w_k), k < n_b: the near blocks' sums in the Schur assembly, the same sums as G's.
+  void G(const Index* a, std::size_t n_a, const Index* b, const double* w, std::size_t n_b, double* out) const;
+  std::size_t memory_bytes() const { return table_.size() * sizeof(double); }
+
+ private:
+  /// Dirichlet: period 2n, table [0, n]; periodic: period n, table [0, n/2]. `period` is the period.
+  static int fold(int s, int period) {
+    s %= period;
+    s = s < 0 ? s + period : s;
+    return s > period / 2 ? period - s : s;
+  }
+  /// fold() for |s| ≤ period: one reflection instead of a remainder (|s| = period gives 0).
+  static int near_fold(int s, int period) {
+    s = s < 0 ? -s : s;
+    return s > period / 2 ? period - s : s;
+  }
+  double at(const Index& s) const {
+    std::size_t k = 0;
+    for (int d = dim - 1; d >= 0; --d) k = k * size_[d] + std::size_t(s[d]);
+    return table_[k];
+  }
+  Grid<dim> grid_;
+  double c_;
+  bool periodic_;
+  std::array<int, dim> period_;        // of T along each axis
+  std::array<std::size_t, dim> size_;  // table entries along each axis: period/2 + 1
+  AlignedVector<double> table_;
+};
+
+}  // namespace fictus

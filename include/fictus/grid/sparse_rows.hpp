@@ -1,0 +1,32 @@
+#pragma once
+// Sparse rows over the unknowns of a grid (any dimension): the trace matrices B_γ, C_γ, B_Γ and the
+// kink correction's rows are sets of them, applied to grid vectors and transposed onto them.
+#include <cstddef>
+#include <vector>
+
+#include "fictus/grid/grid.hpp"
+
+namespace fictus {
+
+struct SparseRows {
+  struct Entry {
+    std::size_t index;  // Grid::index of the node
+    int i, j, k;        // the node (k = 0 in 2-D)
+    double value;
+  };
+  std::vector<std::size_t> row_begin{0};  // entries of row r: [row_begin[r], row_begin[r+1])
+  std::vector<Entry> entries;
+
+  int n_rows() const { return int(row_begin.size()) - 1; }
+  /// out = R u  (out resized to n_rows)
+  void multiply(const GridVector& u, std::vector<double>& out) const;
+  /// u += Rᵀ λ
+  void add_transposed(const std::vector<double>& lambda, GridVector& u) const;
+  /// R·1: the sum of each row's entries.
+  std::vector<double> row_sums() const;
+};
+
+/// Row-wise sum a + b of two sets of rows with the same number of rows (entries of a node merged).
+SparseRows add_rows(const SparseRows& a, const SparseRows& b);
+
+}  // namespace fictus

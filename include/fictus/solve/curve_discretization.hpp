@@ -1,0 +1,69 @@
+#pragma once
+// The boundary of a 2-D problem: a closed curve γ, its collocation points and the curve Γ that
+// carries λ (γ itself in the non-smooth variant, the offset curve at δ outside ω in the smooth one),
+// with the trace rows of the chosen rule (docs/math.md, "Trace matrices"). The solver keeps it for as
+// long as it keeps the solve's setup (`execution` must outlive it).
+#include <memory>
+
+#include "fictus/boundary/collocation.hpp"
+#include "fictus/boundary/curve_grid_intersection.hpp"
+#include "fictus/boundary/kink_correction.hpp"
+#include "fictus/solve/boundary_discretization.hpp"
+#include "fictus/solve/spacing_rule.hpp"
+
+namespace fictus {
+
+class CurveDiscretization final : public BoundaryDiscretization<2> {
+ public:
+  /// Steps 1–2 of the solve for curve γ on `grid` (c: the reaction coefficient the kink rows use):
+  ///   1. geometry: γ checked (counter-clockwise, simple, 2h inside the box), m and δ by the rules of
+  ///      spacing_rule.hpp, the collocation points and Γ (smooth variant: simple, 2h inside the box);
+  ///   2. trace rows: B_γ, C_γ, B_Γ, and the kink correction's rows and direct terms.
+  /// Throws std::invalid_argument naming the option or "geometry" on bad input.
+  CurveDiscretization(std::shared_ptr<const Curve> gamma, const Grid2& grid, const SolverOptions& options, double c,
+                      const Execution& execution);
+
+  const std::vector<Point2>& points() const override { return collocation_.point; }
+  const std::vector<Point2>& normals() const override { return collocation_.normal; }
+  /// The arc length s_i of each point from γ(0).
+  const std::vector<double>& arc_positions() const { return collocation_.s; }
+  const SpacingPlan& spacing() const override { return spacing_; }
+  double delta() const override { return delta_; }
+  const SparseRows& B_gamma() const override { return B_gamma_; }
+  const SparseRows& C_gamma() const override { return C_gamma_; }
+  const SparseRows& B_Gamma() const override { return B_Gamma_; }
+  const SparseRows& loads() const override { return loads_; }
+  const DirectTerms& direct() const override { return direct_; }
+  /// g, or g(x, y, s) when data.g_along_curve is set, at the points.
+  std::vector<double> obstacle(const Data& data) const override;
+  void finish_field(const std::vector<double>& lambda, GridVector& u) const override;
+  std::optional<std::vector<double>> independent_normal_derivative(const GridVector& u,
+                                                                   std::string& rule) const override;
+  ErrorNorms errors(const GridVector& u, const std::vector<double>& trace, const Data& data,
+                    int quadrature) const override;
+  /// ∂u/∂n of the exact solution from its gradient when given, else by a one-sided second-order
+  /// difference into ω (u may be defined in ω only): (3u(x) − 4u(x − εn) + u(x − 2εn))/(2ε), ε = 1e-5·box width.
+  PointErrors point_errors(const std::vector<double>& trace, const std::vector<double>& normal_derivative,
+                           const Data& data) const override;
+  void describe(SolutionBoundary<2>& out) const override;
+
+  const Collocation& collocation() const { return collocation_; }
+  const std::shared_ptr<const Curve>& gamma() const { return gamma_; }
+  const std::shared_ptr<const Curve>& Gamma() const { return Gamma_; }
+
+ private:
+  void make_geometry(const Grid2& grid, SolverOptions options);
+  void make_trace_rows(const Grid2& grid, const SolverOptions& options, double c);
+
+  const Execution& execution_;
+  std::shared_ptr<const Curve> gamma_, Gamma_;
+  Collocation collocation_;
+  double delta_ = 0;
+  SpacingPlan spacing_;
+  std::unique_ptr<CurveGridIntersection> gamma_geometry_, Gamma_geometry_;
+  SparseRows B_gamma_, C_gamma_, B_Gamma_, loads_;
+  DirectTerms direct_;
+  std::unique_ptr<KinkCorrection> kink_;
+};
+
+}  // namespace fictus

@@ -1,0 +1,64 @@
+#pragma once
+// Errors of the grid solution û against an exact solution u on ω and γ, in 2-D and 3-D:
+//   ‖û − u‖_{L²(ω)},  |û − u|_{H¹(ω)} (seminorm),  ‖û − u‖_{H¹(ω)} (full),  ‖û − u‖_{L²(γ)},
+// absolute and relative (divided by the same norm of u). Cells cut by γ use rules that follow γ,
+// so quadrature error is far below the discretization error. The geometry is only named here: a
+// curve's cut cells (curve_grid_intersection.hpp), a surface (surface.hpp) and its patches.
+#include <array>
+#include <functional>
+#include <vector>
+
+#include "fictus/grid/execution.hpp"
+#include "fictus/grid/load_vector.hpp"
+
+namespace fictus {
+
+class CurveGridIntersection;
+class Surface;
+struct PatchedSurface;
+
+struct ErrorNorms {
+  double l2_omega = 0, h1semi_omega = 0, h1_omega = 0, l2_gamma = 0;
+  double rel_l2_omega = 0, rel_h1semi_omega = 0, rel_h1_omega = 0, rel_l2_gamma = 0;
+};
+
+/// Central differences of u with step 1e-6·(box width) where no gradient is given.
+GradientField numerical_gradient(ScalarField u, double scale);
+
+ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& gamma, const ScalarField& exact,
+                          const GradientField& exact_gradient, int q = 3, const Execution& execution = Execution{});
+
+/// ∇u on many points at once: (gx[k], gy[k]) = ∇u(x[k], y[k]).
+using VectorizedGradient = std::function<void(std::size_t n, const double* x, const double* y, double* gx, double* gy)>;
+
+/// The same for an exact solution evaluated in batches (one per cell row, one along γ). Without a
+/// gradient, ∇u by central differences (step 1e-6·box width): four more batches.
+ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& gamma, const VectorizedField& exact,
+                          const VectorizedGradient& exact_gradient = {}, int q = 3,
+                          const Execution& execution = Execution{});
+
+/// Value and gradient of the Q1 function u_h in cell (ix, iy) at (x, y).
+struct Q1Sample {
+  double value;
+  Point2 gradient;
+};
+Q1Sample sample_q1(const Grid2& grid, const GridVector& u_h, int ix, int iy, double x, double y);
+
+/// 3-D: errors of the trilinear û against `exact` in ω (L², H¹) and on γ from the points
+/// (Σ_p |patch p|·(û − u)(x_p)²)^½, absolute and relative.
+ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,
+                          const std::vector<double>& trace, const ScalarField3& exact,
+                          const GradientField3& exact_gradient, int q = 3, const Execution& execution = Execution{});
+/// The same with `exact` in batches (∇u by central differences in batches when no gradient is given).
+ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,
+                          const std::vector<double>& trace, const VectorizedField3& exact,
+                          const GradientField3& exact_gradient, int q = 3, const Execution& execution = Execution{});
+
+/// The coordinates of points as three arrays (for fields evaluated in batches).
+std::array<std::vector<double>, 3> coordinates(const std::vector<Point3>& points);
+/// ∇u at the points x (three coordinate arrays): `gradient` when given, else central differences of
+/// `u` with step e, in batches.
+void gradient_at(const VectorizedField3& u, const GradientField3& gradient, double e,
+                 const std::array<std::vector<double>, 3>& x, std::array<std::vector<double>, 3>& du);
+
+}  // namespace fictus

@@ -1,0 +1,66 @@
+#pragma once
+// A Signorini problem on ω ⊂ Ω ⊂ R^dim (dim = 2 or 3), one type for both dimensions:
+//   −Δu + c·u = f in ω,  u ≥ g, ∂u/∂n ≥ 0, (∂u/∂n)(u − g) = 0 on γ = ∂ω,
+// γ a closed curve (dim = 2, curve.hpp) or a closed surface (dim = 3, surface.hpp).
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "fictus/boundary/curve.hpp"
+#include "fictus/boundary/surface.hpp"
+#include "fictus/grid/load_vector.hpp"
+#include "fictus/solve/solver_options.hpp"
+
+namespace fictus {
+
+/// What γ is in a dimension: a Curve in 2-D, a Surface in 3-D.
+template <int dim>
+struct BoundaryShape;
+template <>
+struct BoundaryShape<2> {
+  using type = Curve;
+};
+template <>
+struct BoundaryShape<3> {
+  using type = Surface;
+};
+
+/// An obstacle that depends on the arc length s along γ too (2-D only: a surface has no arc length).
+template <int dim>
+struct ObstacleAlongBoundary {};
+template <>
+struct ObstacleAlongBoundary<2> {
+  /// Optional g(x, y, s), used instead of g when set.
+  std::function<double(double x, double y, double s)> g_along_curve;
+};
+
+/// What may change from one solve to the next on the same grid: γ, the obstacle and the exact
+/// solution (FictitiousDomainSolver::solve).
+template <int dim>
+struct BasicContactData : ObstacleAlongBoundary<dim> {
+  std::shared_ptr<const typename BoundaryShape<dim>::type> gamma;  // γ, strictly inside Ω (a curve counter-clockwise)
+  typename Fields<dim>::Scalar g;                                  // obstacle, sampled at the points on γ
+  /// Optional batch forms (e.g. numpy callables), used instead of g and exact when set.
+  typename Fields<dim>::Vectorized g_vectorized, exact_vectorized;
+  typename Fields<dim>::Scalar exact;             // optional exact solution on ω (errors are computed if set)
+  typename Fields<dim>::Gradient exact_gradient;  // optional ∇u (central differences of `exact` if unset)
+};
+
+/// The whole problem: the grid-level data (box, N, boundary conditions, c, f: what the
+/// FictitiousDomainSolver is built for) and the contact data.
+template <int dim>
+struct BasicProblem : BasicContactData<dim> {
+  std::string name = "problem";
+  Box<dim> box;                                   // Ω (the unit box by default)
+  Boundary boundary = Boundary::dirichlet;        // conditions on ∂Ω (periodic: c = 0 is allowed)
+  int N = dim == 2 ? 256 : 64;                    // cells along x (h = (x1 − x0)/N)
+  double c = 1.0;                                 // c ≥ 0
+  typename Fields<dim>::Scalar f;                 // load, on all of Ω
+  typename Fields<dim>::Vectorized f_vectorized;  // optional batch form of f, used instead when set
+};
+
+using ContactData = BasicContactData<2>;
+using Problem = BasicProblem<2>;
+using SurfaceProblem = BasicProblem<3>;
+
+}  // namespace fictus

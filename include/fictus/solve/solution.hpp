@@ -1,0 +1,163 @@
+#pragma once
+// What a solve returns, one type for both dimensions: the field û on the grid, the values at the m
+// points of γ (λ, g, B_γû, C_γû, contact flags), Newton's report, checks, errors and timings. The
+// points are a curve's collocation points in 2-D and a surface's patches in 3-D (SolutionBoundary).
+#include <cmath>
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "fictus/boundary/collocation.hpp"
+#include "fictus/boundary/curve.hpp"
+#include "fictus/boundary/surface_integrals.hpp"
+#include "fictus/grid/grid.hpp"
+#include "fictus/solve/error_norms.hpp"
+#include "fictus/solve/schur_complement.hpp"
+#include "fictus/solve/semismooth_newton.hpp"
+#include "fictus/solve/solver_options.hpp"
+
+namespace fictus {
+
+struct SignoriniCheck {
+  double min_gap = 0;                // min_i (B_γ û − g)_i        (≥ −tol)
+  double min_normal_derivative = 0;  // min_i (C_γ û)_i             (≥ −tol)
+  double max_complementarity = 0;    // max_i |(C_γ û)_i (B_γ û − g)_i|
+};
+
+/// The Signorini conditions once more with a normal derivative D_γ û from another stencil than the
+/// solve's C_γ (docs/math.md, "Checks"): where C_γ is wrong, D_γ û − C_γ û shows it.
+struct IndependentCheck {
+  std::string rule;                       // the stencil of D_γ
+  double min_normal_derivative = 0;       // min_i (D_γ û)_i
+  double max_complementarity = 0;         // max_i |(D_γ û)_i (B_γ û − g)_i|
+  double max_difference = 0;              // max_i |D_γ û − C_γ û|_i
+  double rms_difference = 0;              // root mean square of the same
+  std::vector<double> normal_derivative;  // (D_γ û)_i at every point
+};
+
+/// Errors at the points against an exact solution.
+struct PointErrors {
+  double max_trace = 0;              // max_i |(B_γ û)_i − u(x_i)|
+  double max_normal_derivative = 0;  // max_i |(C_γ û)_i − ∂u/∂n(x_i)|
+};
+
+struct Timings {
+  std::vector<std::pair<std::string, double>> phases;  // seconds, in execution order
+  double total = 0;
+  double operator[](const std::string& name) const;
+};
+
+/// With solver.far_field: what the assembly interpolated, and the Newton steps run on the exact S
+/// (preconditioned by S̃) after those on S̃ (all counted in newton.iterations).
+struct FarFieldUse {
+  FarFieldReport assembly;
+  int exact_steps = 0;
+};
+
+/// With solver.nested_start (N at or above it): the solve of the same problem on the grid of N/2
+/// whose active set, taken at each point from the nearest coarse point, started Newton here; or,
+/// when that solve could not be made, why (`skipped`), and Newton started as solver.start says.
+struct NestedStart {
+  int N = 0;             // the coarse grid's
+  int multipliers = 0;   // the coarse m
+  int newton_steps = 0;  // the coarse solve's (not counted in newton.iterations)
+  int active = 0;        // its points in contact
+  double seconds = 0;    // the whole coarse solve, its own nested start included
+  std::string skipped;   // non-empty: no nested start, and why
+};
+
+/// With formulation.flux_balance (3-D non-smooth): how far the kink-corrected readings missed the
+/// discrete flux balance before the correction (docs/math.md, "The flux balance of the patches").
+struct FluxBalanceUse {
+  double scatter = 0;     // the standard deviation over the patches of β_j/a_j
+  double mean = 0;        // μ: a constant layer's error of the mean reading, per unit λ
+  double data_shift = 0;  // what every reading of the data's field u₀ moved by
+};
+
+/// The points of γ a solution's values belong to, and the boundary carrying λ.
+template <int dim>
+struct SolutionBoundary;
+
+template <>
+struct SolutionBoundary<2> {
+  Collocation collocation;             // the points on γ, with the arcs they own
+  std::shared_ptr<const Curve> Gamma;  // the curve carrying λ (γ itself in the non-smooth variant)
+  int n_points() const { return collocation.m; }
+  const std::vector<Point2>& points() const { return collocation.point; }
+  const std::vector<Point2>& normals() const { return collocation.normal; }
+  const std::vector<double>& weights() const { return collocation.arc; }  // the length of γ each point owns
+  double spacing() const { return collocation.spacing; }                  // s = L/m
+};
+
+template <>
+struct SolutionBoundary<3> {
+  PatchedSurface gamma;  // γ's patches: triangles, points, normals, areas
+  PatchedSurface Gamma;  // the surface carrying λ (γ itself in the non-smooth variant)
+  int n_points() const { return gamma.m; }
+  const std::vector<Point3>& points() const { return gamma.point; }
+  const std::vector<Point3>& normals() const { return gamma.normal; }
+  const std::vector<double>& weights() const { return gamma.area; }  // the area of γ each point owns
+  double spacing() const {                                           // s = √(A/m)
+    double area = 0;
+    for (double a : gamma.area) area += a;
+    return gamma.m > 0 ? std::sqrt(area / gamma.m) : 0.0;
+  }
+};
+
+template <int dim>
+struct BasicSolution : SolutionBoundary<dim> {
+  explicit BasicSolution(const Grid<dim>& g) : grid(g) {}
+  Grid<dim> grid;
+  SolverOptions options;              // in effect (m, the offset, the variant and the threads resolved)
+  std::vector<std::string> warnings;  // what the solve changed to fit (one line each), for the user
+  GridVector u;                       // û at the unknowns (empty when the field was not asked for)
+  double delta = 0;                   // distance of Γ from γ
+  std::vector<double> lambda, g, trace, normal_derivative;  // per point: λ, g, B_γû, C_γû
+  double lambda_total = 0;  // Σ_i λ_i·|Γ_i| = 1ᵀB_Γᵀλ, the total load λ adds to the box (∫_Γ λ)
+  double alpha = 0;         // constant added to û (singular A: periodic box, c = 0)
+  NewtonResult newton;
+  std::size_t fast_solves = 0;  // applications of A⁻¹ in this solve (the paper's it₁)
+  int inner_iterations = 0;     // Krylov iterations over all Newton steps
+  int factorizations = 0;       // dense LUs of Newton matrices (green; the others by updates)
+  bool reused_curve = false;    // γ's trace rows and Schur blocks came from the previous solve
+  std::optional<double> condition_number;
+  using FarFieldUse = fictus::FarFieldUse;
+  using NestedStart = fictus::NestedStart;
+  using FluxBalanceUse = fictus::FluxBalanceUse;
+  std::optional<FarFieldUse> far_field;
+  std::optional<NestedStart> nested_start;
+  std::optional<FluxBalanceUse> flux_balance;
+  SignoriniCheck signorini;
+  std::optional<IndependentCheck> check;  // with the field only
+  std::optional<ErrorNorms> errors;
+  std::optional<PointErrors> point_errors;
+  Timings timings;
+  std::size_t peak_memory_bytes = 0;  // of the process so far (VmHWM; set by the caller, 0 if unknown)
+};
+
+using Solution = BasicSolution<2>;
+using SurfaceSolution = BasicSolution<3>;
+
+/// The contact in numbers, from the per-point values of a solution (point i owns the part
+/// weights()[i] of γ: an arc length in 2-D, a patch area in 3-D).
+struct ContactSummary {
+  long points = 0;     // points in contact (the active set)
+  double measure = 0;  // length (2-D) or area (3-D) of the contact set: Σ over the contact points of their part
+  double force = 0;    // total contact force ∫ ∂u/∂n over the contact set: Σ_active (C_γû)_i·part_i
+  double lambda = 0;   // ∫_Γ λ = Σ λ_i·|Γ_i| (BasicSolution::lambda_total): non-smooth, the jump [∂û/∂n]
+                       // integrated over γ (it includes the fictitious field outside ω: not the
+                       // contact force); smooth, the total control on Γ
+  double min_gap = 0;  // min_i (B_γû − g)_i  (≈ 0: the contact points)
+  double max_gap = 0;  // max_i (B_γû − g)_i  (the widest opening)
+};
+template <int dim>
+ContactSummary contact_summary(const BasicSolution<dim>& solution);
+
+/// The one-line report of a Newton failure, with its history (what the CLI and the bindings print).
+template <int dim>
+std::string describe_newton_failure(const BasicSolution<dim>& solution);
+
+}  // namespace fictus

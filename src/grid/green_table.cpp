@@ -1,0 +1,172 @@
+#include "fictus/grid/green_table.hpp"
+
+#include "fftw_plan.hpp"
+#include "fictus/grid/q1_symbol.hpp"
+
+namespace fictus {
+
+template <int dim>
+GreenTable<dim>::GreenTable(const Grid<dim>& grid, double c, const Execution& execution)
+    : grid_(grid), c_(c), periodic_(grid.periodic()) {
+  const Q1Symbol<dim> symbol(grid, c);
+  std::size_t entries = 1;
+  for (int d = 0; d < dim; ++d) {
+    period_[d] = periodic_ ? grid.n(d) : 2 * grid.n(d);
+    size_[d] = std::size_t(period_[d] / 2 + 1);
+    entries *= size_[d];
+  }
+  table_.assign(entries, 0.0);
+  // Table entry p holds 1/λ of mode p. Dirichlet: p_d = 1..n_d−1 (spectrum index p_d − 1), zero at
+  // p_d ∈ {0, n_d}; periodic: p_d = 0..n_d/2 (spectrum index p_d), the zero mode dropped when λ = 0.
+  double denominator = periodic_ ? 1.0 : double(1 << dim);
+  for (int d = 0; d < dim; ++d) denominator *= grid.n(d);
+  const double scale = 1.0 / denominator;
+  const int shift = periodic_ ? 0 : 1, rows = int(entries / size_[0]), row_length = int(size_[0]);
+  const double* k0 = symbol.axis(0).stiffness.data();
+  const double* m0 = symbol.axis(0).mass.data();
+#pragma omp parallel for num_threads(execution.threads()) schedule(static)
+  for (int r = 0; r < rows; ++r) {
+    std::array<int, dim> slow{};
+    bool inside = true;
+    for (int d = 1, rest = r; d < dim; ++d) {
+      slow[d] = rest % int(size_[d]) - shift, rest /= int(size_[d]);
+      inside = inside && slow[d] >= 0 && slow[d] < symbol.axis(d).size();
+    }
+    if (!inside) continue;
+    const typename Q1Symbol<dim>::Row factors = symbol.row(slow);
+    double* row = table_.data() + std::size_t(r) * size_[0];
+    for (int p = 0; p < row_length; ++p) {
+      const int ip = p - shift;
+      if (ip < 0 || ip >= symbol.axis(0).size()) continue;
+      const double lambda = Q1Symbol<dim>::lambda(k0[ip], m0[ip], c, factors);
+      row[p] = lambda > 0 ? scale / lambda : 0.0;
+    }
+  }
+  std::vector<int> shape;  // slowest axis first
+  for (int d = dim - 1; d >= 0; --d) shape.push_back(int(size_[d]));
+  detail::R2rPlan plan(shape, detail::R2rKind::dct1, execution.threads());
+  plan.execute(table_.data());
+}
+
+namespace {
+
+/// Σ over the reflections from the table rows at the folded (y, z) offsets (3-D: (−,−), (+,−), (−,+),
+/// (+,+); 2-D: y = −, +) and the folded x offsets m = |a − b|, p = a + b: the order of the
+/// node-by-node form's sums.
+inline double reflections(const double* mm, const double* pm, const double* mp, const double* pp, std::size_t m,
+                          std::size_t p) {
+  return (mm[m] - mm[p] - pm[m] + pm[p]) - (mp[m] - mp[p] - pp[m] + pp[p]);
+}
+inline double reflections(const double* tm, const double* tp, std::size_t m, std::size_t p) {
+  return tm[m] - tm[p] - tp[m] + tp[p];
+}
+
+}  // namespace
+
+template <int dim>
+void GreenTable<dim>::G(const std::array<std::vector<int>, dim>& a, const std::array<std::vector<int>, dim>& b,
+                        double* out, std::size_t ld) const {
+  // Per axis and pair of coordinates (b's slowest): the table offsets of a − b and (Dirichlet) a + b.
+  std::array<std::vector<std::size_t>, dim> minus, plus;
+  std::size_t stride = 1;
+  for (int d = 0; d < dim; ++d) {
+    const auto &ad = a[std::size_t(d)], &bd = b[std::size_t(d)];
+    for (int y : bd)
+      for (int x : ad) {
+        minus[std::size_t(d)].push_back(std::size_t(near_fold(x - y, period_[d])) * stride);
+        if (!periodic_) plus[std::size_t(d)].push_back(std::size_t(near_fold(x + y, period_[d])) * stride);
+      }
+    stride *= size_[d];
+  }
+  const double* t = table_.data();
+  const std::size_t na0 = a[0].size(), nb0 = b[0].size(), na1 = a[1].size(), nb1 = b[1].size();
+  if constexpr (dim == 2) {
+    for (std::size_t q1 = 0; q1 < nb1; ++q1)
+      for (std::size_t q0 = 0; q0 < nb0; ++q0) {
+        double* column = out + ld * (q1 * nb0 + q0);
+        const std::size_t* sm = minus[0].data() + q0 * na0;
+        const std::size_t* sp = plus[0].data() + q0 * na0;  // empty in a periodic box
+        for (std::size_t p1 = 0; p1 < na1; ++p1) {
+          const double* tm = t + minus[1][q1 * na1 + p1];
+          double* o = column + p1 * na0;
+          if (periodic_) {
+            for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = tm[sm[p0]];
+            continue;
+          }
+          const double* tp = t + plus[1][q1 * na1 + p1];
+          for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = reflections(tm, tp, sm[p0], sp[p0]);
+        }
+      }
+  } else {
+    const std::size_t na2 = a[2].size(), nb2 = b[2].size();
+    for (std::size_t q2 = 0; q2 < nb2; ++q2)
+      for (std::size_t q1 = 0; q1 < nb1; ++q1)
+        for (std::size_t q0 = 0; q0 < nb0; ++q0) {
+          double* column = out + ld * ((q2 * nb1 + q1) * nb0 + q0);
+          const std::size_t* xm = minus[0].data() + q0 * na0;
+          const std::size_t* xp = plus[0].data() + q0 * na0;  // empty in a periodic box
+          for (std::size_t p2 = 0; p2 < na2; ++p2)
+            for (std::size_t p1 = 0; p1 < na1; ++p1) {
+              const std::size_t ym = minus[1][q1 * na1 + p1], zm = minus[2][q2 * na2 + p2];
+              double* o = column + (p2 * na1 + p1) * na0;
+              if (periodic_) {
+                for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = t[zm + ym + xm[p0]];
+                continue;
+              }
+              const std::size_t yp = plus[1][q1 * na1 + p1], zp = plus[2][q2 * na2 + p2];
+              const double *mm = t + ym + zm, *pm = t + yp + zm, *mp = t + ym + zp, *pp = t + yp + zp;
+              for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = reflections(mm, pm, mp, pp, xm[p0], xp[p0]);
+            }
+        }
+  }
+}
+
+template <int dim>
+void GreenTable<dim>::G(const Index* a, std::size_t n_a, const Index* b, const double* w, std::size_t n_b,
+                        double* out) const {
+  // The folded offsets of a_d ± b_d times the axes' strides in the table.
+  const std::size_t s1 = size_[0], s2 = dim == 3 ? size_[0] * size_[1] : 0;
+  const int p0 = period_[0], p1 = period_[1], p2 = period_[dim - 1];
+  const double* t = table_.data();
+  for (std::size_t u = 0; u < n_a; ++u) {
+    const Index& x = a[u];
+    double sum = 0.0;
+    if constexpr (dim == 2) {
+      if (periodic_) {
+        for (std::size_t k = 0; k < n_b; ++k)
+          sum += t[std::size_t(near_fold(x[1] - b[k][1], p1)) * s1 + std::size_t(near_fold(x[0] - b[k][0], p0))] * w[k];
+      } else {
+        for (std::size_t k = 0; k < n_b; ++k) {
+          const double* tm = t + std::size_t(near_fold(x[1] - b[k][1], p1)) * s1;
+          const double* tp = t + std::size_t(near_fold(x[1] + b[k][1], p1)) * s1;
+          sum += reflections(tm, tp, std::size_t(near_fold(x[0] - b[k][0], p0)),
+                             std::size_t(near_fold(x[0] + b[k][0], p0))) *
+                 w[k];
+        }
+      }
+    } else {
+      if (periodic_) {
+        for (std::size_t k = 0; k < n_b; ++k)
+          sum += t[std::size_t(near_fold(x[2] - b[k][2], p2)) * s2 + std::size_t(near_fold(x[1] - b[k][1], p1)) * s1 +
+                   std::size_t(near_fold(x[0] - b[k][0], p0))] *
+                 w[k];
+      } else {
+        for (std::size_t k = 0; k < n_b; ++k) {
+          const std::size_t ym = std::size_t(near_fold(x[1] - b[k][1], p1)) * s1;
+          const std::size_t yp = std::size_t(near_fold(x[1] + b[k][1], p1)) * s1;
+          const std::size_t zm = std::size_t(near_fold(x[2] - b[k][2], p2)) * s2;
+          const std::size_t zp = std::size_t(near_fold(x[2] + b[k][2], p2)) * s2;
+          sum += reflections(t + ym + zm, t + yp + zm, t + ym + zp, t + yp + zp,
+                             std::size_t(near_fold(x[0] - b[k][0], p0)), std::size_t(near_fold(x[0] + b[k][0], p0))) *
+                 w[k];
+        }
+      }
+    }
+    out[u] = sum;
+  }
+}
+
+template class GreenTable<2>;
+template class GreenTable<3>;
+
+}  // namespace fictus

@@ -1,0 +1,44 @@
+#include "fictus/grid/sparse_rows.hpp"
+
+#include <algorithm>
+
+namespace fictus {
+
+void SparseRows::multiply(const GridVector& u, std::vector<double>& out) const {
+  out.assign(n_rows(), 0.0);
+  for (int r = 0; r < n_rows(); ++r)
+    for (std::size_t k = row_begin[r]; k < row_begin[r + 1]; ++k) out[r] += entries[k].value * u[entries[k].index];
+}
+
+void SparseRows::add_transposed(const std::vector<double>& lambda, GridVector& u) const {
+  for (int r = 0; r < n_rows(); ++r)
+    for (std::size_t k = row_begin[r]; k < row_begin[r + 1]; ++k) u[entries[k].index] += entries[k].value * lambda[r];
+}
+
+std::vector<double> SparseRows::row_sums() const {
+  std::vector<double> sums(std::size_t(n_rows()), 0.0);
+  for (int r = 0; r < n_rows(); ++r)
+    for (std::size_t k = row_begin[r]; k < row_begin[r + 1]; ++k) sums[std::size_t(r)] += entries[k].value;
+  return sums;
+}
+
+SparseRows add_rows(const SparseRows& a, const SparseRows& b) {
+  SparseRows out;
+  for (int r = 0; r < a.n_rows(); ++r) {
+    std::vector<SparseRows::Entry> row(a.entries.begin() + std::ptrdiff_t(a.row_begin[r]),
+                                       a.entries.begin() + std::ptrdiff_t(a.row_begin[r + 1]));
+    for (std::size_t k = b.row_begin[r]; k < b.row_begin[r + 1]; ++k) {
+      const auto& e = b.entries[k];
+      auto same = std::find_if(row.begin(), row.end(), [&](const SparseRows::Entry& x) { return x.index == e.index; });
+      if (same != row.end())
+        same->value += e.value;
+      else
+        row.push_back(e);
+    }
+    out.entries.insert(out.entries.end(), row.begin(), row.end());
+    out.row_begin.push_back(out.entries.size());
+  }
+  return out;
+}
+
+}  // namespace fictus

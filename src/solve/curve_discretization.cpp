@@ -1,0 +1,257 @@
+#include "fictus/solve/curve_discretization.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "fictus/boundary/shapes.hpp"
+#include "solve_steps.hpp"
+
+namespace fictus {
+
+CurveDiscretization::CurveDiscretization(std::shared_ptr<const Curve> gamma, const Grid2& grid,
+                                         const SolverOptions& options, double c, const Execution& execution)
+    : execution_(execution), gamma_(std::move(gamma)) {
+  if (!gamma_) throw std::invalid_argument("geometry: no curve given");
+  SolverOptions resolved = options;
+  resolved.variant = resolved_variant(options.variant, gamma_->smooth());
+  make_geometry(grid, resolved);
+  make_trace_rows(grid, resolved, c);
+}
+
+namespace {
+
+/// The room of Γ = γ + δn (spacing_rule.hpp) at grid spacing h: on every side of the box, from
+/// the samples of γ whose normal points towards it, δ <= (distance − 2h)/(n toward the side); and
+/// the δ beyond which Γ stops being simple, found once by bisection when Γ at the box's limit folds.
+OffsetRoom curve_offset_room(std::shared_ptr<const Curve> gamma, const Box2& box) {
+  struct Sample {
+    double distance, toward;  // to one side of the box, and n's component toward it
+  };
+  auto samples = std::make_shared<std::vector<Sample>>();
+  constexpr int count = 4096;  // as check_inside_box and check_simple
+  std::vector<double> t = gamma->corners();
+  for (int k = 0; k < count; ++k) t.push_back(2 * std::numbers::pi * k / count);
+  for (double s : t) {
+    const Point2 p = gamma->position(s), n = gamma->outward_normal(s);
+    const Sample sides[4] = {
+        {p.x - box.lower.x, -n.x}, {box.upper.x - p.x, n.x}, {p.y - box.lower.y, -n.y}, {box.upper.y - p.y, n.y}};
+    for (const Sample& side : sides)
+      if (side.toward > 0) samples->push_back(side);
+  }
+  const auto box_room = [samples](double h) {
+    double room = std::numeric_limits<double>::infinity();
+    for (const Sample& s : *samples) room = std::min(room, (s.distance - 2 * h) / s.toward);
+    return room;
+  };
+  auto fold = std::make_shared<std::optional<double>>();  // the δ where Γ stops being simple (+∞: never)
+  return [gamma, box_room, fold](double h) {
+    const double room = box_room(h);
+    if (!fold->has_value()) {
+      const auto simple = [&gamma](double delta) {
+        try {
+          check_simple(OffsetCurve(gamma, delta), "formulation.offset");
+          return true;
+        } catch (const std::invalid_argument&) {
+          return false;
+        }
+      };
+      const double widest = box_room(0);
+      if (!(widest > 0) || simple(widest)) {
+        *fold = std::numeric_limits<double>::infinity();
+      } else {
+        double low = 0, high = widest;
+        for (int k = 0; k < 40 && high - low > 1e-9 * widest; ++k)
+          ((simple((low + high) / 2)) ? low : high) = (low + high) / 2;
+        *fold = low;
+      }
+    }
+    return std::min(room, **fold);
+  };
+}
+
+}  // namespace
+
+void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options) {
+  const Curve& gamma = *gamma_;
+  const double h = grid.h(), width = grid.box().width(0);
+  check_simple(gamma, "geometry");
+  if (signed_area(gamma) <= 0)
+    throw std::invalid_argument("geometry: the curve must be counter-clockwise (ω on its left)");
+  if (const BoxClearance c = box_clearance(gamma, grid.box(), "geometry"); c.distance < 2 * h) {
+    char text[240];
+    if (c.distance > 0)
+      std::snprintf(text, sizeof text,
+                    "geometry: the curve comes within %.3g of the box at (%.6g, %.6g); the grid needs 2h = %.3g "
+                    "there: N >= %.0f (or a larger box)",
+                    c.distance, c.at.x, c.at.y, 2 * h, std::ceil(2 * width / c.distance - 1e-9));
+    else
+      std::snprintf(
+          text, sizeof text,
+          "geometry: the curve comes within %.3g of the box boundary (or leaves it) at (%.6g, %.6g): a larger box",
+          c.distance, c.at.x, c.at.y);
+    throw std::invalid_argument(text);
+  }
+  gamma_geometry_ = std::make_unique<CurveGridIntersection>(gamma, grid, "geometry");
+
+  const ArcLengthTable arc_length(gamma);
+  const double L = arc_length.length();
+  if (options.variant == Variant::smooth && !gamma.smooth())
+    throw std::invalid_argument(
+        "formulation.variant: the smooth variant needs a curve with a continuous normal "
+        "(use \"nonsmooth\" for polygons)");
+  const double spacing_cells =
+      options.variant == Variant::smooth ? default_spacing_cells_smooth : default_spacing_cells_nonsmooth;
+  SpacingInput input{2,
+                     L,
+                     h,
+                     width,
+                     [L, spacing_cells](double k) { return default_multipliers(L, k, spacing_cells); },
+                     options.variant == Variant::smooth ? curve_offset_room(gamma_, grid.box()) : OffsetRoom()};
+  spacing_ = plan_spacing(input, options);
+  const int m = spacing_.m;
+  if (options.variant == Variant::nonsmooth) {
+    collocation_ = make_collocation(gamma, arc_length, m, phase_off_corners(gamma, arc_length, m));
+    Gamma_ = gamma_;
+    return;
+  }
+  delta_ = spacing_.delta;
+  // Points placed so that the arcs of Γ behind them are equal where γ is convex (there Γ's arcs are
+  // stretched by 1 + δκ): the longest arc of Γ, which sets the ripple of the controls, is as short as m
+  // allows (docs/math.md, "Placement of the points").
+  const ArcLengthTable placement = offset_placement(gamma, delta_);
+  collocation_ = make_collocation(gamma, arc_length, m, 0.5, &placement);
+  Gamma_ = std::make_shared<OffsetCurve>(gamma_, delta_);
+  check_simple(*Gamma_, "formulation.offset");  // the plan's room says so; checked again on Γ itself
+  check_inside_box(*Gamma_, grid.box(), 2 * h, "formulation.offset");
+  Gamma_geometry_ = std::make_unique<CurveGridIntersection>(*Gamma_, grid, "formulation.offset");
+}
+
+void CurveDiscretization::make_trace_rows(const Grid2& grid, const SolverOptions& options, double c) {
+  const Collocation& points = collocation_;
+  B_gamma_ = point_value_rows(grid, points.point);
+  B_Gamma_ = arc_integral_rows(Gamma_geometry_ ? *Gamma_geometry_ : *gamma_geometry_, points.arc_begin, points.arc_end);
+  loads_ = B_Gamma_;
+  if (options.normal_derivative == NormalDerivative::shifted) {
+    C_gamma_ = normal_derivative_rows(grid, points.point, points.normal, options.normal_shift * grid.h());
+    return;
+  }
+  C_gamma_ = normal_derivative_rows_centered(grid, points.point, points.normal, 2);
+  if (options.variant == Variant::nonsmooth) {
+    kink_ = std::make_unique<KinkCorrection>(*gamma_geometry_, collocation_, c, execution_);
+    loads_ = add_rows(B_Gamma_, kink_->galerkin());
+    direct_.trace = kink_->direct(B_gamma_);
+    direct_.normal_derivative = kink_->direct(C_gamma_);
+  }
+}
+
+void CurveDiscretization::finish_field(const std::vector<double>& lambda, GridVector& u) const {
+  if (kink_) kink_->add_kinks(lambda, u);
+}
+
+std::optional<std::vector<double>> CurveDiscretization::independent_normal_derivative(const GridVector& u,
+                                                                                      std::string& rule) const {
+  std::vector<double> d;
+  if (kink_) {
+    rule = "bicubic interpolant of the kink-corrected field";
+    normal_derivative_rows_centered(gamma_geometry_->grid(), points(), normals(), 3).multiply(u, d);
+    return d;
+  }
+  rule = "one-sided quadratic least-squares fit through the nodes of omega";
+  try {
+    one_sided_rows(*gamma_geometry_, points(), normals(), OneSidedTrace::normal_derivative, 2, 2.5).multiply(u, d);
+  } catch (const std::runtime_error&) {  // ω too thin for the fit: no check, not a failed solve
+    return std::nullopt;
+  }
+  return d;
+}
+
+namespace {
+
+std::string format_number(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3g", v);
+  return buffer;
+}
+
+std::string format_point(Point2 p) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "(%.6g, %.6g)", p.x, p.y);
+  return buffer;
+}
+
+}  // namespace
+
+std::vector<double> CurveDiscretization::obstacle(const Data& data) const {
+  const int m = n_points();
+  const std::vector<Point2>& p = points();
+  std::vector<double> g(m);
+  if (data.g_vectorized && !data.g_along_curve) {
+    std::vector<double> x(m), y(m);
+    for (int i = 0; i < m; ++i) x[i] = p[i].x, y[i] = p[i].y;
+    data.g_vectorized(m, x.data(), y.data(), g.data());
+  }
+  for (int i = 0; i < m; ++i) {
+    if (data.g_along_curve)
+      g[i] = data.g_along_curve(p[i].x, p[i].y, arc_positions()[i]);
+    else if (!data.g_vectorized)
+      g[i] = data.g(p[i].x, p[i].y);
+    if (!std::isfinite(g[i]))
+      throw std::invalid_argument("data.g: not finite at the collocation point " + format_point(p[i]));
+    if (std::abs(g[i]) > detail::largest_scale)
+      throw std::invalid_argument("data.g: " + format_number(g[i]) + " at " + format_point(p[i]) + " is beyond " +
+                                  format_number(detail::largest_scale) +
+                                  ": rescale the problem (u, f and g by one factor)");
+  }
+  return g;
+}
+
+ErrorNorms CurveDiscretization::errors(const GridVector& u, const std::vector<double>&, const Data& data,
+                                       int quadrature) const {
+  if (data.exact_vectorized)
+    return compute_errors(u, *gamma_geometry_, data.exact_vectorized, {}, quadrature, execution_);
+  return compute_errors(u, *gamma_geometry_, data.exact, data.exact_gradient, quadrature, execution_);
+}
+
+PointErrors CurveDiscretization::point_errors(const std::vector<double>& trace,
+                                              const std::vector<double>& normal_derivative, const Data& data) const {
+  const VectorizedField exact = data.exact_vectorized ? data.exact_vectorized : vectorize(data.exact);
+  const std::vector<Point2>& p = points();
+  const std::vector<Point2>& n = normals();
+  const std::size_t m = p.size();
+  std::vector<double> x(m), y(m), values(m);
+  for (std::size_t i = 0; i < m; ++i) x[i] = p[i].x, y[i] = p[i].y;
+  exact(m, x.data(), y.data(), values.data());
+  const Grid2& grid = gamma_geometry_->grid();
+  const double step = 1e-5 * (grid.box().upper.x - grid.box().lower.x);
+  std::vector<double> xs(2 * m), ys(2 * m), inner(2 * m);
+  for (std::size_t i = 0; i < m; ++i)
+    for (int k = 0; k < 2; ++k) {
+      const Point2 q = p[i] - (k + 1) * step * n[i];
+      xs[2 * i + k] = q.x, ys[2 * i + k] = q.y;
+    }
+  if (!data.exact_gradient) exact(2 * m, xs.data(), ys.data(), inner.data());
+  PointErrors pe;
+  for (std::size_t i = 0; i < m; ++i) {
+    if (!std::isfinite(values[i])) throw std::invalid_argument("data.exact: not finite at " + format_point(p[i]));
+    const double dudn = data.exact_gradient ? dot(n[i], data.exact_gradient(x[i], y[i]))
+                                            : (3 * values[i] - 4 * inner[2 * i] + inner[2 * i + 1]) / (2 * step);
+    if (!std::isfinite(dudn))
+      throw std::invalid_argument("data.exact: its normal derivative is not finite near " + format_point(p[i]));
+    pe.max_trace = std::max(pe.max_trace, std::abs(trace[i] - values[i]));
+    pe.max_normal_derivative = std::max(pe.max_normal_derivative, std::abs(normal_derivative[i] - dudn));
+  }
+  return pe;
+}
+
+void CurveDiscretization::describe(SolutionBoundary<2>& out) const {
+  out.collocation = collocation_;
+  out.Gamma = Gamma_;
+}
+
+}  // namespace fictus

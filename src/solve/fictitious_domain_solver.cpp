@@ -1,0 +1,607 @@
+#include "fictus/solve/fictitious_domain_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include "fictus/grid/execution.hpp"
+#include "fictus/grid/fast_solver.hpp"
+#include "fictus/grid/green_table.hpp"
+#include "fictus/grid/load_vector.hpp"
+#include "fictus/solve/boundary_discretization.hpp"
+#include "fictus/solve/curve_discretization.hpp"
+#include "fictus/solve/options.hpp"
+#include "fictus/solve/schur_complement.hpp"
+#include "fictus/solve/surface_discretization.hpp"
+#include "solve_steps.hpp"
+
+namespace fictus {
+
+using detail::PhaseClock;
+using detail::row_sums;
+using detail::to_eigen;
+
+namespace {
+
+using detail::largest_scale;
+
+/// The options that shape the boundary's rows and Schur blocks: a change in any of them rebuilds them.
+bool same_boundary_options(const SolverOptions& a, const SolverOptions& b) {
+  return a.variant == b.variant && a.multipliers == b.multipliers && a.offset == b.offset &&
+         a.normal_derivative == b.normal_derivative && a.normal_shift == b.normal_shift && a.inner == b.inner &&
+         a.krylov_tolerance == b.krylov_tolerance && a.krylov_max_iterations == b.krylov_max_iterations &&
+         a.flux_balance == b.flux_balance && a.far_field == b.far_field;
+}
+
+template <int dim>
+bool same_box(const Box<dim>& a, const Box<dim>& b) {
+  for (int d = 0; d < dim; ++d)
+    if (a.lower[d] != b.lower[d] || a.upper[d] != b.upper[d]) return false;
+  return true;
+}
+
+template <class Vector>
+bool all_finite(const Vector& v) {
+  for (double x : v)
+    if (!std::isfinite(x)) return false;
+  return true;
+}
+
+template <class Vector>
+double max_abs(const Vector& v) {
+  double m = 0;
+  for (double x : v) m = std::max(m, std::abs(x));
+  return m;
+}
+
+std::string format_number(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3g", v);
+  return buffer;
+}
+
+/// Does γ have a continuous normal (the smooth variant's Γ needs one)? Every surface does.
+bool smooth_boundary(const Curve& gamma) { return gamma.smooth(); }
+bool smooth_boundary(const Surface&) { return true; }
+
+}  // namespace
+
+/// Steps 1–3 for one boundary: kept while the boundary and its options stay.
+template <int dim>
+struct BoundarySetup {
+  std::shared_ptr<const typename BoundaryShape<dim>::type> gamma;
+  SolverOptions options;  // as asked (m = 0 stays 0), so the next request compares equal
+  std::unique_ptr<BoundaryDiscretization<dim>> boundary;
+  std::unique_ptr<SchurComplement> schur;
+  std::unique_ptr<ImplicitSchur> exact;  // the exact S behind an interpolated far field
+  std::optional<FarFieldReport> far_field;
+  std::size_t fast_solves = 0;       // made by the setup (2b), counted in the solve that made it
+  Eigen::VectorXd b0, c0;            // B_γu₀, C_γu₀ (+ the reading shift)
+  double shift = 0;                  // what the data's readings moved by (the flux balance)
+  std::optional<ConstantMode> mode;  // singular A only
+  int load_version = -1;             // the u₀ that b0, c0, shift and mode came from
+};
+
+template <int dim>
+struct FictitiousDomainSolver<dim>::State {
+  Grid<dim> grid;
+  double c;
+  Execution execution;
+  int load_quadrature;
+  typename Fields<dim>::Scalar f;
+  typename Fields<dim>::Vectorized f_vectorized;
+  std::unique_ptr<FastSolver<dim>> fast;
+  std::unique_ptr<GreenTable<dim>> green;
+  GridVector u0;
+  bool have_u0 = false;
+  double load_total = 0;
+  int load_version = 0;  // counts the loads given (replace_load)
+  std::unique_ptr<BoundarySetup<dim>> setup;
+};
+
+template <int dim>
+FictitiousDomainSolver<dim>::FictitiousDomainSolver(const BasicProblem<dim>& problem, const SolverOptions& options) {
+  validate_options(problem, options);
+  if (!problem.f && !problem.f_vectorized) throw std::invalid_argument("data.f: not given");
+  if (!(problem.c >= 0) || !std::isfinite(problem.c)) throw std::invalid_argument("data.c: must be finite and >= 0");
+  const Grid<dim> grid(problem.box, problem.N, problem.boundary);
+  const Execution execution(options.threads);
+  state_ = std::make_unique<State>(State{grid,
+                                         problem.c,
+                                         execution,
+                                         options.load_quadrature,
+                                         problem.f,
+                                         problem.f_vectorized,
+                                         make_fast_solver(grid, problem.c, execution),
+                                         nullptr,
+                                         {},
+                                         false,
+                                         0.0,
+                                         0,
+                                         nullptr});
+}
+
+template <int dim>
+FictitiousDomainSolver<dim>::~FictitiousDomainSolver() = default;
+
+template <int dim>
+const Grid<dim>& FictitiousDomainSolver<dim>::grid() const {
+  return state_->grid;
+}
+
+template <int dim>
+void FictitiousDomainSolver<dim>::set_interrupt_check(std::function<bool()> check) {
+  state_->execution.set_interrupt_check(std::move(check));
+}
+
+template <int dim>
+void FictitiousDomainSolver<dim>::replace_load(const BasicProblem<dim>& problem) {
+  State& st = *state_;
+  if (!problem.f && !problem.f_vectorized) throw std::invalid_argument("data.f: not given");
+  if (problem.N != st.grid.nx() || problem.c != st.c || problem.boundary != st.grid.boundary() ||
+      !same_box<dim>(problem.box, st.grid.box()))
+    throw std::invalid_argument(
+        "data.f: replace_load keeps the grid, c and the boundary conditions; make a new solver to change them");
+  st.f = problem.f;
+  st.f_vectorized = problem.f_vectorized;
+  st.have_u0 = false;
+  ++st.load_version;
+}
+
+template <int dim>
+void FictitiousDomainSolver<dim>::set_progress(std::function<void(const std::string&, double)> progress) {
+  state_->execution.set_progress(std::move(progress));
+}
+
+namespace {
+
+template <int dim>
+using State = typename FictitiousDomainSolver<dim>::State;
+
+/// Checks the per-solve options against the solver's and resolves the variant (`chosen`: it was automatic).
+template <int dim>
+SolverOptions solve_options(const State<dim>& st, const BasicContactData<dim>& data, SolverOptions options,
+                            bool& chosen) {
+  options.validate();
+  if (Execution(options.threads).threads() != st.execution.threads() || options.load_quadrature != st.load_quadrature)
+    throw std::invalid_argument("solver.threads: threads and load_quadrature are the solver's (" +
+                                std::to_string(st.execution.threads()) + ", " + std::to_string(st.load_quadrature) +
+                                "); make a new FictitiousDomainSolver to change them");
+  if (!data.gamma) throw std::invalid_argument(dim == 2 ? "geometry: no curve given" : "geometry: no surface given");
+  bool has_g = data.g || data.g_vectorized;
+  if constexpr (dim == 2) has_g = has_g || data.g_along_curve;
+  if (!has_g) throw std::invalid_argument("data.g: not given");
+  chosen = options.variant == Variant::automatic;
+  options.variant = resolved_variant(options.variant, smooth_boundary(*data.gamma));
+  options.threads = st.execution.threads();
+  return options;
+}
+
+/// Steps 1–2 for data.gamma, or the previous ones when the boundary and its options are unchanged.
+template <int dim>
+BoundarySetup<dim>& boundary_setup(State<dim>& st, const BasicContactData<dim>& data, const SolverOptions& options,
+                                   PhaseClock& clock, bool& reused) {
+  reused =
+      st.setup && st.setup->schur && st.setup->gamma == data.gamma && same_boundary_options(st.setup->options, options);
+  if (reused) return *st.setup;
+  st.setup.reset();
+  auto setup = std::make_unique<BoundarySetup<dim>>();
+  setup->gamma = data.gamma;
+  setup->options = options;
+  const MarkPhase mark = [&clock](const std::string& phase) { clock.mark(phase); };
+  if constexpr (dim == 2) {
+    setup->boundary = std::make_unique<CurveDiscretization>(data.gamma, st.grid, options, st.c, st.execution);
+    clock.mark("geometry");
+  } else {
+    setup->boundary = std::make_unique<SurfaceDiscretization>(data.gamma, st.grid, options, st.c, st.execution, mark);
+  }
+  st.setup = std::move(setup);
+  return *st.setup;
+}
+
+/// Step 0: the load vector and u₀ = A⁻¹f (A⁺f for a singular A), once per load.
+template <int dim>
+void load_and_u0(State<dim>& st, PhaseClock& clock, std::size_t& fast_solves) {
+  if (st.have_u0) return;
+  st.u0 = st.f_vectorized ? assemble_load(st.grid, st.f_vectorized, st.load_quadrature, st.execution)
+                          : assemble_load(st.grid, st.f, st.load_quadrature, st.execution);
+  st.load_total = 0;
+  for (double v : st.u0) {
+    if (!std::isfinite(v)) throw std::invalid_argument("data.f: not finite somewhere in the box");
+    st.load_total += v;
+  }
+  clock.mark("load");
+  st.execution.throw_if_interrupted();
+  const double largest_load = max_abs(st.u0);
+  st.fast->solve_in_place(st.u0);
+  ++fast_solves;
+  if (!all_finite(st.u0) || max_abs(st.u0) > largest_scale)
+    throw std::invalid_argument("data.f: u0 = A^-1 f reaches " + format_number(max_abs(st.u0)) +
+                                " (load entries up to " + format_number(largest_load) + "), beyond " +
+                                format_number(largest_scale) + ": rescale the problem (u, f and g by one factor)");
+  st.have_u0 = true;
+  clock.mark("u0");
+}
+
+/// Steps 2b–3: the boundary's grid-level setup and the Schur blocks, explicit from the Green's table
+/// (its far field interpolated where the boundary allows it) or implicit. With `keep` false the
+/// Green's table is freed once the blocks are made.
+template <int dim>
+void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions& options, PhaseClock& clock,
+                  bool keep) {
+  if (setup.schur) return;
+  BoundaryDiscretization<dim>& b = *setup.boundary;
+  const MarkPhase mark = [&clock](const std::string& phase) { clock.mark(phase); };
+  setup.fast_solves += b.finish_setup(*st.fast, mark);
+  const GmresOptions gmres = detail::gmres_options(options, b.n_points(), st.execution);
+  if (options.inner == InnerSolver::krylov) {
+    setup.schur = std::make_unique<ImplicitSchur>(*st.fast, b.B_gamma(), b.C_gamma(), b.loads(), gmres, b.direct());
+    return;
+  }
+  if (!st.green) {
+    st.green = std::make_unique<GreenTable<dim>>(st.grid, st.c, st.execution);
+    clock.mark("green_table");
+  }
+  FarFieldReport report;
+  setup.schur = std::make_unique<ExplicitSchur>(*st.green, b.B_gamma(), b.C_gamma(), b.loads(), st.execution,
+                                                b.direct(), b.far_field(options), &report);
+  if (!keep) st.green.reset();
+  if (report.far_pairs > 0) {
+    setup.far_field = report;
+    setup.exact = std::make_unique<ImplicitSchur>(*st.fast, b.B_gamma(), b.C_gamma(), b.loads(), gmres, b.direct());
+  }
+  clock.mark("schur");
+  st.execution.throw_if_interrupted();
+}
+
+/// What a boundary's setup takes from u₀: B_γu₀, C_γu₀ (+ the reading shift) and (singular A) the
+/// load's total; again for each new load.
+template <int dim>
+void load_terms(const State<dim>& st, BoundarySetup<dim>& setup) {
+  if (setup.load_version == st.load_version) return;
+  const BoundaryDiscretization<dim>& boundary = *setup.boundary;
+  std::vector<double> b0, c0;
+  boundary.B_gamma().multiply(st.u0, b0);
+  boundary.C_gamma().multiply(st.u0, c0);
+  setup.shift = boundary.reading_shift(st.u0, st.f_vectorized ? st.f_vectorized : vectorize(st.f), st.load_quadrature);
+  if (setup.shift != 0.0)  // the data's readings: their area-weighted sum is c∫_ω u₀ − ∫_ω f
+    for (double& v : c0) v += setup.shift;
+  setup.b0 = to_eigen(b0);
+  setup.c0 = to_eigen(c0);
+  if (st.fast->singular())
+    setup.mode = ConstantMode{row_sums(boundary.B_gamma()), row_sums(boundary.C_gamma()), row_sums(boundary.B_Gamma()),
+                              st.load_total};
+  setup.load_version = st.load_version;
+}
+
+/// Each of `points` takes the flag of the nearest of `from`.
+template <int dim>
+ActiveSet nearest_flags(const std::vector<Point<dim>>& from, const ActiveSet& flags,
+                        const std::vector<Point<dim>>& points, const Execution& execution) {
+  ActiveSet out(points.size());
+  const std::ptrdiff_t n = std::ptrdiff_t(points.size());
+#pragma omp parallel for num_threads(execution.threads()) schedule(static)
+  for (std::ptrdiff_t p = 0; p < n; ++p) {
+    double best = std::numeric_limits<double>::infinity();
+    std::size_t nearest = 0;
+    for (std::size_t q = 0; q < from.size(); ++q) {
+      const Point<dim> d = from[q] - points[std::size_t(p)];
+      double d2 = 0;
+      for (int k = 0; k < dim; ++k) d2 += d[k] * d[k];
+      if (d2 < best) best = d2, nearest = q;
+    }
+    out[std::size_t(p)] = flags[nearest];
+  }
+  return out;
+}
+
+}  // namespace
+
+namespace {
+
+/// The nested start: the same problem on the grid of N/2 (m/4 points when m is given; Γ at the same
+/// distance δ from γ; no error integrals), its active set carried to this grid's points (each takes the
+/// flag of the nearest coarse point), or nothing, with `report.skipped` saying why: the coarse grid
+/// checks the box's margin (2h), the boundary's reach and δ ≥ 4h with its own h, and may refuse what
+/// this grid takes. Its steps are reported as "N/2 <step>"; an interrupt asked there ends this solve too.
+template <int dim>
+ActiveSet nested_start(const State<dim>& st, const BasicContactData<dim>& data, const SolverOptions& options,
+                       const BoundaryDiscretization<dim>& fine, NestedStart& report) {
+  const int N = st.grid.nx();
+  if (N % 2 != 0) {
+    report.skipped = "N is odd";
+    return {};
+  }
+  if (N / 2 < minimum_nested_grid) {
+    report.skipped = "N/2 is below " + std::to_string(minimum_nested_grid);
+    return {};
+  }
+  BasicProblem<dim> coarse;
+  static_cast<BasicContactData<dim>&>(coarse) = data;
+  coarse.exact = {};
+  coarse.exact_vectorized = {};
+  coarse.exact_gradient = {};
+  coarse.box = st.grid.box(), coarse.boundary = st.grid.boundary(), coarse.N = N / 2, coarse.c = st.c;
+  coarse.f = st.f, coarse.f_vectorized = st.f_vectorized;
+  SolverOptions coarse_options = options;
+  if (options.multipliers > 0)
+    coarse_options.multipliers = std::max(minimum_multipliers, int(std::lround(options.multipliers / 4.0)));
+  coarse_options.offset = fine.spacing().offset / 2;  // δ = offset·s, and s doubles
+  const Execution& execution = st.execution;
+  const auto progress = [&execution](const std::string& phase, double seconds) {
+    execution.report("N/2 " + phase, seconds);
+  };
+  bool stop_asked = false;  // a data callback may turn an interrupt into invalid_argument (Python's Ctrl-C)
+  const auto check = [&execution, &stop_asked] { return stop_asked = stop_asked || execution.interrupt_requested(); };
+  try {
+    const BasicSolution<dim> s = solve(coarse, coarse_options, progress, check);
+    if (!s.newton.converged) {
+      report.skipped = "the solve on the grid of N/2 did not converge: " + s.newton.failure;
+      return {};
+    }
+    report.N = coarse.N;
+    report.multipliers = s.options.multipliers;
+    report.newton_steps = s.newton.iterations;
+    report.active = int(std::count(s.newton.active.begin(), s.newton.active.end(), 1));
+    return nearest_flags<dim>(s.points(), s.newton.active, fine.points(), execution);
+  } catch (const Interrupted&) {
+    throw;
+  } catch (const std::runtime_error& e) {  // e.g. an empty patch
+    if (stop_asked) throw Interrupted();
+    report.skipped = std::string("the solve on the grid of N/2 failed: ") + e.what();
+  } catch (const std::invalid_argument& e) {  // a grid too coarse for the boundary or the box
+    if (stop_asked) throw Interrupted();
+    report.skipped = std::string("the grid of N/2 does not take the problem: ") + e.what();
+  }
+  return {};
+}
+
+/// Step 5: semismooth Newton on λ with the Schur blocks; where the far field was interpolated, on S̃
+/// until the active set has nearly settled, then on the exact S preconditioned by S̃ from there.
+template <int dim>
+void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions& options, const ActiveSet& start,
+            BasicSolution<dim>& sol) {
+  const NewtonOptions newton_options = detail::newton_options(options, st.execution);
+  NewtonOptions first = newton_options;
+  const int m = setup.boundary->n_points();
+  if (setup.exact) first.hand_on_at_changes = std::max(1, int(far_field_hand_on * m));
+  if (!start.empty()) first.start_active = &start;
+  const ConstantMode* mode = setup.mode ? &*setup.mode : nullptr;
+  const Eigen::VectorXd g = to_eigen(sol.g);
+  const std::size_t before = setup.schur->fast_solves(), exact_before = setup.exact ? setup.exact->fast_solves() : 0;
+  sol.newton = solve_semismooth_newton(*setup.schur, setup.b0, setup.c0, g, first, mode);
+  if (setup.exact) {
+    GmresOptions polish = detail::gmres_options(options, m, st.execution);
+    polish.relative_tolerance = far_field_gmres_tolerance;
+    const PreconditionedSchur preconditioned(static_cast<const ExplicitSchur&>(*setup.schur), *setup.exact, polish);
+    NewtonOptions from_there = newton_options;  // solver.max_newton caps both runs together
+    from_there.start = &sol.newton;
+    from_there.max_iterations = std::max(1, newton_options.max_iterations - sol.newton.iterations);
+    NewtonResult second = solve_semismooth_newton(preconditioned, setup.b0, setup.c0, g, from_there, mode);
+    sol.far_field = FarFieldUse{*setup.far_field, second.iterations};
+    second.iterations += sol.newton.iterations;
+    second.history.insert(second.history.begin(), sol.newton.history.begin(), sol.newton.history.end());
+    second.inner_failed = second.inner_failed || sol.newton.inner_failed;
+    sol.newton = std::move(second);
+    sol.fast_solves += setup.exact->fast_solves() - exact_before;
+  }
+  sol.fast_solves += setup.schur->fast_solves() - before;
+  if (const auto* dense = dynamic_cast<const ExplicitSchur*>(setup.schur.get()))
+    sol.factorizations = dense->factorizations();
+  for (const NewtonStep& step : sol.newton.history) sol.inner_iterations += step.inner_iterations;
+  if (options.condition_number && dim == 2) sol.condition_number = setup.schur->condition_number(sol.newton.active);
+  sol.lambda.assign(sol.newton.lambda.data(), sol.newton.lambda.data() + sol.newton.lambda.size());
+  sol.lambda_total = row_sums(setup.boundary->B_Gamma()).dot(sol.newton.lambda);
+  sol.alpha = sol.newton.alpha;
+  if (!all_finite(sol.lambda) || !std::isfinite(sol.alpha) || max_abs(sol.lambda) > largest_scale)
+    throw std::invalid_argument("data.g: the multipliers reach " + format_number(max_abs(sol.lambda)) + " (|g| up to " +
+                                format_number(max_abs(sol.g)) + "), beyond " + format_number(largest_scale) +
+                                ": rescale the problem (u, f and g by one factor)");
+}
+
+/// Step 6: û = u₀ + A⁻¹ loadsᵀλ + α, finished by the boundary (the kink-corrected field I_h w in the
+/// non-smooth variant, whose traces and readings are those of the Newton system); its traces at the points.
+template <int dim>
+void field(const State<dim>& st, const BoundarySetup<dim>& setup, BasicSolution<dim>& sol) {
+  const BoundaryDiscretization<dim>& boundary = *setup.boundary;
+  GridVector u(st.grid.n_unknowns(), 0.0);
+  boundary.loads().add_transposed(sol.lambda, u);
+  st.fast->solve_in_place(u);
+  ++sol.fast_solves;
+  for (std::size_t k = 0; k < u.size(); ++k) u[k] += st.u0[k] + sol.alpha;
+  boundary.finish_field(sol.lambda, u);
+  if (!all_finite(u))
+    throw std::invalid_argument("data: the field u is not finite: the data are too large for double precision");
+  sol.u = std::move(u);
+  boundary.B_gamma().multiply(sol.u, sol.trace);
+  boundary.C_gamma().multiply(sol.u, sol.normal_derivative);
+  boundary.finish_readings(sol.lambda, sol.normal_derivative);
+  if (setup.shift != 0.0)
+    for (double& v : sol.normal_derivative) v += setup.shift;
+}
+
+/// Step 7: the Signorini conditions at the points, and again with an independent ∂u/∂n.
+template <int dim>
+void signorini_checks(const BoundaryDiscretization<dim>& boundary, BasicSolution<dim>& sol) {
+  const int m = boundary.n_points();
+  sol.signorini = detail::signorini_check(sol.trace, sol.normal_derivative, sol.g);
+  if (sol.u.empty()) return;
+  IndependentCheck check;
+  std::optional<std::vector<double>> d = boundary.independent_normal_derivative(sol.u, check.rule);
+  if (!d) return;
+  check.min_normal_derivative = std::numeric_limits<double>::infinity();
+  double sum = 0.0;
+  for (int i = 0; i < m; ++i) {
+    const double gap = sol.trace[i] - sol.g[i], difference = (*d)[i] - sol.normal_derivative[i];
+    check.min_normal_derivative = std::min(check.min_normal_derivative, (*d)[i]);
+    check.max_complementarity = std::max(check.max_complementarity, std::abs(gap * (*d)[i]));
+    check.max_difference = std::max(check.max_difference, std::abs(difference));
+    sum += difference * difference;
+  }
+  check.rms_difference = std::sqrt(sum / m);
+  check.normal_derivative = std::move(*d);
+  sol.check = std::move(check);
+}
+
+/// Step 8: the errors against the exact solution, at the points and in ω and on γ.
+template <int dim>
+void errors(const State<dim>& st, const BoundaryDiscretization<dim>& boundary, const BasicContactData<dim>& data,
+            const SolverOptions& options, BasicSolution<dim>& sol) {
+  sol.point_errors = boundary.point_errors(sol.trace, sol.normal_derivative, data);
+  sol.errors = boundary.errors(sol.u, sol.trace, data, options.error_quadrature);
+  const ErrorNorms& e = *sol.errors;
+  for (double v : {e.l2_omega, e.h1semi_omega, e.l2_gamma, e.rel_l2_omega, e.rel_h1_omega, e.rel_l2_gamma})
+    if (!std::isfinite(v))
+      throw std::invalid_argument("data.exact: not finite somewhere in omega or on gamma (or its gradient is not)");
+  (void)st;
+}
+
+}  // namespace
+
+template <int dim>
+BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim>& data, SolverOptions options,
+                                                      bool compute_field, bool keep) {
+  State& st = *state_;
+  bool chosen = false;
+  options = solve_options<dim>(st, data, options, chosen);
+  Eigen::setNbThreads(st.execution.threads());  // the dense LU of the Newton steps follows the threads option
+  BasicSolution<dim> sol(st.grid);
+  PhaseClock clock(sol.timings, st.execution);
+  BoundarySetup<dim>& setup = boundary_setup<dim>(st, data, options, clock, sol.reused_curve);  // 1–2
+  st.execution.throw_if_interrupted();
+  ActiveSet start;
+  if (dim == 3 && options.nested_start > 0 && st.grid.nx() >= options.nested_start) {  // nested start
+    sol.nested_start.emplace();
+    start = nested_start<dim>(st, data, options, *setup.boundary, *sol.nested_start);
+    clock.mark("nested_start");
+    sol.nested_start->seconds = sol.timings.phases.back().second;
+    st.execution.throw_if_interrupted();
+  }
+  load_and_u0<dim>(st, clock, sol.fast_solves);  // 0
+  st.execution.throw_if_interrupted();
+  const bool made = !setup.schur;
+  schur_blocks<dim>(st, setup, options, clock, keep);  // 2b–3
+  if (made) sol.fast_solves += setup.fast_solves;
+  load_terms<dim>(st, setup);
+  const BoundaryDiscretization<dim>& boundary = *setup.boundary;
+  boundary.describe(sol);
+  sol.delta = boundary.delta();
+  sol.flux_balance = boundary.flux_balance(setup.shift);
+  sol.g = boundary.obstacle(data);                      // 4
+  newton<dim>(st, setup, options, start, sol);          // 5
+  if (!keep) setup.schur.reset(), setup.exact.reset();  // S_B, S_C and the kept LU: freed before the field
+  clock.mark("newton");
+  st.execution.throw_if_interrupted();
+  if (compute_field) {  // 6
+    field<dim>(st, setup, sol);
+    if (!keep) st.u0 = GridVector(), st.have_u0 = false;
+    clock.mark("final_solve");
+    st.execution.throw_if_interrupted();
+  } else {
+    sol.trace.assign(sol.newton.trace.data(), sol.newton.trace.data() + sol.newton.trace.size());
+    sol.normal_derivative.assign(sol.newton.normal_derivative.data(),
+                                 sol.newton.normal_derivative.data() + sol.newton.normal_derivative.size());
+  }
+  signorini_checks<dim>(boundary, sol);  // 7
+  if (compute_field) clock.mark("check");
+  if ((data.exact || data.exact_vectorized) && compute_field) {  // 8
+    errors<dim>(st, boundary, data, options, sol);
+    clock.mark("errors");
+  }
+  sol.options = options;
+  sol.options.multipliers = boundary.spacing().m;
+  sol.options.offset = boundary.spacing().offset;
+  if (chosen && options.variant == Variant::nonsmooth)
+    sol.warnings.push_back(
+        "formulation.variant: γ has corners: solved with the non-smooth variant (the smooth one needs a continuous "
+        "normal)");
+  if (!boundary.spacing().warning.empty()) sol.warnings.push_back(boundary.spacing().warning);
+  if (!keep) st.setup.reset();
+  return sol;
+}
+
+template <int dim>
+BasicSolution<dim> solve(const BasicProblem<dim>& problem, SolverOptions options,
+                         std::function<void(const std::string& phase, double seconds)> progress,
+                         std::function<bool()> interrupt) {
+  FictitiousDomainSolver<dim> solver(problem, options);
+  solver.set_progress(std::move(progress));
+  solver.set_interrupt_check(std::move(interrupt));
+  return solver.solve(problem, options, true, false);
+}
+
+namespace {
+
+/// Grid nodes and the m a solve will use (the default rule, with γ's length or area), before any
+/// array is made.
+template <int dim>
+std::pair<double, double> nodes_and_multipliers(const BasicProblem<dim>& problem, const SolverOptions& options) {
+  const double h = problem.box.width(0) / problem.N;
+  double nodes = double(problem.N) + 1;
+  for (int d = 1; d < dim; ++d) nodes *= std::floor(problem.box.width(d) / h + 0.5) + 1;
+  double m = options.multipliers;
+  if constexpr (dim == 2) {
+    const double L = problem.gamma ? ArcLengthTable(*problem.gamma, 256).length()
+                                   : 2 * (problem.box.width(0) + problem.box.width(1));
+    const Variant variant = resolved_variant(options.variant, !problem.gamma || problem.gamma->smooth());
+    const double cells = variant == Variant::smooth ? default_spacing_cells_smooth : default_spacing_cells_nonsmooth;
+    if (m == 0)
+      m = std::max(double(minimum_multipliers), L / (cells * h));
+    else if (problem.gamma)
+      m = std::min(m, L / (2 * h));  // the most a solve accepts
+  } else {
+    const double area = problem.gamma ? problem.gamma->area() : 0.0;
+    const Variant variant = resolved_variant(options.variant, true);
+    if (m == 0)
+      m = default_patches(area, h, variant);
+    else if (problem.gamma)
+      m = std::min(m, area / (4 * h * h));
+  }
+  return {nodes, m};
+}
+
+}  // namespace
+
+template <int dim>
+std::size_t estimated_peak_bytes(const BasicProblem<dim>& problem, const SolverOptions& options) {
+  const auto [nodes, m] = nodes_and_multipliers(problem, options);
+  const double bytes = (dim == 2 ? 3 : 4) * 8 * nodes + (dim == 2 ? 4 : 3) * 8 * m * m + 32.0 * (1 << 20);
+  return bytes > 1.8e19 ? std::size_t(1.8e19) : std::size_t(bytes);
+}
+
+template <int dim>
+double estimated_seconds(const BasicProblem<dim>& problem, const SolverOptions& options) {
+  const auto [nodes, m] = nodes_and_multipliers(problem, options);
+  const double n_log_n = nodes * std::log2(std::max(nodes, 2.0));
+  // Calibrated on the benchmark's 2-core machine (bench/results): in 2-D the grid work (load, u₀,
+  // Green's table, final solve, errors) costs about 9e-9 s per node·log2(nodes) on one thread, the
+  // Schur blocks 2.3e-6 s per pair of points, each Newton step one dense LU of 1e-10·m³ s (8 steps
+  // assumed); GMRES about 2.5 m iterations of 2.5 fast solves of 4.6e-10 s per node·log2(nodes). In 3-D
+  // the grid work (with the kink correction and the cut-voxel rules) is about 6e-8 s per node·log2(nodes)
+  // and the assembly 4e-6 s per pair, three LUs. Threads divide it, up to the cores there are.
+  const double threads = std::clamp(double(Execution(options.threads).threads()), 1.0,
+                                    double(std::max(1u, std::thread::hardware_concurrency())));
+  const double grid = (dim == 2 ? 4.5e-9 : 3e-8) * n_log_n, pairs = (dim == 2 ? 1.15e-6 : 2e-6) * m * m,
+               dense = (dim == 2 ? 8 : 3) * 0.5e-10 * m * m * m;
+  const double seconds =
+      options.inner == InnerSolver::green ? grid + pairs + dense : grid + 2.5 * m * 2.5 * 2.3e-10 * n_log_n;
+  return seconds * 2 / threads;
+}
+
+template class FictitiousDomainSolver<2>;
+template class FictitiousDomainSolver<3>;
+template BasicSolution<2> solve(const BasicProblem<2>&, SolverOptions, std::function<void(const std::string&, double)>,
+                                std::function<bool()>);
+template BasicSolution<3> solve(const BasicProblem<3>&, SolverOptions, std::function<void(const std::string&, double)>,
+                                std::function<bool()>);
+template std::size_t estimated_peak_bytes(const BasicProblem<2>&, const SolverOptions&);
+template std::size_t estimated_peak_bytes(const BasicProblem<3>&, const SolverOptions&);
+template double estimated_seconds(const BasicProblem<2>&, const SolverOptions&);
+template double estimated_seconds(const BasicProblem<3>&, const SolverOptions&);
+
+}  // namespace fictus

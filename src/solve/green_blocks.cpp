@@ -1,0 +1,520 @@
+// Dense blocks R G Qᵀ from sparse rows and the Green's table: exact, or with the far field
+// interpolated (schur_complement.hpp, docs/math.md "The far field of the 3-D Schur complement").
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <climits>
+#include <cmath>
+#include <exception>
+#include <memory>
+#include <numeric>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "fictus/solve/schur_complement.hpp"
+
+namespace fictus {
+namespace {
+
+template <int dim>
+using Index = std::array<int, dim>;
+
+template <int dim>
+Index<dim> node_of(const SparseRows::Entry& e) {
+  if constexpr (dim == 2)
+    return {e.i, e.j};
+  else
+    return {e.i, e.j, e.k};
+}
+
+/// Inclusive ranges of node indices.
+template <int dim>
+struct NodeBox {
+  Index<dim> lo, hi;
+  NodeBox() {
+    lo.fill(INT_MAX);
+    hi.fill(INT_MIN);
+  }
+  void add(const Index<dim>& a) {
+    for (int d = 0; d < dim; ++d) lo[d] = std::min(lo[d], a[d]), hi[d] = std::max(hi[d], a[d]);
+  }
+  void add(const NodeBox& b) {
+    if (b.empty()) return;
+    add(b.lo);
+    add(b.hi);
+  }
+  bool empty() const { return lo[0] > hi[0]; }  // a row without entries
+  double center(int d) const { return empty() ? 0.0 : 0.5 * (double(lo[d]) + double(hi[d])); }
+  /// Half the diagonal.
+  double radius() const {
+    double s = 0;
+    for (int d = 0; d < dim && !empty(); ++d) s += (double(hi[d]) - lo[d]) * (double(hi[d]) - lo[d]);
+    return 0.5 * std::sqrt(s);
+  }
+};
+
+/// Distance between two boxes, the nearest image of `b` counted: the singularities of G(·, b) lie at
+/// b and, in a Dirichlet box, at its reflections −b and 2n − b along each axis (period 2n); in a
+/// periodic box at b ± n.
+template <int dim>
+double image_distance(const NodeBox<dim>& a, const NodeBox<dim>& b, const Grid<dim>& grid) {
+  double sum = 0;
+  for (int d = 0; d < dim; ++d) {
+    const double n = grid.n(d);
+    double nearest = INFINITY;
+    const auto gap = [&](double lo, double hi) {
+      nearest = std::min(nearest, std::max({0.0, lo - a.hi[d], a.lo[d] - hi}));
+    };
+    if (grid.periodic()) {
+      for (int shift = -1; shift <= 1; ++shift) gap(b.lo[d] + shift * n, b.hi[d] + shift * n);
+    } else {
+      gap(b.lo[d], b.hi[d]);
+      gap(-double(b.hi[d]), -double(b.lo[d]));
+      gap(2 * n - b.hi[d], 2 * n - b.lo[d]);
+    }
+    sum += nearest * nearest;
+  }
+  return std::sqrt(sum);
+}
+
+/// A binary tree of items (rows) split at the median of their centers along the longest axis.
+template <int dim>
+struct ClusterTree {
+  struct Cluster {
+    int begin, end, left = -1, right = -1;
+    NodeBox<dim> box;  // of the items' nodes
+    double work = 0;   // entries (exact cost of a block with this cluster)
+  };
+  std::vector<int> item;  // items in cluster order
+  std::vector<Cluster> clusters;
+  bool leaf(int c) const { return clusters[std::size_t(c)].left < 0; }
+
+  ClusterTree(const std::vector<NodeBox<dim>>& boxes, const std::vector<double>& work, int leaf_size)
+      : item(boxes.size()) {
+    std::iota(item.begin(), item.end(), 0);
+    if (!boxes.empty()) build(boxes, work, 0, int(boxes.size()), leaf_size);
+  }
+
+ private:
+  int build(const std::vector<NodeBox<dim>>& boxes, const std::vector<double>& work, int begin, int end,
+            int leaf_size) {
+    const int c = int(clusters.size());
+    clusters.push_back({begin, end, -1, -1, NodeBox<dim>(), 0.0});
+    NodeBox<dim> box, centers;
+    double sum = 0;
+    for (int k = begin; k < end; ++k) {
+      const NodeBox<dim>& b = boxes[std::size_t(item[std::size_t(k)])];
+      box.add(b);
+      Index<dim> mid;
+      for (int d = 0; d < dim; ++d) mid[d] = int(std::lround(b.center(d)));
+      centers.add(mid);
+      sum += work[std::size_t(item[std::size_t(k)])];
+    }
+    clusters[std::size_t(c)].box = box;
+    clusters[std::size_t(c)].work = sum;
+    if (end - begin <= leaf_size) return c;
+    int axis = 0;
+    for (int d = 1; d < dim; ++d)
+      if (centers.hi[d] - centers.lo[d] > centers.hi[axis] - centers.lo[axis]) axis = d;
+    const int mid = begin + (end - begin) / 2;
+    std::nth_element(item.begin() + begin, item.begin() + mid, item.begin() + end, [&](int p, int q) {
+      return boxes[std::size_t(p)].center(axis) < boxes[std::size_t(q)].center(axis);
+    });
+    const int left = build(boxes, work, begin, mid, leaf_size);
+    const int right = build(boxes, work, mid, end, leaf_size);
+    clusters[std::size_t(c)].left = left;
+    clusters[std::size_t(c)].right = right;
+    return c;
+  }
+};
+
+/// Tensor Lagrange interpolation on grid nodes in a box: along each axis min(order, width) nodes
+/// near the Chebyshev points of the box's range (all of its nodes when it is narrower).
+template <int dim>
+struct Interpolation {
+  NodeBox<dim> box;
+  std::array<std::vector<int>, dim> nodes;
+  std::array<std::vector<double>, dim> weights;  // weights[d][(t − lo)·p + k] = L_k(t)
+
+  Interpolation(const NodeBox<dim>& b, int order) : box(b) {
+    for (int d = 0; d < dim; ++d) {
+      const int lo = b.lo[d], hi = b.hi[d], width = hi - lo + 1;
+      std::vector<int>& x = nodes[std::size_t(d)];
+      x = interpolation_nodes(lo, hi, order);
+      const int p = int(x.size());
+      std::vector<double>& w = weights[std::size_t(d)];
+      w.assign(std::size_t(width * p), 0.0);
+      for (int t = lo; t <= hi; ++t)
+        for (int k = 0; k < p; ++k) {
+          double v = 1;
+          for (int l = 0; l < p; ++l)
+            if (l != k) v *= double(t - x[std::size_t(l)]) / double(x[std::size_t(k)] - x[std::size_t(l)]);
+          w[std::size_t((t - lo) * p + k)] = v;
+        }
+    }
+  }
+  int size() const {
+    int s = 1;
+    for (int d = 0; d < dim; ++d) s *= int(nodes[std::size_t(d)].size());
+    return s;
+  }
+  /// row += value · Π_d L(a_d) over the tensor nodes (flat index, first axis fastest).
+  void add(const Index<dim>& a, double value, double* row) const {
+    const int p0 = int(nodes[0].size());
+    const double* w0 = &weights[0][std::size_t((a[0] - box.lo[0]) * p0)];
+    if constexpr (dim == 2) {
+      const int p1 = int(nodes[1].size());
+      const double* w1 = &weights[1][std::size_t((a[1] - box.lo[1]) * p1)];
+      for (int k1 = 0; k1 < p1; ++k1)
+        for (int k0 = 0; k0 < p0; ++k0) row[k1 * p0 + k0] += value * w1[k1] * w0[k0];
+    } else {
+      const int p1 = int(nodes[1].size()), p2 = int(nodes[2].size());
+      const double* w1 = &weights[1][std::size_t((a[1] - box.lo[1]) * p1)];
+      const double* w2 = &weights[2][std::size_t((a[2] - box.lo[2]) * p2)];
+      for (int k2 = 0; k2 < p2; ++k2)
+        for (int k1 = 0; k1 < p1; ++k1) {
+          const double v = value * w2[k2] * w1[k1];
+          double* r = row + (k2 * p1 + k1) * p0;
+          for (int k0 = 0; k0 < p0; ++k0) r[k0] += v * w0[k0];
+        }
+    }
+  }
+};
+
+/// The rows of one side: one or more row sets with the same number of rows (row r of every set is
+/// item r of the tree).
+struct RowSide {
+  std::vector<const SparseRows*> sets;
+  int n_rows() const { return sets.front()->n_rows(); }
+};
+
+template <int dim>
+NodeBox<dim> item_box(const RowSide& side, int r) {
+  NodeBox<dim> box;
+  for (const SparseRows* R : side.sets)
+    for (std::size_t a = R->row_begin[std::size_t(r)]; a < R->row_begin[std::size_t(r) + 1]; ++a)
+      box.add(node_of<dim>(R->entries[a]));
+  return box;
+}
+
+/// The distinct nodes of the rows of a cluster and, for each entry of each set in cluster order,
+/// its node's slot.
+template <int dim>
+struct DistinctNodes {
+  std::vector<Index<dim>> nodes;
+  std::vector<std::uint32_t> slot;
+  DistinctNodes(const RowSide& side, const std::vector<int>& items) {
+    std::unordered_map<std::size_t, std::uint32_t> slots;
+    for (const SparseRows* R : side.sets)
+      for (int r : items)
+        for (std::size_t a = R->row_begin[std::size_t(r)]; a < R->row_begin[std::size_t(r) + 1]; ++a) {
+          const auto [it, added] = slots.emplace(R->entries[a].index, std::uint32_t(nodes.size()));
+          if (added) nodes.push_back(node_of<dim>(R->entries[a]));
+          slot.push_back(it->second);
+        }
+  }
+};
+
+struct Block {
+  int x, y;  // row and column clusters
+  bool far;
+  double cost;
+};
+
+}  // namespace
+
+std::vector<int> interpolation_nodes(int lo, int hi, int order) {
+  std::vector<int> x;
+  if (hi - lo + 1 <= order) {
+    for (int t = lo; t <= hi; ++t) x.push_back(t);
+    return x;
+  }
+  for (int k = order - 1; k >= 0; --k)
+    x.push_back(int(std::lround(0.5 * (lo + hi) + 0.5 * (hi - lo) * std::cos((2 * k + 1) * M_PI / (2 * order)))));
+  // Nodes that round to the same grid node are pushed apart, inside [lo, hi] (there are more nodes than
+  // `order` there).
+  for (int k = 1; k < order; ++k) x[std::size_t(k)] = std::max(x[std::size_t(k)], x[std::size_t(k - 1)] + 1);
+  x.back() = std::min(x.back(), hi);
+  for (int k = order - 2; k >= 0; --k) x[std::size_t(k)] = std::min(x[std::size_t(k)], x[std::size_t(k + 1)] - 1);
+  return x;
+}
+
+template <int dim>
+Eigen::MatrixXd green_block(const GreenTable<dim>& green, const SparseRows& R, const SparseRows& Q,
+                            const Execution& execution, const FarField& far_field) {
+  return green_blocks(green, {&R}, Q, execution, far_field).front();
+}
+
+namespace {
+
+/// The assembly of green_blocks step by step: the cluster trees, the block partition, each cluster's
+/// interpolation or distinct nodes, then the blocks themselves.
+template <int dim>
+struct BlockAssembly {
+  BlockAssembly(const GreenTable<dim>& g, const std::vector<const SparseRows*>& r, const SparseRows& q,
+                const Execution& e, const FarField& f)
+      : green(g), row_sets(r), Q(q), execution(e), far_field(f) {}
+  const GreenTable<dim>& green;
+  const std::vector<const SparseRows*>& row_sets;
+  const SparseRows& Q;
+  const Execution& execution;
+  const FarField& far_field;
+  RowSide rows{row_sets}, cols{{&Q}};
+  bool compress = far_field.order > 0;
+  std::unique_ptr<ClusterTree<dim>> X, Y;
+  std::vector<Block> blocks;
+  std::vector<std::unique_ptr<Interpolation<dim>>> x_interp, y_interp;
+  std::vector<std::vector<Eigen::MatrixXd>> U;  // per row cluster with far blocks: R L, one per row set
+  std::vector<Eigen::MatrixXd> V;               // per column cluster with far blocks: Q L
+  std::vector<std::unique_ptr<DistinctNodes<dim>>> distinct;
+  std::exception_ptr failure;  // an exception (out of memory) inside a parallel loop, thrown after it
+
+  void keep() {
+#pragma omp critical(fictus_green_blocks_failure)
+    if (!failure) failure = std::current_exception();
+  }
+  void trees();
+  void partition();
+  void cluster_data();
+  void fill(std::vector<Eigen::MatrixXd>& out);
+  void far_block(const Block& b, Eigen::MatrixXd& core, Eigen::MatrixXd& half, Eigen::MatrixXd& block,
+                 std::vector<Eigen::MatrixXd>& out) const;
+  void near_block(const Block& b, const std::vector<Index<dim>>& q_nodes, const std::vector<double>& q_values,
+                  std::vector<double>& column, std::vector<Eigen::MatrixXd>& out) const;
+  void report(FarFieldReport& r) const;
+  std::vector<int> cluster_items(const ClusterTree<dim>& T, int c) const {
+    const auto& cl = T.clusters[std::size_t(c)];
+    return std::vector<int>(T.item.begin() + cl.begin, T.item.begin() + cl.end);
+  }
+};
+
+/// The trees: without compression one row cluster and columns in fours (the threads' work).
+template <int dim>
+void BlockAssembly<dim>::trees() {
+  const int n_rows = rows.n_rows(), n_cols = Q.n_rows();
+  const auto n_r = std::size_t(n_rows), n_c = std::size_t(n_cols);
+  std::vector<NodeBox<dim>> row_boxes(n_r), col_boxes(n_c);
+  std::vector<double> row_work(n_r, 0.0), col_work(n_c, 0.0);
+  for (int r = 0; r < n_rows; ++r) {
+    row_boxes[std::size_t(r)] = item_box<dim>(rows, r);
+    for (const SparseRows* R : row_sets)
+      row_work[std::size_t(r)] += double(R->row_begin[std::size_t(r) + 1] - R->row_begin[std::size_t(r)]);
+  }
+  for (int c = 0; c < n_cols; ++c) {
+    col_boxes[std::size_t(c)] = item_box<dim>(cols, c);
+    col_work[std::size_t(c)] = double(Q.row_begin[std::size_t(c) + 1] - Q.row_begin[std::size_t(c)]);
+  }
+  X = std::make_unique<ClusterTree<dim>>(row_boxes, row_work, compress ? far_field.leaf : n_rows);
+  Y = std::make_unique<ClusterTree<dim>>(col_boxes, col_work, compress ? far_field.leaf : 4);
+}
+
+/// The block partition: a pair far apart (max radius ≤ eta·distance) is interpolated when that is
+/// cheaper than exact; otherwise split, down to pairs of leaves computed exactly. Dearest first.
+template <int dim>
+void BlockAssembly<dim>::partition() {
+  const auto interpolation_size = [&](const NodeBox<dim>& b) {
+    double s = 1;
+    for (int d = 0; d < dim && !b.empty(); ++d) s *= std::min(double(far_field.order), double(b.hi[d]) - b.lo[d] + 1);
+    return s;
+  };
+  const auto split = [&](auto&& self, int x, int y) -> void {
+    const auto &cx = X->clusters[std::size_t(x)], &cy = Y->clusters[std::size_t(y)];
+    const double exact = cx.work * cy.work;
+    if (compress) {
+      const double interpolated = interpolation_size(cx.box) * interpolation_size(cy.box);
+      if (std::max(cx.box.radius(), cy.box.radius()) <= far_field.eta * image_distance(cx.box, cy.box, green.grid()) &&
+          interpolated < exact) {
+        blocks.push_back({x, y, true, interpolated});
+        return;
+      }
+    }
+    if (X->leaf(x) && Y->leaf(y)) {
+      blocks.push_back({x, y, false, exact});
+    } else if (X->leaf(x) || (!Y->leaf(y) && cy.end - cy.begin > cx.end - cx.begin)) {
+      self(self, x, cy.left);
+      self(self, x, cy.right);
+    } else {
+      self(self, cx.left, y);
+      self(self, cx.right, y);
+    }
+  };
+  split(split, 0, 0);
+  std::sort(blocks.begin(), blocks.end(), [](const Block& a, const Block& b) { return a.cost > b.cost; });
+}
+
+/// Per cluster: the interpolation and U = R L (rows) or V = Q L (columns) for the far blocks; the
+/// distinct nodes for the near ones.
+template <int dim>
+void BlockAssembly<dim>::cluster_data() {
+  const std::size_t nx = X->clusters.size(), ny = Y->clusters.size();
+  std::vector<char> x_far(nx, 0), y_far(ny, 0), x_near(nx, 0);
+  for (const Block& b : blocks) {
+    if (b.far)
+      x_far[std::size_t(b.x)] = y_far[std::size_t(b.y)] = 1;
+    else
+      x_near[std::size_t(b.x)] = 1;
+  }
+  x_interp.resize(nx), y_interp.resize(ny), U.resize(nx), V.resize(ny), distinct.resize(nx);
+  const auto interpolate = [&](const RowSide& side, const std::vector<int>& items, const Interpolation<dim>& L,
+                               std::vector<Eigen::MatrixXd>& mats) {
+    mats.clear();
+    for (const SparseRows* R : side.sets) {
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rowmajor =
+          Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>::Zero(Eigen::Index(items.size()),
+                                                                                       L.size());
+      for (std::size_t i = 0; i < items.size(); ++i)
+        for (std::size_t a = R->row_begin[std::size_t(items[i])]; a < R->row_begin[std::size_t(items[i]) + 1]; ++a)
+          L.add(node_of<dim>(R->entries[a]), R->entries[a].value, rowmajor.row(Eigen::Index(i)).data());
+      mats.push_back(rowmajor);
+    }
+  };
+#pragma omp parallel for schedule(dynamic, 1) num_threads(execution.threads())
+  for (int c = 0; c < int(nx) + int(ny); ++c) try {
+      if (c < int(nx)) {
+        if (x_far[std::size_t(c)]) {
+          x_interp[std::size_t(c)] =
+              std::make_unique<Interpolation<dim>>(X->clusters[std::size_t(c)].box, far_field.order);
+          interpolate(rows, cluster_items(*X, c), *x_interp[std::size_t(c)], U[std::size_t(c)]);
+        }
+        if (x_near[std::size_t(c)])
+          distinct[std::size_t(c)] = std::make_unique<DistinctNodes<dim>>(rows, cluster_items(*X, c));
+      } else {
+        const int y = c - int(nx);
+        if (!y_far[std::size_t(y)]) continue;
+        y_interp[std::size_t(y)] =
+            std::make_unique<Interpolation<dim>>(Y->clusters[std::size_t(y)].box, far_field.order);
+        std::vector<Eigen::MatrixXd> mats;
+        interpolate(cols, cluster_items(*Y, y), *y_interp[std::size_t(y)], mats);
+        V[std::size_t(y)] = std::move(mats.front());
+      }
+    } catch (...) {
+      keep();
+    }
+  if (failure) std::rethrow_exception(failure);
+  execution.throw_if_interrupted();
+}
+
+/// A far block: U_x (G between the interpolation nodes) V_yᵀ.
+template <int dim>
+void BlockAssembly<dim>::far_block(const Block& b, Eigen::MatrixXd& core, Eigen::MatrixXd& half, Eigen::MatrixXd& block,
+                                   std::vector<Eigen::MatrixXd>& out) const {
+  const auto &cx = X->clusters[std::size_t(b.x)], &cy = Y->clusters[std::size_t(b.y)];
+  const Interpolation<dim>&Lx = *x_interp[std::size_t(b.x)], &Ly = *y_interp[std::size_t(b.y)];
+  core.resize(Lx.size(), Ly.size());
+  green.G(Lx.nodes, Ly.nodes, core.data(), std::size_t(Lx.size()));
+  half.noalias() = core * V[std::size_t(b.y)].transpose();
+  for (std::size_t s = 0; s < row_sets.size(); ++s) {
+    block.noalias() = U[std::size_t(b.x)][s] * half;
+    for (int j = cy.begin; j < cy.end; ++j)
+      for (int i = cx.begin; i < cx.end; ++i)
+        out[s](X->item[std::size_t(i)], Y->item[std::size_t(j)]) = block(i - cx.begin, j - cy.begin);
+  }
+}
+
+/// A near block, exactly: for each column, G between the row cluster's distinct nodes and the column's
+/// entries, then each row's weighted sum.
+template <int dim>
+void BlockAssembly<dim>::near_block(const Block& b, const std::vector<Index<dim>>& q_nodes,
+                                    const std::vector<double>& q_values, std::vector<double>& column,
+                                    std::vector<Eigen::MatrixXd>& out) const {
+  const auto &cx = X->clusters[std::size_t(b.x)], &cy = Y->clusters[std::size_t(b.y)];
+  const DistinctNodes<dim>& nodes = *distinct[std::size_t(b.x)];
+  column.resize(nodes.nodes.size());
+  for (int j = cy.begin; j < cy.end; ++j) {
+    const int col = Y->item[std::size_t(j)];
+    const std::size_t first = Q.row_begin[std::size_t(col)];
+    green.G(nodes.nodes.data(), nodes.nodes.size(), q_nodes.data() + first, q_values.data() + first,
+            Q.row_begin[std::size_t(col) + 1] - first, column.data());
+    std::size_t entry = 0;
+    for (std::size_t s = 0; s < row_sets.size(); ++s) {
+      const SparseRows& R = *row_sets[s];
+      for (int i = cx.begin; i < cx.end; ++i) {
+        const int row = X->item[std::size_t(i)];
+        double sum = 0.0;
+        for (std::size_t a = R.row_begin[std::size_t(row)]; a < R.row_begin[std::size_t(row) + 1]; ++a, ++entry)
+          sum += R.entries[a].value * column[nodes.slot[entry]];
+        out[s](row, col) = sum;
+      }
+    }
+  }
+}
+
+/// Every block, dearest first, on the threads.
+template <int dim>
+void BlockAssembly<dim>::fill(std::vector<Eigen::MatrixXd>& out) {
+  std::vector<Index<dim>> q_nodes;  // Q's entries' nodes and values, for the near blocks' sums
+  std::vector<double> q_values;
+  q_nodes.reserve(Q.entries.size());
+  q_values.reserve(Q.entries.size());
+  for (const SparseRows::Entry& e : Q.entries) q_nodes.push_back(node_of<dim>(e)), q_values.push_back(e.value);
+  std::atomic<bool> stop = false;  // an interruption seen by thread 0 (the caller's) ends every thread's work
+#pragma omp parallel num_threads(execution.threads())
+  {
+    std::vector<double> column;
+    Eigen::MatrixXd core, half, block;
+#pragma omp for schedule(dynamic, 1)
+    for (std::size_t k = 0; k < blocks.size(); ++k) try {
+        if (omp_get_thread_num() == 0 && execution.interrupt_requested()) stop = true;
+        if (stop) continue;
+        if (blocks[k].far)
+          far_block(blocks[k], core, half, block, out);
+        else
+          near_block(blocks[k], q_nodes, q_values, column, out);
+      } catch (...) {
+        keep();
+        stop = true;
+      }
+  }
+  if (failure) std::rethrow_exception(failure);
+  if (stop) throw Interrupted();
+}
+
+template <int dim>
+void BlockAssembly<dim>::report(FarFieldReport& r) const {
+  r = {};
+  for (const Block& b : blocks) {
+    const double pairs = double(X->clusters[std::size_t(b.x)].end - X->clusters[std::size_t(b.x)].begin) *
+                         double(Y->clusters[std::size_t(b.y)].end - Y->clusters[std::size_t(b.y)].begin);
+    (b.far ? r.far_pairs : r.near_pairs) += pairs;
+    (b.far ? r.far_blocks : r.near_blocks) += 1;
+  }
+}
+
+}  // namespace
+
+template <int dim>
+std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
+                                          const SparseRows& Q, const Execution& execution, const FarField& far_field,
+                                          FarFieldReport* report) {
+  for (const SparseRows* R : row_sets)
+    if (R->n_rows() != row_sets.front()->n_rows())
+      throw std::invalid_argument("green_blocks: the row sets differ in their number of rows");
+  const int n_cols = Q.n_rows();
+  std::vector<Eigen::MatrixXd> out;
+  for (const SparseRows* R : row_sets) out.emplace_back(R->n_rows(), n_cols);
+  if (far_field.order < 0 || (far_field.order > 0 && !(far_field.eta > 0 && far_field.leaf >= 1)))
+    throw std::invalid_argument("green_blocks: a far field needs order >= 0, eta > 0 and leaves of >= 1 row");
+  if (row_sets.front()->n_rows() == 0 || n_cols == 0) return out;
+  BlockAssembly<dim> assembly(green, row_sets, Q, execution, far_field);
+  assembly.trees();
+  assembly.partition();
+  assembly.cluster_data();
+  assembly.fill(out);
+  if (report) assembly.report(*report);
+  return out;
+}
+
+template Eigen::MatrixXd green_block(const GreenTable<2>&, const SparseRows&, const SparseRows&, const Execution&,
+                                     const FarField&);
+template Eigen::MatrixXd green_block(const GreenTable<3>&, const SparseRows&, const SparseRows&, const Execution&,
+                                     const FarField&);
+template std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<2>&, const std::vector<const SparseRows*>&,
+                                                   const SparseRows&, const Execution&, const FarField&,
+                                                   FarFieldReport*);
+template std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<3>&, const std::vector<const SparseRows*>&,
+                                                   const SparseRows&, const Execution&, const FarField&,
+                                                   FarFieldReport*);
+
+}  // namespace fictus

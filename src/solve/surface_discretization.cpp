@@ -1,0 +1,255 @@
+#include "fictus/solve/surface_discretization.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+#include "fictus/boundary/omega_quadrature.hpp"
+#include "fictus/boundary/surface_kink.hpp"
+#include "solve_steps.hpp"
+
+namespace fictus {
+
+int default_patches(double area, double h, Variant variant) {
+  const double s = (variant == Variant::smooth ? default_patch_cells_smooth_3d : default_patch_cells_nonsmooth_3d) * h;
+  return std::max(minimum_multipliers, int(std::lround(area / (s * s))));
+}
+
+namespace {
+
+using detail::row_sums;
+using detail::to_eigen;
+
+std::string format(const char* pattern, double a, double b = 0, double c = 0) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, pattern, a, b, c);
+  return buffer;
+}
+
+/// γ (or Γ) with its bounds grown by `grow` must keep 2h from the box's sides.
+void check_inside_box(const Surface& gamma, const Grid3& grid, double grow, const std::string& field) {
+  const Box3 bounds = gamma.bounds();
+  const double margin = 2 * grid.h();
+  for (int d = 0; d < 3; ++d) {
+    const double room =
+        std::min(bounds.lower[d] - grow - grid.box().lower[d], grid.box().upper[d] - bounds.upper[d] - grow);
+    if (room >= margin) continue;
+    std::string text = field + ": " + (grow > 0 ? "the offset surface" : "the surface") +
+                       format(" comes within %.3g of the box along axis %.0f; the grid needs 2h = %.3g there", room,
+                              double(d), margin);
+    if (room > 0 && grow == 0)
+      text += format(": N >= %.0f (or a larger box)", std::ceil(2 * grid.box().width(0) / room - 1e-9));
+    throw std::invalid_argument(text);
+  }
+}
+
+/// The triangles of `surface` moved by δ along the surface's unit normal at each vertex.
+std::vector<Triangle3> offset_triangles(const std::vector<Triangle3>& triangles, const Surface& gamma, double delta) {
+  const auto move = [&](const Point3& p) {
+    const Point3 n = gamma.level_gradient(p);
+    return p + (delta / norm(n)) * n;
+  };
+  std::vector<Triangle3> out;
+  out.reserve(triangles.size());
+  for (const Triangle3& t : triangles) out.push_back({move(t.a), move(t.b), move(t.c)});
+  return out;
+}
+
+}  // namespace
+
+/// The kink correction, and the flux balance once finish_setup has made it.
+struct SurfaceDiscretization::Kink {
+  SurfaceKink model;
+  Eigen::SparseMatrix<double> balance;  // X (empty without the flux balance)
+  Eigen::VectorXd area;                 // the patch areas of the flux balance
+  double scatter = 0, mean = 0;
+  bool balanced = false;
+};
+
+SurfaceDiscretization::SurfaceDiscretization(std::shared_ptr<const Surface> gamma, const Grid3& grid,
+                                             const SolverOptions& options, double c, const Execution& execution,
+                                             const MarkPhase& mark)
+    : grid_(grid), gamma_(std::move(gamma)), execution_(execution), c_(c), balance_wanted_(options.flux_balance) {
+  if (!gamma_) throw std::invalid_argument("geometry: no surface given");
+  make_geometry(options);
+  make_trace_rows(options, mark);
+}
+
+SurfaceDiscretization::~SurfaceDiscretization() = default;
+
+void SurfaceDiscretization::make_geometry(const SolverOptions& options) {
+  const Surface& gamma = *gamma_;
+  const double h = grid_.h();
+  check_inside_box(gamma, grid_, 0, "geometry");  // before any work
+  const double area = gamma.area();
+  const Box3 bounds = gamma.bounds(), box = grid_.box();
+  const OffsetRoom room = [&gamma, bounds, box](double k) {  // Γ keeps 2h from the box and does not fold
+    double room = gamma.reach() - 2 * k;
+    for (int d = 0; d < 3; ++d)
+      room = std::min({room, bounds.lower[d] - box.lower[d] - 2 * k, box.upper[d] - bounds.upper[d] - 2 * k});
+    return room;
+  };
+  const Variant variant = options.variant;
+  plan_ = plan_spacing(
+      {3, area, h, box.width(0), [area, variant](double k) { return default_patches(area, k, variant); }, room},
+      options);
+  execution_.throw_if_interrupted();
+  gamma_patches_ = gamma.patches(plan_.m, h);
+  execution_.throw_if_interrupted();
+  Gamma_patches_ = gamma_patches_;
+  if (options.variant == Variant::smooth) {
+    delta_ = plan_.delta;
+    check_inside_box(gamma, grid_, delta_, "formulation.offset");
+    Gamma_patches_.triangles = offset_triangles(gamma_patches_.triangles, gamma, delta_);
+    for (int p = 0; p < plan_.m; ++p)
+      Gamma_patches_.point[p] = gamma_patches_.point[p] + delta_ * gamma_patches_.normal[p];
+  }
+  Gamma_patches_.area.assign(plan_.m, 0.0);
+  for (std::size_t t = 0; t < Gamma_patches_.triangles.size(); ++t)
+    Gamma_patches_.area[Gamma_patches_.patch_of[t]] += fictus::area(Gamma_patches_.triangles[t]);
+}
+
+void SurfaceDiscretization::make_trace_rows(const SolverOptions& options, const MarkPhase& mark) {
+  const double h = grid_.h();
+  const int m = plan_.m;
+  const PatchedSurface& patches = gamma_patches_;
+  B_gamma_ = point_value_rows(grid_, patches.point);
+  const bool reconstructed = options.normal_derivative == NormalDerivative::reconstructed;
+  C_gamma_ = reconstructed ? normal_derivative_rows_centered(grid_, patches.point, patches.normal)
+                           : normal_derivative_rows(grid_, patches.point, patches.normal, options.normal_shift * h);
+  // Non-smooth: λ lives on γ itself, where the kink of û must sit to O(h³) for C_γ (which reaches across
+  // γ): the triangles' points are mapped onto γ (their O(h²) sag would be a double layer, an O(h) error).
+  execution_.throw_if_interrupted();
+  B_Gamma_ = patch_integral_rows(
+      grid_,
+      patch_integrals(grid_, Gamma_patches_.triangles, Gamma_patches_.patch_of, m,
+                      options.variant == Variant::nonsmooth ? onto_surface(*gamma_, 1e-13 * h) : SurfaceMap{}),
+      m);
+  mark("geometry");
+  execution_.throw_if_interrupted();
+  loads_ = B_Gamma_;
+  if (options.variant != Variant::nonsmooth || !reconstructed) return;
+  if (!(gamma_->reach() > 6 * h))  // the kink band reaches 6h outside γ: its nearest points must be unique
+    throw std::invalid_argument(
+        format("formulation.variant: the surface folds within %.3g of itself outside, "
+               "inside the non-smooth variant's band of 6h = %.3g: a larger N",
+               gamma_->reach(), 6 * h));
+  kink_ = std::make_unique<Kink>(Kink{SurfaceKink(grid_, *gamma_, patches, c_, execution_), {}, {}, 0, 0, false});
+  direct_.trace = kink_->model.direct(B_gamma_);
+  direct_.normal_derivative = kink_->model.direct(C_gamma_);
+  loads_ = add_rows(B_Gamma_, kink_->model.galerkin());
+  mark("kink_correction");
+  execution_.throw_if_interrupted();
+}
+
+FarField SurfaceDiscretization::far_field(const SolverOptions& options) const {
+  if (!options.far_field) return {};
+  return options.variant == Variant::nonsmooth ? default_far_field_3d_nonsmooth : default_far_field_3d;
+}
+
+std::size_t SurfaceDiscretization::finish_setup(const FastSolver<3>& fast, const MarkPhase& mark) {
+  // The flux balance (flux_balance in surface_kink.hpp): X joins D_C.
+  if (!kink_ || !balance_wanted_ || fast.singular()) return 0;
+  constexpr int load_points = 3;  // per Gauss line of the cut-voxel rule, as the error integrals'
+  GridVector load_of_omega = c_ != 0.0 ? omega_load(grid_, *gamma_, load_points, execution_) : GridVector();
+  FluxBalance b = fictus::flux_balance(kink_->model, B_Gamma_, C_gamma_, loads_, direct_.normal_derivative,
+                                       std::move(load_of_omega), fast);
+  direct_.normal_derivative += b.correction;
+  kink_->balance = std::move(b.correction);
+  kink_->area = std::move(b.area);
+  kink_->scatter = b.scatter;
+  kink_->mean = b.mean;
+  kink_->balanced = true;
+  mark("flux_balance");
+  execution_.throw_if_interrupted();
+  return std::size_t(b.fast_solves);
+}
+
+double SurfaceDiscretization::reading_shift(const GridVector& u0, const VectorizedField3& f,
+                                            int load_quadrature) const {
+  if (!kink_ || !kink_->balanced) return 0;
+  constexpr int load_points = 3;  // as finish_setup's ℓ
+  double u0_integral = 0;         // ∫_ω u₀
+  if (c_ != 0.0) {
+    const GridVector load_of_omega = omega_load(grid_, *gamma_, load_points, execution_);
+    for (std::size_t k = 0; k < load_of_omega.size(); ++k) u0_integral += load_of_omega[k] * u0[k];
+  }
+  std::vector<double> c_u0;
+  C_gamma_.multiply(u0, c_u0);
+  const double readings = kink_->area.dot(to_eigen(c_u0)), area_total = kink_->area.sum();
+  const double f_integral = omega_integral(grid_, *gamma_, f, load_quadrature, execution_);
+  if (!std::isfinite(f_integral)) throw std::invalid_argument("data.f: not finite somewhere in ω");
+  return (c_ * u0_integral - f_integral - readings) / area_total;
+}
+
+std::optional<FluxBalanceUse> SurfaceDiscretization::flux_balance(double data_shift) const {
+  if (!kink_ || !kink_->balanced) return std::nullopt;
+  return FluxBalanceUse{kink_->scatter, kink_->mean, data_shift};
+}
+
+std::vector<double> SurfaceDiscretization::obstacle(const Data& data) const {
+  const int m = n_points();
+  std::vector<double> g(m);
+  const std::array<std::vector<double>, 3> x = coordinates(points());
+  (data.g_vectorized ? data.g_vectorized : vectorize(data.g))(std::size_t(m), x[0].data(), x[1].data(), x[2].data(),
+                                                              g.data());
+  for (int p = 0; p < m; ++p) {
+    const Point3 q = points()[p];
+    if (!std::isfinite(g[p]))
+      throw std::invalid_argument(format("data.g: not finite at the point (%.6g, %.6g, %.6g)", q.x, q.y, q.z));
+    if (std::abs(g[p]) > detail::largest_scale)
+      throw std::invalid_argument(format("data.g: %.3g is beyond %.0e: rescale the problem (u, f and g by one factor)",
+                                         g[p], detail::largest_scale));
+  }
+  return g;
+}
+
+void SurfaceDiscretization::finish_field(const std::vector<double>& lambda, GridVector& u) const {
+  if (kink_) kink_->model.add_kinks(lambda, u);  // the kink-corrected field I_h w
+}
+
+void SurfaceDiscretization::finish_readings(const std::vector<double>& lambda,
+                                            std::vector<double>& normal_derivative) const {
+  if (!kink_ || !kink_->balanced) return;  // the readings of the Newton system: C_γ I_h w + Xλ
+  const int m = n_points();
+  Eigen::Map<Eigen::VectorXd>(normal_derivative.data(), m) +=
+      kink_->balance * Eigen::Map<const Eigen::VectorXd>(lambda.data(), m);
+}
+
+std::optional<std::vector<double>> SurfaceDiscretization::independent_normal_derivative(const GridVector&,
+                                                                                        std::string&) const {
+  return std::nullopt;
+}
+
+ErrorNorms SurfaceDiscretization::errors(const GridVector& u, const std::vector<double>& trace, const Data& data,
+                                         int quadrature) const {
+  const VectorizedField3 exact = data.exact_vectorized ? data.exact_vectorized : vectorize(data.exact);
+  return compute_errors(u, grid_, *gamma_, gamma_patches_, trace, exact, data.exact_gradient, quadrature, execution_);
+}
+
+PointErrors SurfaceDiscretization::point_errors(const std::vector<double>& trace,
+                                                const std::vector<double>& normal_derivative, const Data& data) const {
+  const VectorizedField3 exact = data.exact_vectorized ? data.exact_vectorized : vectorize(data.exact);
+  const std::array<std::vector<double>, 3> x = coordinates(points());
+  std::array<std::vector<double>, 3> du;
+  std::vector<double> u(points().size());
+  exact(u.size(), x[0].data(), x[1].data(), x[2].data(), u.data());
+  gradient_at(exact, data.exact_gradient, 1e-6 * grid_.box().width(0), x, du);
+  PointErrors pe;
+  for (int p = 0; p < n_points(); ++p) {
+    const Point3 n = normals()[p];
+    pe.max_trace = std::max(pe.max_trace, std::abs(trace[p] - u[p]));
+    pe.max_normal_derivative = std::max(
+        pe.max_normal_derivative, std::abs(normal_derivative[p] - (n.x * du[0][p] + n.y * du[1][p] + n.z * du[2][p])));
+  }
+  return pe;
+}
+
+void SurfaceDiscretization::describe(SolutionBoundary<3>& out) const {
+  out.gamma = gamma_patches_;
+  out.Gamma = Gamma_patches_;
+}
+
+}  // namespace fictus
