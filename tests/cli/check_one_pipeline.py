@@ -17,6 +17,8 @@ import shutil
 import subprocess
 import sys
 
+from toml_text import toml_value
+
 FICTUS, SOURCE, SCRATCH = sys.argv[1], sys.argv[2], sys.argv[3]
 SPHERE = os.path.join(SOURCE, "tests", "inputs", "sphere_parameters.toml")
 
@@ -73,16 +75,6 @@ def sweeps_equal_single_solves():
     s = sweep("sweep_rotate", "--rotate", "0,0.4", "--axis", "x")
     check(s["sweep"]["axis"] == "x", "the rotation axis is recorded")
     same_contact(s["rows"][0], solve("single_plain", SPHERE), "rotate = 0")
-
-
-def toml_value(v):
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, str):
-        return json.dumps(v)
-    if isinstance(v, list):
-        return "[" + ", ".join(toml_value(x) for x in v) + "]"
-    return repr(v)
 
 
 def problem_file_from(results):

@@ -13,6 +13,8 @@ import sys
 
 import fictus
 
+from toml_text import toml_value
+
 exe, out = sys.argv[1], sys.argv[2]
 
 BASES = {
@@ -64,16 +66,6 @@ WALK = {
 def walk_value(key, dim):
     value = WALK[key]
     return value[dim] if isinstance(value, dict) else value
-
-
-def toml_value(v):
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, str):
-        return json.dumps(v)
-    if isinstance(v, list):
-        return "[" + ", ".join(toml_value(x) for x in v) + "]"
-    return repr(v)
 
 
 def flag_value(v):
