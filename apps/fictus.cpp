@@ -67,6 +67,8 @@ std::string parse_error_line(const std::string& message, const std::vector<std::
     std::string word, first;
     while (words >> word)
       if (first.empty() && word.size() > 1 && word[0] == '-') first = word;
+    if (first == "--dim" || first.rfind("--dim=", 0) == 0)  // the dimension is the problem's, not a flag
+      return "--dim: not a flag; the problem file sets the dimension ([domain] dim = 3 for a surface)";
     if (!first.empty()) return first.substr(0, 60) + ": not expected" + fictus::did_you_mean(first, flags);
     const std::string what = match[1].str();
     return what.find(' ') == std::string::npos && !what.empty() ? what.substr(0, 60) + ": not expected"
@@ -234,7 +236,8 @@ template <int dim>
 fictus::BasicProblemSpec<dim> solve_spec(std::string text, const SolveCommand& command) {
   if (command.mesh_file.size() || command.mesh_resolution >= 0) {
     if (dim != 3)
-      throw std::invalid_argument("--file: a mesh file is the geometry of a 3-D problem ([domain] dim = 3)");
+      throw std::invalid_argument(std::string(command.mesh_file.size() ? "--file" : "--resolution") +
+                                  ": applies to a mesh, the geometry of 3-D problems only ([domain] dim = 3)");
     text = fictus::with_mesh_overrides(text, command.problem_path, command.mesh_file, command.mesh_resolution);
   }
   fictus::BasicProblemSpec<dim> spec = fictus::cli::problem_from_text<dim>(text, command.problem_path, command.flags,

@@ -60,10 +60,6 @@ void OptionFlags::apply(DomainSettings& domain, SolverOptions& options) const {
   }
 }
 
-ProblemSpec problem_from(const std::string& path, const OptionFlags& flags, const ParameterValues& parameters) {
-  return problem_from_text<2>(path.empty() ? "" : read_problem_text(path), path, flags, parameters);
-}
-
 namespace {
 
 /// The paper's problem, with its m and δ unless the flags say otherwise.

@@ -50,8 +50,6 @@ template <int dim>
 BasicProblemSpec<dim> problem_from_text(const std::string& text, const std::string& path, const OptionFlags& flags,
                                         const ParameterValues& parameters = {},
                                         std::shared_ptr<const typename BoundaryShape<dim>::type> shape = nullptr);
-/// The same for the 2-D problem file at `path`, or the paper's problem without one.
-ProblemSpec problem_from(const std::string& path, const OptionFlags& flags, const ParameterValues& parameters = {});
 
 /// Markdown text as plain text for the terminal (without the backticks of `fictus options --markdown`).
 std::string plain(std::string text);

@@ -150,7 +150,7 @@ BasicProblem<dim> member(const Family& family, const BasicProblemSpec<dim>& base
 
 const char* const columns =
     "converged,newton_steps,multipliers,contact_points,contact_measure,contact_force,lambda_integral,min_gap,max_gap,"
-    "min_normal_derivative,max_complementarity,seconds";
+    "min_normal_derivative,max_complementarity,reused_boundary,seconds";
 
 /// One member's line of sweep.csv and its row of sweep.json.
 template <int dim>
@@ -161,7 +161,8 @@ void record(const Family& family, double v, const BasicSolution<dim>& s, double 
               c.force, c.min_gap, c.max_gap, seconds, s.newton.converged ? "" : "  NOT converged");
   csv << v << ',' << s.newton.converged << ',' << s.newton.iterations << ',' << s.n_points() << ',' << c.points << ','
       << c.measure << ',' << c.force << ',' << c.lambda << ',' << c.min_gap << ',' << c.max_gap << ','
-      << s.signorini.min_normal_derivative << ',' << s.signorini.max_complementarity << ',' << seconds << '\n';
+      << s.signorini.min_normal_derivative << ',' << s.signorini.max_complementarity << ',' << int(s.reused_curve)
+      << ',' << seconds << '\n';
   rows.push_back({{family.name, v},
                   {"converged", s.newton.converged},
                   {"newton_steps", s.newton.iterations},
@@ -174,6 +175,7 @@ void record(const Family& family, double v, const BasicSolution<dim>& s, double 
                   {"max_gap", c.max_gap},
                   {"min_normal_derivative", s.signorini.min_normal_derivative},
                   {"max_complementarity", s.signorini.max_complementarity},
+                  {"reused_boundary", s.reused_curve},
                   {"seconds", seconds}});
 }
 
@@ -194,8 +196,11 @@ int run_sweep_in(const std::string& text, const SweepArguments& args, const Opti
     throw std::invalid_argument("--axis: applies to 3-D sweeps only (this one is 2-D)");
   if (!args.axis.empty() && args.rotate.empty())
     throw std::invalid_argument("--axis: the axis of --rotate; give --rotate");
+  axis_of(args.axis);  // a bad axis before any work
   const BasicProblemSpec<dim> base = problem_from_text<dim>(text, args.problem_path, flags);
   const Family family = family_of(args, base);
+  if (dim == 2 && flags.given("condition_number") && base.options.condition_number)
+    throw std::invalid_argument("solver.condition_number: not computed in a sweep (solve one problem for cond(S))");
   for (const std::string& w : base.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
   if (!args.out.empty()) check_output_folder(args.out, {"sweep.csv", "sweep.json"});
   SolverOptions options = base.options;

@@ -116,7 +116,7 @@ Box3 Torus::bounds() const {
 TransformedSurface::TransformedSurface(std::shared_ptr<const Surface> base, int axis, double angle, Point3 shift)
     : base_(std::move(base)), axis_(axis), cos_(std::cos(angle)), sin_(std::sin(angle)), shift_(shift) {
   if (!base_) throw std::invalid_argument("geometry: no surface given");
-  if (axis < 0 || axis > 2) throw std::invalid_argument("--axis: expected x, y or z");
+  if (axis < 0 || axis > 2) throw std::invalid_argument("TransformedSurface: the axis is 0 (x), 1 (y) or 2 (z)");
   const Box3 b = base_->bounds();
   center_ = 0.5 * (b.lower + b.upper);
 }

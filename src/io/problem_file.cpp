@@ -296,8 +296,6 @@ const std::vector<std::string>& output_file_names(int dim) {
   return dim == 3 ? surfaces : curves;
 }
 
-const std::vector<std::string>& surface_output_file_names() { return output_file_names(3); }
-
 namespace {
 
 /// A mesh file named relative to the problem file's folder when `source` names a file.
@@ -312,7 +310,7 @@ std::filesystem::path mesh_path(const std::string& file, const std::string& sour
 /// [geometry] of a 3-D problem: a sphere, an ellipsoid, a torus, an implicit surface, or a mesh (built
 /// by `build_mesh`, which the caller runs once every other key has been read: it can take seconds).
 std::shared_ptr<const Surface> read_surface(TableReader& geometry, const ExpressionMaker& expression,
-                                            const std::string& source, std::shared_ptr<const Surface> given,
+                                            const std::string& source,
                                             std::function<std::shared_ptr<const Surface>()>& build_mesh,
                                             std::vector<std::string>& warnings) {
   const std::string shape = geometry.required_string("shape");
@@ -332,7 +330,6 @@ std::shared_ptr<const Surface> read_surface(TableReader& geometry, const Express
   if (shape == "mesh") {
     const double resolution = geometry.number("resolution", automatic_mesh_resolution);
     check_mesh_resolution(resolution);
-    if (given) return given;
     geometry.require("file");
     const std::filesystem::path file = mesh_path(geometry.string("file", ""), source);
     build_mesh = [file, resolution, &warnings] {
@@ -449,7 +446,8 @@ std::string with_mesh_overrides(const std::string& text, const std::string& sour
   if (!node || !node->is_table()) fail("geometry", "missing section [geometry]");
   toml::table& geometry = *node->as_table();
   const auto* shape = geometry.get_as<std::string>("shape");
-  if (!shape || shape->get() != "mesh") fail("--file", "--file and --resolution need geometry.shape = \"mesh\"");
+  if (!shape || shape->get() != "mesh")
+    fail(file.empty() ? "--resolution" : "--file", "--file and --resolution need geometry.shape = \"mesh\"");
   if (!file.empty()) geometry.insert_or_assign("file", std::filesystem::absolute(file).lexically_normal().string());
   if (resolution >= 0) {
     check_mesh_resolution(resolution);
@@ -485,12 +483,15 @@ BasicProblemSpec<dim> parse_problem(const std::string& text, const std::string& 
   if (!geometry_table) fail("geometry", "missing section [geometry]");
   TableReader geometry(geometry_table, "geometry");
   std::function<std::shared_ptr<const Surface>()> build_mesh;
-  if constexpr (dim == 2) {
-    p.gamma = shape ? shape : read_geometry(geometry, expression, spec.warnings);
+  if (shape) {  // the caller's boundary (a sweep member whose parameter is not in [geometry]): not read again
+    p.gamma = shape;
   } else {
-    p.gamma = read_surface(geometry, expression, source, shape, build_mesh, spec.warnings);
+    if constexpr (dim == 2)
+      p.gamma = read_geometry(geometry, expression, spec.warnings);
+    else
+      p.gamma = read_surface(geometry, expression, source, build_mesh, spec.warnings);
+    geometry.finish();
   }
-  if (!(dim == 2 && shape)) geometry.finish();
 
   TableReader formulation(subtable(root, "formulation"), "formulation");
   formulation.read_options(domain, spec.options);

@@ -171,22 +171,6 @@ std::optional<std::vector<double>> CurveDiscretization::independent_normal_deriv
   return d;
 }
 
-namespace {
-
-std::string format_number(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.3g", v);
-  return buffer;
-}
-
-std::string format_point(Point2 p) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "(%.6g, %.6g)", p.x, p.y);
-  return buffer;
-}
-
-}  // namespace
-
 std::vector<double> CurveDiscretization::obstacle(const Data& data) const {
   const int m = n_points();
   const std::vector<Point2>& p = points();
@@ -201,13 +185,8 @@ std::vector<double> CurveDiscretization::obstacle(const Data& data) const {
       g[i] = data.g_along_curve(p[i].x, p[i].y, arc_positions()[i]);
     else if (!data.g_vectorized)
       g[i] = data.g(p[i].x, p[i].y);
-    if (!std::isfinite(g[i]))
-      throw std::invalid_argument("data.g: not finite at the collocation point " + format_point(p[i]));
-    if (std::abs(g[i]) > detail::largest_scale)
-      throw std::invalid_argument("data.g: " + format_number(g[i]) + " at " + format_point(p[i]) + " is beyond " +
-                                  format_number(detail::largest_scale) +
-                                  ": rescale the problem (u, f and g by one factor)");
   }
+  detail::check_obstacle(g, p);
   return g;
 }
 
@@ -238,11 +217,9 @@ PointErrors CurveDiscretization::point_errors(const std::vector<double>& trace,
   if (!data.exact_gradient) exact(2 * m, xs.data(), ys.data(), inner.data());
   PointErrors pe;
   for (std::size_t i = 0; i < m; ++i) {
-    if (!std::isfinite(values[i])) throw std::invalid_argument("data.exact: not finite at " + format_point(p[i]));
     const double dudn = data.exact_gradient ? dot(n[i], data.exact_gradient(x[i], y[i]))
                                             : (3 * values[i] - 4 * inner[2 * i] + inner[2 * i + 1]) / (2 * step);
-    if (!std::isfinite(dudn))
-      throw std::invalid_argument("data.exact: its normal derivative is not finite near " + format_point(p[i]));
+    detail::check_exact(values[i], dudn, p[i]);
     pe.max_trace = std::max(pe.max_trace, std::abs(trace[i] - values[i]));
     pe.max_normal_derivative = std::max(pe.max_normal_derivative, std::abs(normal_derivative[i] - dudn));
   }

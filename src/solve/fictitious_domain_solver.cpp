@@ -168,6 +168,7 @@ template <int dim>
 SolverOptions solve_options(const State<dim>& st, const BasicContactData<dim>& data, SolverOptions options,
                             bool& chosen) {
   options.validate();
+  check_options_apply(dim, options);  // an option of the other dimension is refused, never ignored
   if (Execution(options.threads).threads() != st.execution.threads() || options.load_quadrature != st.load_quadrature)
     throw std::invalid_argument("solver.threads: threads and load_quadrature are the solver's (" +
                                 std::to_string(st.execution.threads()) + ", " + std::to_string(st.load_quadrature) +

@@ -542,6 +542,7 @@ OptionValue parse_option_text(const OptionSpec& spec, const std::string& text, i
 }
 
 void set_option(const OptionSpec& spec, DomainSettings& domain, SolverOptions& options, OptionValue value) {
+  check_applies(spec, domain.dim);
   spec.set(domain, options, checked(spec, std::move(value), domain.dim));
 }
 
@@ -583,16 +584,19 @@ void SolverOptions::validate() const {
     if (spec.section == "formulation" || spec.section == "solver") checked(spec, spec.get(defaults, *this));
 }
 
+void check_options_apply(int dim, const SolverOptions& options) {
+  const DomainSettings domain(dim);  // every [domain] key applies to both dimensions
+  const SolverOptions defaults;
+  for (const OptionSpec& spec : option_specs())
+    if (!spec.applies_to(dim) && spec.get(domain, options) != spec.get(domain, defaults))
+      check_applies(spec, dim);  // set away from its default where it means nothing: refused
+}
+
 void validate_options(const DomainSettings& domain, const SolverOptions& options) {
   if (domain.dim != 2 && domain.dim != 3) throw std::invalid_argument("domain.dim: expected 2 or 3");
-  const DomainSettings default_domain;
-  const SolverOptions default_options;
-  for (const OptionSpec& spec : option_specs()) {
-    if (spec.applies_to(domain.dim))
-      checked(spec, spec.get(domain, options), domain.dim);
-    else if (spec.get(domain, options) != spec.get(default_domain, default_options))
-      check_applies(spec, domain.dim);  // set away from its default where it means nothing: refused
-  }
+  for (const OptionSpec& spec : option_specs())
+    if (spec.applies_to(domain.dim)) checked(spec, spec.get(domain, options), domain.dim);
+  check_options_apply(domain.dim, options);
   // The box must hold whole cells; periodic: even counts.
   if (domain.dim == 2) {
     BasicProblem<2> p;

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -22,6 +24,40 @@ namespace fictus::detail {
 /// The largest |u₀|, |g|, |λ| a solve accepts: the Newton residuals, the LU and the norms square
 /// these values, which must stay far from the overflow at 1.8e308.
 inline constexpr double largest_scale = 1e100;
+
+/// "(x, y)" or "(x, y, z)", 6 digits each: a point in a message.
+template <int dim>
+std::string format_point(const Point<dim>& p) {
+  std::string text = "(";
+  for (int d = 0; d < dim; ++d) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.6g", p[d]);
+    text += (d ? ", " : "") + std::string(buffer);
+  }
+  return text + ")";
+}
+
+/// Throws naming data.g where the obstacle at a boundary point is not finite or beyond largest_scale.
+template <int dim>
+void check_obstacle(const std::vector<double>& g, const std::vector<Point<dim>>& points) {
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    if (!std::isfinite(g[i])) throw std::invalid_argument("data.g: not finite at the point " + format_point(points[i]));
+    if (std::abs(g[i]) > largest_scale) {
+      char buffer[64];
+      std::snprintf(buffer, sizeof buffer, "%.3g is beyond %.0e", g[i], largest_scale);
+      throw std::invalid_argument("data.g: " + std::string(buffer) + " at " + format_point(points[i]) +
+                                  ": rescale the problem (u, f and g by one factor)");
+    }
+  }
+}
+
+/// Throws naming data.exact where the exact solution or its normal derivative at a point is not finite.
+template <int dim>
+void check_exact(double value, double normal_derivative, const Point<dim>& point) {
+  if (!std::isfinite(value)) throw std::invalid_argument("data.exact: not finite at " + format_point(point));
+  if (!std::isfinite(normal_derivative))
+    throw std::invalid_argument("data.exact: its normal derivative is not finite near " + format_point(point));
+}
 
 /// Records each step's seconds into `timings` as it ends, and reports it (the progress lines).
 class PhaseClock {

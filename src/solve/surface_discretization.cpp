@@ -195,14 +195,7 @@ std::vector<double> SurfaceDiscretization::obstacle(const Data& data) const {
   const std::array<std::vector<double>, 3> x = coordinates(points());
   (data.g_vectorized ? data.g_vectorized : vectorize(data.g))(std::size_t(m), x[0].data(), x[1].data(), x[2].data(),
                                                               g.data());
-  for (int p = 0; p < m; ++p) {
-    const Point3 q = points()[p];
-    if (!std::isfinite(g[p]))
-      throw std::invalid_argument(format("data.g: not finite at the point (%.6g, %.6g, %.6g)", q.x, q.y, q.z));
-    if (std::abs(g[p]) > detail::largest_scale)
-      throw std::invalid_argument(format("data.g: %.3g is beyond %.0e: rescale the problem (u, f and g by one factor)",
-                                         g[p], detail::largest_scale));
-  }
+  detail::check_obstacle(g, points());
   return g;
 }
 
@@ -240,9 +233,10 @@ PointErrors SurfaceDiscretization::point_errors(const std::vector<double>& trace
   PointErrors pe;
   for (int p = 0; p < n_points(); ++p) {
     const Point3 n = normals()[p];
+    const double dudn = n.x * du[0][p] + n.y * du[1][p] + n.z * du[2][p];
+    detail::check_exact(u[p], dudn, points()[p]);
     pe.max_trace = std::max(pe.max_trace, std::abs(trace[p] - u[p]));
-    pe.max_normal_derivative = std::max(
-        pe.max_normal_derivative, std::abs(normal_derivative[p] - (n.x * du[0][p] + n.y * du[1][p] + n.z * du[2][p])));
+    pe.max_normal_derivative = std::max(pe.max_normal_derivative, std::abs(normal_derivative[p] - dudn));
   }
   return pe;
 }

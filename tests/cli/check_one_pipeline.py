@@ -47,10 +47,10 @@ def solve(folder, *args):
         return json.load(f)
 
 
-def sweep(folder, *args):
+def sweep(folder, *args, problem=SPHERE):
     path = os.path.join(SCRATCH, folder)
     shutil.rmtree(path, ignore_errors=True)
-    run("sweep", SPHERE, *args, "--out", path)
+    run("sweep", problem, *args, "--out", path)
     with open(os.path.join(path, "sweep.json")) as f:
         return json.load(f)
 
@@ -72,6 +72,14 @@ def sweeps_equal_single_solves():
     for row in s["rows"]:
         single = solve("single_lift", SPHERE, "--parameter", f"lift={row['lift']!r}")
         same_contact(row, single, f"lift = {row['lift']}")
+        check(row["reused_boundary"] is True, f"lift = {row['lift']}: a parameter of g only keeps the boundary")
+    # a mesh surface whose parameter is not in [geometry]: the mesh is kept, not read again
+    mesh = os.path.join(SOURCE, "tests", "inputs", "mesh_parameters.toml")
+    s = sweep("sweep_mesh", "--parameter", "lift=0,0.05", problem=mesh)
+    for row in s["rows"]:
+        single = solve("single_mesh", mesh, "--parameter", f"lift={row['lift']!r}")
+        same_contact(row, single, f"mesh, lift = {row['lift']}")
+        check(row["reused_boundary"] is True, f"mesh, lift = {row['lift']}: the mesh is kept")
     s = sweep("sweep_rotate", "--rotate", "0,0.4", "--axis", "x")
     check(s["sweep"]["axis"] == "x", "the rotation axis is recorded")
     same_contact(s["rows"][0], solve("single_plain", SPHERE), "rotate = 0")
@@ -144,6 +152,16 @@ def mesh_flags():
               os.path.relpath(os.path.join(SOURCE, "examples", "meshes", "torus.off")))
     check(r["boundary"]["mesh"]["resolution"] == 24, f"--resolution: {r['boundary']['mesh']}")
     check(os.path.isabs(r["problem"]["geometry"]["file"]), "the mesh file is echoed as an absolute path")
+    plain = os.path.join(SOURCE, "examples", "circle.toml")
+    for flag, value in (("--resolution", "24"), ("--file", "x.off")):
+        r = run("solve", plain, flag, value, "--out", os.path.join(SCRATCH, "no_mesh"), ok=False)
+        check(r.returncode == 1 and r.stderr.startswith(f"fictus: error: {flag}:"),
+              f"{flag} on a 2-D problem names itself: {r.stderr.strip()}")
+    r = run("sweep", SPHERE, "--rotate", "0,1", "--axis", "w", ok=False)
+    check(r.returncode == 1 and "--axis: expected x, y or z" in r.stderr and "g_scale" not in r.stdout
+          and "rotate" not in r.stdout, f"a bad --axis is refused before any work: {r.stdout}{r.stderr}")
+    r = run("solve", plain, "--dim", "3", ok=False)
+    check(r.returncode == 1 and "--dim: not a flag" in r.stderr, f"--dim: {r.stderr.strip()}")
 
 
 def main():

@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/options.hpp"
 #include "fictus/solve/paper_problem.hpp"
 
 namespace {
@@ -146,6 +147,27 @@ TEST(Reuse, NewLoadKeepsTheCurveAndMatchesAFreshSolve) {
   fictus::Problem other = fictus::paper_problem(256);
   fictus::FictitiousDomainSolver solver(fictus::paper_problem(128));
   EXPECT_THROW(solver.replace_load(other), std::invalid_argument);  // another grid needs another solver
+}
+
+TEST(Options, ThoseOfTheOtherDimensionAreRefusedPerSolveToo) {
+  // The constructor checks its options; each solve checks its own: a 3-D option set in a 2-D solve
+  // (or the reverse) is an error naming the key, never ignored.
+  const fictus::Problem problem = fictus::paper_problem(128);
+  fictus::FictitiousDomainSolver solver(problem);
+  fictus::SolverOptions o = options_for(fictus::Variant::smooth, fictus::InnerSolver::green, 128);
+  o.flux_balance = !o.flux_balance;
+  try {
+    (void)solver.solve(problem, o);
+    ADD_FAILURE() << "formulation.flux_balance accepted in a 2-D solve";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("formulation.flux_balance: applies to 3-D problems only"), std::string::npos)
+        << e.what();
+  }
+  o = options_for(fictus::Variant::smooth, fictus::InnerSolver::green, 128);
+  o.nested_start = 0;
+  EXPECT_THROW((void)solver.solve(problem, o), std::invalid_argument);
+  fictus::DomainSettings domain(2);
+  EXPECT_THROW(fictus::set_option(*fictus::find_option("far_field"), domain, o, false), std::invalid_argument);
 }
 
 TEST(ContactSummary, MeasureForceAndGapsFromThePoints) {

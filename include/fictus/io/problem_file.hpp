@@ -63,8 +63,6 @@ std::string read_problem_text(const std::string& path);
 
 /// The names `[output] files` accepts in a dimension.
 const std::vector<std::string>& output_file_names(int dim = 2);
-/// The 3-D names (output_file_names(3)).
-const std::vector<std::string>& surface_output_file_names();
 
 /// The text of a 3-D mesh problem file with [geometry] file (made absolute against the working folder;
 /// "" keeps the file's) and resolution (< 0 keeps the file's) replaced: the flags --file and --resolution.

@@ -73,7 +73,9 @@ OptionValue parse_option_text(const OptionSpec& spec, const std::string& text, i
 /// Throws std::invalid_argument "section.key: applies to 3-D problems only (this one is 2-D)" when the
 /// option does not apply to dimension dim (given in a file, a flag or Python: refused, never ignored).
 void check_applies(const OptionSpec& spec, int dim);
-/// checked() then set().
+/// Refuses (check_applies) an option that does not apply to dimension dim and is set away from its default.
+void check_options_apply(int dim, const SolverOptions& options);
+/// check_applies(), checked(), then set().
 void set_option(const OptionSpec& spec, DomainSettings& domain, SolverOptions& options, OptionValue value);
 template <int dim>
 void set_option(const OptionSpec& spec, BasicProblem<dim>& problem, SolverOptions& options, OptionValue value);

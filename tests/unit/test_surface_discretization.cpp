@@ -1,5 +1,5 @@
-// 3-D pieces of the surface solver: trace rows on the trilinear grid, the quadrature over ω, and the
-// solver's checks of its input.
+// The 3-D boundary (SurfaceDiscretization) and what it rests on: trace rows on the trilinear grid, the quadrature over
+// ω, and the solver's checks of its input.
 #include <gtest/gtest.h>
 
 #include <cmath>
