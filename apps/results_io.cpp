@@ -63,7 +63,7 @@ json newton_json(const NewtonResult& n) {
             {"n_active", std::count(n.active.begin(), n.active.end(), 1)},
             {"residual", n.residual},
             {"history", history}};
-  if (!n.converged) j["failure"] = n.failure;
+  j["failure"] = n.converged ? json(nullptr) : json(n.failure);
   return j;
 }
 
@@ -129,7 +129,8 @@ json inner_json(const BasicSolution<dim>& s) {
   json j = {{"solver", to_string(s.options.inner)},
             {"fast_solves", s.fast_solves},
             {"krylov_iterations", s.inner_iterations},
-            {"factorizations", s.factorizations}};
+            {"factorizations", s.factorizations},
+            {"far_field", nullptr}};  // null where no pair was interpolated, as every optional block
   if (s.far_field) {
     const FarFieldReport& a = s.far_field->assembly;
     j["far_field"] = {{"far_fraction", a.far_pairs / (a.far_pairs + a.near_pairs)},
@@ -167,11 +168,12 @@ json solution_to_json(const BasicProblem<dim>& problem, const BasicSolution<dim>
   j["boundary"] = boundary_json(problem, s);
   j["alpha"] = s.alpha;
   j["newton"] = newton_json(s.newton);
-  if (s.nested_start) j["newton"]["nested_start"] = nested_start_json(*s.nested_start);
+  j["newton"]["nested_start"] = s.nested_start ? nested_start_json(*s.nested_start) : json(nullptr);
   j["inner"] = inner_json(s);
   j["timings"] = timings_json(s.timings);
   j["condition_number"] = s.condition_number ? json(*s.condition_number) : json(nullptr);
   j["signorini"] = signorini_json(s.signorini);
+  j["signorini"]["check"] = nullptr;
   if (s.check)
     j["signorini"]["check"] = {{"rule", s.check->rule},
                                {"min_normal_derivative", s.check->min_normal_derivative},
