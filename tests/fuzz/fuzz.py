@@ -103,12 +103,16 @@ def check_success(folder):
     if text == OLD_RESULTS:
         return ["results.json was not written"]
     results = json.loads(text)
-    # Optional figures are null by design when not computed (no exact solution, krylov's cond(S), the
-    # 3-D flux balance).
+    # Optional figures are null by design when not computed (no exact solution, krylov's cond(S)); the
+    # optional blocks are null where they do not apply (the flux balance in 2-D and the smooth variant,
+    # the far field, the nested start, the independent check, a failure of a converged Newton).
     for key in ("errors", "condition_number", "problem"):
         results.pop(key, None)
-    if results.get("flux_balance", 0) is None:  # null where it does not apply (2-D, smooth variant)
-        results.pop("flux_balance")
+    for block, key in ((None, "flux_balance"), ("inner", "far_field"), ("newton", "nested_start"),
+                       ("newton", "failure"), ("signorini", "check")):
+        table = results if block is None else results.get(block, {})
+        if isinstance(table, dict) and key in table and table[key] is None:
+            table.pop(key)
     finite_numbers(results, "results", problems)
     if not results.get("newton", {}).get("converged", False):
         problems.append("newton.converged is not true")
