@@ -215,15 +215,11 @@ PointErrors CurveDiscretization::point_errors(const std::vector<double>& trace,
       xs[2 * i + k] = q.x, ys[2 * i + k] = q.y;
     }
   if (!data.exact_gradient) exact(2 * m, xs.data(), ys.data(), inner.data());
-  PointErrors pe;
-  for (std::size_t i = 0; i < m; ++i) {
-    const double dudn = data.exact_gradient ? dot(n[i], data.exact_gradient(x[i], y[i]))
-                                            : (3 * values[i] - 4 * inner[2 * i] + inner[2 * i + 1]) / (2 * step);
-    detail::check_exact(values[i], dudn, p[i]);
-    pe.max_trace = std::max(pe.max_trace, std::abs(trace[i] - values[i]));
-    pe.max_normal_derivative = std::max(pe.max_normal_derivative, std::abs(normal_derivative[i] - dudn));
-  }
-  return pe;
+  std::vector<double> dudn(m);
+  for (std::size_t i = 0; i < m; ++i)
+    dudn[i] = data.exact_gradient ? dot(n[i], data.exact_gradient(x[i], y[i]))
+                                  : (3 * values[i] - 4 * inner[2 * i] + inner[2 * i + 1]) / (2 * step);
+  return detail::point_errors_at(p, trace, normal_derivative, values, dudn);
 }
 
 void CurveDiscretization::describe(SolutionBoundary<2>& out) const {

@@ -51,12 +51,21 @@ void check_obstacle(const std::vector<double>& g, const std::vector<Point<dim>>&
   }
 }
 
-/// Throws naming data.exact where the exact solution or its normal derivative at a point is not finite.
+/// The largest |B_γû − u| and |C_γû − ∂u/∂n| over the points, from the exact u and ∂u/∂n there; throws
+/// naming data.exact where either is not finite.
 template <int dim>
-void check_exact(double value, double normal_derivative, const Point<dim>& point) {
-  if (!std::isfinite(value)) throw std::invalid_argument("data.exact: not finite at " + format_point(point));
-  if (!std::isfinite(normal_derivative))
-    throw std::invalid_argument("data.exact: its normal derivative is not finite near " + format_point(point));
+PointErrors point_errors_at(const std::vector<Point<dim>>& points, const std::vector<double>& trace,
+                            const std::vector<double>& normal_derivative, const std::vector<double>& u,
+                            const std::vector<double>& dudn) {
+  PointErrors pe;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!std::isfinite(u[i])) throw std::invalid_argument("data.exact: not finite at " + format_point(points[i]));
+    if (!std::isfinite(dudn[i]))
+      throw std::invalid_argument("data.exact: its normal derivative is not finite near " + format_point(points[i]));
+    pe.max_trace = std::max(pe.max_trace, std::abs(trace[i] - u[i]));
+    pe.max_normal_derivative = std::max(pe.max_normal_derivative, std::abs(normal_derivative[i] - dudn[i]));
+  }
+  return pe;
 }
 
 /// Records each step's seconds into `timings` as it ends, and reports it (the progress lines).

@@ -230,15 +230,12 @@ PointErrors SurfaceDiscretization::point_errors(const std::vector<double>& trace
   std::vector<double> u(points().size());
   exact(u.size(), x[0].data(), x[1].data(), x[2].data(), u.data());
   gradient_at(exact, data.exact_gradient, 1e-6 * grid_.box().width(0), x, du);
-  PointErrors pe;
-  for (int p = 0; p < n_points(); ++p) {
+  std::vector<double> dudn(u.size());
+  for (std::size_t p = 0; p < u.size(); ++p) {
     const Point3 n = normals()[p];
-    const double dudn = n.x * du[0][p] + n.y * du[1][p] + n.z * du[2][p];
-    detail::check_exact(u[p], dudn, points()[p]);
-    pe.max_trace = std::max(pe.max_trace, std::abs(trace[p] - u[p]));
-    pe.max_normal_derivative = std::max(pe.max_normal_derivative, std::abs(normal_derivative[p] - dudn));
+    dudn[p] = n.x * du[0][p] + n.y * du[1][p] + n.z * du[2][p];
   }
-  return pe;
+  return detail::point_errors_at(points(), trace, normal_derivative, u, dudn);
 }
 
 void SurfaceDiscretization::describe(SolutionBoundary<3>& out) const {
