@@ -141,6 +141,24 @@ json inner_json(const BasicSolution<dim>& s) {
   return j;
 }
 
+json domain_json(const DomainQuantities& d) {
+  return {{"volume", d.volume},           {"integral_u", d.integral_u}, {"integral_u2", d.integral_u2},
+          {"integral_grad2", d.integral_grad2}, {"integral_f", d.integral_f}, {"integral_fu", d.integral_fu},
+          {"energy", d.energy},           {"flux", d.flux}};
+}
+
+json estimate_json(const ErrorEstimate& e) {
+  return e.skipped.empty() ? json{{"N", e.N},
+                                  {"l2_omega", e.l2_omega},
+                                  {"rel_l2_omega", e.rel_l2_omega},
+                                  {"force", e.force},
+                                  {"measure", e.measure},
+                                  {"energy", e.energy},
+                                  {"integral_u", e.integral_u},
+                                  {"seconds", e.seconds}}
+                           : json{{"skipped", e.skipped}, {"seconds", e.seconds}};
+}
+
 json nested_start_json(const NestedStart& n) {
   return n.skipped.empty() ? json{{"N", n.N},
                                   {"multipliers", n.multipliers},
@@ -181,8 +199,16 @@ json solution_to_json(const BasicProblem<dim>& problem, const BasicSolution<dim>
                                {"max_difference", s.check->max_difference},
                                {"rms_difference", s.check->rms_difference}};
   const ContactSummary contact = contact_summary(s);
-  j["contact"] = {{"points", contact.points},          {"measure", contact.measure}, {"force", contact.force},
-                  {"lambda_integral", contact.lambda}, {"min_gap", contact.min_gap}, {"max_gap", contact.max_gap}};
+  j["contact"] = {{"points", contact.points},
+                  {"measure", contact.measure},
+                  {"force", contact.force},
+                  {"force_patches", contact.force_patches},
+                  {"force_rule", contact.force_from_domain ? "domain" : "patches"},
+                  {"lambda_integral", contact.lambda},
+                  {"min_gap", contact.min_gap},
+                  {"max_gap", contact.max_gap}};
+  j["domain"] = s.domain ? domain_json(*s.domain) : json(nullptr);
+  j["estimate"] = s.estimate ? estimate_json(*s.estimate) : json(nullptr);
   j["flux_balance"] = s.flux_balance ? json{{"scatter", s.flux_balance->scatter},
                                             {"mean", s.flux_balance->mean},
                                             {"data_shift", s.flux_balance->data_shift}}

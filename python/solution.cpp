@@ -128,10 +128,37 @@ py::dict contact(const BasicSolution<dim>& s) {
   d["points"] = c.points;
   d["measure"] = c.measure;
   d["force"] = c.force;
+  d["force_patches"] = c.force_patches;
+  d["force_rule"] = c.force_from_domain ? "domain" : "patches";
   d["lambda_integral"] = c.lambda;
   d["min_gap"] = c.min_gap;
   d["max_gap"] = c.max_gap;
   return d;
+}
+
+template <int dim>
+py::object domain(const BasicSolution<dim>& s) {
+  if (!s.domain) return py::none();
+  const DomainQuantities& q = *s.domain;
+  py::dict d;
+  d["volume"] = q.volume, d["integral_u"] = q.integral_u, d["integral_u2"] = q.integral_u2;
+  d["integral_grad2"] = q.integral_grad2, d["integral_f"] = q.integral_f, d["integral_fu"] = q.integral_fu;
+  d["energy"] = q.energy, d["flux"] = q.flux;
+  return std::move(d);
+}
+
+template <int dim>
+py::object estimate(const BasicSolution<dim>& s) {
+  if (!s.estimate) return py::none();
+  const ErrorEstimate& e = *s.estimate;
+  py::dict d;
+  if (!e.skipped.empty()) {
+    d["skipped"] = e.skipped, d["seconds"] = e.seconds;
+    return std::move(d);
+  }
+  d["N"] = e.N, d["l2_omega"] = e.l2_omega, d["rel_l2_omega"] = e.rel_l2_omega, d["force"] = e.force;
+  d["measure"] = e.measure, d["energy"] = e.energy, d["integral_u"] = e.integral_u, d["seconds"] = e.seconds;
+  return std::move(d);
 }
 
 template <int dim>
@@ -303,6 +330,10 @@ void bind_solution(py::module_& m) {
                              [](const PySolution& p) { return on(p, [](const auto& s) { return signorini(s); }); })
       .def_property_readonly("contact_summary",
                              [](const PySolution& p) { return on(p, [](const auto& s) { return contact(s); }); })
+      .def_property_readonly("domain",
+                             [](const PySolution& p) { return on(p, [](const auto& s) { return domain(s); }); })
+      .def_property_readonly("estimate",
+                             [](const PySolution& p) { return on(p, [](const auto& s) { return estimate(s); }); })
       .def_property_readonly("errors",
                              [](const PySolution& p) { return on(p, [](const auto& s) { return errors(s); }); })
       .def_property_readonly("options", &options, "the options in effect that apply to this dimension, by key")

@@ -190,6 +190,11 @@ std::vector<double> CurveDiscretization::obstacle(const Data& data) const {
   return g;
 }
 
+void CurveDiscretization::for_each_omega_sample(const GridVector& u, int quadrature,
+                                        const OmegaSampleVisitor<2>& visit) const {
+  fictus::for_each_omega_sample(u, *gamma_geometry_, quadrature, execution_, visit);
+}
+
 ErrorNorms CurveDiscretization::errors(const GridVector& u, const std::vector<double>&, const Data& data,
                                        int quadrature) const {
   if (data.exact_vectorized)

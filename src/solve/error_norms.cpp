@@ -1,8 +1,11 @@
 #include "fictus/solve/error_norms.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
+
+#include <omp.h>
 
 #include "fictus/boundary/curve_grid_intersection.hpp"
 #include "fictus/boundary/omega_quadrature.hpp"
@@ -65,44 +68,101 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
   return compute_errors(u_h, gamma, vectorize(exact), gradient, q, execution);
 }
 
-ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& gamma, const VectorizedField& exact,
-                          const VectorizedGradient& exact_gradient, int q, const Execution& execution) {
+void for_each_omega_sample(const GridVector& u_h, const CurveGridIntersection& gamma, int q, const Execution& execution,
+                           const OmegaSampleVisitor<2>& visit) {
   const Grid2& grid = gamma.grid();
-  const double e = 1e-6 * (grid.box().upper.x - grid.box().lower.x);
-  // Over ω, row by row: [e², |∇e|², u², |∇u|²], summed per cell, per row, then over rows.
-  std::array<double, 4> omega{};
 #pragma omp parallel num_threads(execution.threads())
   {
-    std::array<double, 4> local{};
+    const int thread = omp_get_thread_num();
     std::vector<CellQuadraturePoint> points;
-    std::vector<double> x, y, u, gx, gy;
+    OmegaSamples<2> row;
 #pragma omp for schedule(dynamic, 8)
     for (int iy = 0; iy < grid.ny(); ++iy) {
       gamma.row_rule(iy, q, points);
       const std::size_t n = points.size();
       if (n == 0) continue;
-      x.resize(n), y.resize(n), u.resize(n);
-      for (std::size_t k = 0; k < n; ++k) x[k] = points[k].x, y[k] = points[k].y;
-      exact(n, x.data(), y.data(), u.data());
-      gradient_at(exact, exact_gradient, e, x, y, gx, gy);
-      std::array<double, 4> row{}, cell{};
+      for (auto* v : {&row.x[0], &row.x[1], &row.weight, &row.value, &row.gradient[0], &row.gradient[1]}) v->resize(n);
       for (std::size_t k = 0; k < n; ++k) {
-        const Q1Sample s = sample_q1(grid, u_h, points[k].ix, iy, x[k], y[k]);
-        const Point2 du{gx[k], gy[k]};
-        const Point2 de = s.gradient - du;
-        const double w = points[k].weight;
-        cell[0] += w * (s.value - u[k]) * (s.value - u[k]);
-        cell[1] += w * dot(de, de);
-        cell[2] += w * u[k] * u[k];
-        cell[3] += w * dot(du, du);
-        if (k + 1 == n || points[k + 1].ix != points[k].ix)
-          for (int c = 0; c < 4; ++c) row[c] += cell[c], cell[c] = 0.0;
+        const CellQuadraturePoint& p = points[k];
+        const Q1Sample s = sample_q1(grid, u_h, p.ix, iy, p.x, p.y);
+        row.x[0][k] = p.x, row.x[1][k] = p.y, row.weight[k] = p.weight, row.value[k] = s.value;
+        row.gradient[0][k] = s.gradient.x, row.gradient[1][k] = s.gradient.y;
       }
-      for (int c = 0; c < 4; ++c) local[c] += row[c];
+      visit(thread, row);
     }
-#pragma omp critical
-    for (int c = 0; c < 4; ++c) omega[c] += local[c];
   }
+}
+
+void evaluate_at(const VectorizedField& f, const std::array<std::vector<double>, 2>& x, std::vector<double>& out) {
+  out.resize(x[0].size());
+  f(out.size(), x[0].data(), x[1].data(), out.data());
+}
+
+void evaluate_at(const VectorizedField3& f, const std::array<std::vector<double>, 3>& x, std::vector<double>& out) {
+  out.resize(x[0].size());
+  f(out.size(), x[0].data(), x[1].data(), x[2].data(), out.data());
+}
+
+namespace {
+
+/// Σ w·[(û − u)², |∇û − ∇u|², u², |∇u|²] over ω, u and ∇u evaluated by `exact` on each row's points.
+template <int dim, class Sampler, class Exact>
+std::array<double, 4> omega_error_sums(const Sampler& for_each_sample, const Exact& exact, const Execution& execution) {
+  struct Buffers {
+    std::vector<double> u;
+    std::array<std::vector<double>, dim> du;
+  };
+  std::vector<std::array<double, 4>> sums(std::size_t(execution.threads()), std::array<double, 4>{});
+  std::vector<Buffers> buffers(sums.size());
+  for_each_sample([&](int thread, const OmegaSamples<dim>& row) {
+    Buffers& b = buffers[std::size_t(thread)];
+    exact(row.x, b.u, b.du);
+    std::array<double, 4> s{};  // per row, then per thread: round-off stays ~1e-15 of the total
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      double de2 = 0, du2 = 0;
+      for (int d = 0; d < dim; ++d) {
+        const double de = row.gradient[d][k] - b.du[d][k];
+        de2 += de * de, du2 += b.du[d][k] * b.du[d][k];
+      }
+      const double w = row.weight[k], e = row.value[k] - b.u[k];
+      s[0] += w * e * e, s[1] += w * de2, s[2] += w * b.u[k] * b.u[k], s[3] += w * du2;
+    }
+    for (int c = 0; c < 4; ++c) sums[std::size_t(thread)][std::size_t(c)] += s[std::size_t(c)];
+  });
+  std::array<double, 4> total{};
+  for (const auto& s : sums)
+    for (int c = 0; c < 4; ++c) total[std::size_t(c)] += s[std::size_t(c)];
+  return total;
+}
+
+/// The norms from the sums over ω ([e², |∇e|², u², |∇u|²]) and along γ (e², u²).
+ErrorNorms norms_from(const std::array<double, 4>& omega, double boundary_error, double boundary_norm) {
+  ErrorNorms n;
+  n.l2_omega = std::sqrt(omega[0]);
+  n.h1semi_omega = std::sqrt(omega[1]);
+  n.h1_omega = std::sqrt(omega[0] + omega[1]);
+  n.l2_gamma = std::sqrt(boundary_error);
+  const auto relative = [](double error, double norm) { return norm > 0 ? error / norm : error; };
+  n.rel_l2_omega = relative(n.l2_omega, std::sqrt(omega[2]));
+  n.rel_h1semi_omega = relative(n.h1semi_omega, std::sqrt(omega[3]));
+  n.rel_h1_omega = relative(n.h1_omega, std::sqrt(omega[2] + omega[3]));
+  n.rel_l2_gamma = relative(n.l2_gamma, std::sqrt(boundary_norm));
+  return n;
+}
+
+}  // namespace
+
+ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& gamma, const VectorizedField& exact,
+                          const VectorizedGradient& exact_gradient, int q, const Execution& execution) {
+  const Grid2& grid = gamma.grid();
+  const double e = 1e-6 * (grid.box().upper.x - grid.box().lower.x);
+  const std::array<double, 4> omega = omega_error_sums<2>(
+      [&](const OmegaSampleVisitor<2>& visit) { for_each_omega_sample(u_h, gamma, q, execution, visit); },
+      [&](const std::array<std::vector<double>, 2>& x, std::vector<double>& u, std::array<std::vector<double>, 2>& du) {
+        evaluate_at(exact, x, u);
+        gradient_at(exact, exact_gradient, e, x[0], x[1], du[0], du[1]);
+      },
+      execution);
 
   // Along γ: the Gauss points of every piece, one batch; [e², u²].
   const GaussRule& rule = gauss_legendre(q);
@@ -123,18 +183,7 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
     boundary_error += w[k] * err * err;
     boundary_norm += w[k] * u[k] * u[k];
   }
-
-  ErrorNorms n;
-  n.l2_omega = std::sqrt(omega[0]);
-  n.h1semi_omega = std::sqrt(omega[1]);
-  n.h1_omega = std::sqrt(omega[0] + omega[1]);
-  n.l2_gamma = std::sqrt(boundary_error);
-  auto rel = [](double err, double norm) { return norm > 0 ? err / norm : err; };
-  n.rel_l2_omega = rel(n.l2_omega, std::sqrt(omega[2]));
-  n.rel_h1semi_omega = rel(n.h1semi_omega, std::sqrt(omega[3]));
-  n.rel_h1_omega = rel(n.h1_omega, std::sqrt(omega[2] + omega[3]));
-  n.rel_l2_gamma = rel(n.l2_gamma, std::sqrt(boundary_norm));
-  return n;
+  return norms_from(omega, boundary_error, boundary_norm);
 }
 
 namespace {
@@ -192,67 +241,79 @@ ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surfac
   return compute_errors(u_h, grid, gamma, patches, trace, vectorize(exact), exact_gradient, q, execution);
 }
 
+void for_each_omega_sample(const GridVector& u_h, const Grid3& grid, const Surface& gamma, int q,
+                           const Execution& execution, const OmegaSampleVisitor<3>& visit) {
+  std::vector<OmegaSamples<3>> rows(std::size_t(execution.threads()));
+  for_each_omega_row(grid, gamma, q, execution, [&](int thread, const std::vector<OmegaPoint>& points) {
+    OmegaSamples<3>& row = rows[std::size_t(thread)];
+    const std::size_t n = points.size();
+    for (auto* v : {&row.x[0], &row.x[1], &row.x[2], &row.weight, &row.value, &row.gradient[0], &row.gradient[1],
+                    &row.gradient[2]})
+      v->resize(n);
+    std::array<double, 8> nodal{};
+    for (std::size_t k = 0; k < n; ++k) {
+      const OmegaPoint& p = points[k];
+      if (k == 0 || p.cell != points[k - 1].cell) nodal = nodal_values(grid, u_h, p.cell);
+      Point3 xi;
+      for (int d = 0; d < 3; ++d) xi[d] = (p.x[d] - grid.coordinate(d, p.cell[d])) / grid.h();
+      const auto [value, slope] = Q1Element<3>::interpolate(nodal, xi, grid.h());
+      for (int d = 0; d < 3; ++d) row.x[d][k] = p.x[d], row.gradient[d][k] = slope[d];
+      row.weight[k] = p.weight, row.value[k] = value;
+    }
+    visit(thread, row);
+  });
+}
+
+template <int dim>
+void sample_q1_at(const Grid<dim>& grid, const GridVector& u_h, const std::array<std::vector<double>, dim>& x,
+                  std::vector<double>& out) {
+  const std::size_t n = x[0].size();
+  out.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    typename Grid<dim>::Index cell;
+    Point<dim> xi;
+    for (int d = 0; d < dim; ++d) {
+      cell[d] = std::clamp(int(std::floor((x[d][k] - grid.box().lower[d]) / grid.h())), 0, grid.n(d) - 1);
+      xi[d] = (x[d][k] - grid.coordinate(d, cell[d])) / grid.h();
+    }
+    std::array<double, 1 << dim> nodal;
+    for (int c = 0; c < (1 << dim); ++c) {
+      typename Grid<dim>::Index node = cell;
+      for (int d = 0; d < dim; ++d) node[d] += (c >> d) & 1;
+      nodal[std::size_t(c)] = grid.has_unknown(node) ? u_h[grid.index(node)] : 0.0;
+    }
+    if constexpr (dim == 2)
+      out[k] = Q1Element<2>::interpolate(nodal[0], nodal[1], nodal[2], nodal[3], xi, grid.h()).value;
+    else
+      out[k] = Q1Element<3>::interpolate(nodal, xi, grid.h()).value;
+  }
+}
+
+template void sample_q1_at<2>(const Grid<2>&, const GridVector&, const std::array<std::vector<double>, 2>&,
+                           std::vector<double>&);
+template void sample_q1_at<3>(const Grid<3>&, const GridVector&, const std::array<std::vector<double>, 3>&,
+                           std::vector<double>&);
+
 ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,
                           const std::vector<double>& trace, const VectorizedField3& exact,
                           const GradientField3& exact_gradient, int q, const Execution& execution) {
   const double e = 1e-6 * grid.box().width(0);
-  struct Sums {
-    double e2 = 0, de2 = 0, u2 = 0, du2 = 0;
-  };
-  struct Buffers {
-    std::array<std::vector<double>, 3> x, du;
-    std::vector<double> u;
-  };
-  std::vector<Sums> sums(execution.threads());
-  std::vector<Buffers> buffers(execution.threads());
-  for_each_omega_row(grid, gamma, q, execution, [&](int thread, const std::vector<OmegaPoint>& row) {
-    Buffers& b = buffers[thread];
-    const std::size_t n = row.size();
-    for (int d = 0; d < 3; ++d) {
-      b.x[d].resize(n);
-      for (std::size_t k = 0; k < n; ++k) b.x[d][k] = row[k].x[d];
-    }
-    b.u.resize(n);
-    exact(n, b.x[0].data(), b.x[1].data(), b.x[2].data(), b.u.data());
-    gradient_at(exact, exact_gradient, e, b.x, b.du);
-    Sums& s = sums[thread];
-    std::array<double, 8> nodal{};
-    for (std::size_t k = 0; k < n; ++k) {
-      if (k == 0 || row[k].cell != row[k - 1].cell) nodal = nodal_values(grid, u_h, row[k].cell);
-      Point3 xi;
-      for (int d = 0; d < 3; ++d) xi[d] = (row[k].x[d] - grid.coordinate(d, row[k].cell[d])) / grid.h();
-      const auto [value, slope] = Q1Element<3>::interpolate(nodal, xi, grid.h());
-      const double u = b.u[k];
-      const Point3 du{b.du[0][k], b.du[1][k], b.du[2][k]};
-      const Point3 de = slope - du;
-      const double w = row[k].weight;
-      s.e2 += w * (value - u) * (value - u);
-      s.de2 += w * dot(de, de);
-      s.u2 += w * u * u;
-      s.du2 += w * dot(du, du);
-    }
-  });
-  Sums total;
-  for (const Sums& s : sums) total.e2 += s.e2, total.de2 += s.de2, total.u2 += s.u2, total.du2 += s.du2;
+  const std::array<double, 4> omega = omega_error_sums<3>(
+      [&](const OmegaSampleVisitor<3>& visit) { for_each_omega_sample(u_h, grid, gamma, q, execution, visit); },
+      [&](const std::array<std::vector<double>, 3>& x, std::vector<double>& u, std::array<std::vector<double>, 3>& du) {
+        evaluate_at(exact, x, u);
+        gradient_at(exact, exact_gradient, e, x, du);
+      },
+      execution);
   const std::array<std::vector<double>, 3> x = coordinates(patches.point);
-  std::vector<double> u(x[0].size());
-  exact(u.size(), x[0].data(), x[1].data(), x[2].data(), u.data());
+  std::vector<double> u;
+  evaluate_at(exact, x, u);
   double g2 = 0, gu2 = 0;
   for (int p = 0; p < patches.m; ++p) {
     g2 += patches.area[p] * (trace[p] - u[p]) * (trace[p] - u[p]);
     gu2 += patches.area[p] * u[p] * u[p];
   }
-  ErrorNorms out;
-  out.l2_omega = std::sqrt(total.e2);
-  out.h1semi_omega = std::sqrt(total.de2);
-  out.h1_omega = std::sqrt(total.e2 + total.de2);
-  out.l2_gamma = std::sqrt(g2);
-  const auto relative = [](double error, double norm) { return norm > 0 ? error / norm : error; };
-  out.rel_l2_omega = relative(out.l2_omega, std::sqrt(total.u2));
-  out.rel_h1semi_omega = relative(out.h1semi_omega, std::sqrt(total.du2));
-  out.rel_h1_omega = relative(out.h1_omega, std::sqrt(total.u2 + total.du2));
-  out.rel_l2_gamma = relative(out.l2_gamma, std::sqrt(gu2));
-  return out;
+  return norms_from(omega, g2, gu2);
 }
 
 }  // namespace fictus

@@ -305,22 +305,23 @@ ActiveSet nearest_flags(const std::vector<Point<dim>>& from, const ActiveSet& fl
 
 namespace {
 
-/// The nested start: the same problem on the grid of N/2 (m/4 points when m is given; Γ at the same
-/// distance δ from γ; no error integrals), its active set carried to this grid's points (each takes the
-/// flag of the nearest coarse point), or nothing, with `report.skipped` saying why: the coarse grid
-/// checks the box's margin (2h), the boundary's reach and δ ≥ 4h with its own h, and may refuse what
-/// this grid takes. Its steps are reported as "N/2 <step>"; an interrupt asked there ends this solve too.
+/// The same problem on the grid of N/2 (m/4 points when m is given; Γ at the same distance δ from γ;
+/// no error integrals and no estimate of its own), for the nested start and the error estimate; or
+/// nothing, with `skipped` saying why: the coarse grid checks the box's margin (2h), the boundary's reach
+/// and δ ≥ 4h with its own h, and may refuse what this grid takes. Its steps are reported as
+/// "N/2 <step>"; an interrupt asked there ends this solve too.
 template <int dim>
-ActiveSet nested_start(const State<dim>& st, const BasicContactData<dim>& data, const SolverOptions& options,
-                       const BoundaryDiscretization<dim>& fine, NestedStart& report) {
+std::optional<BasicSolution<dim>> coarse_solve(const State<dim>& st, const BasicContactData<dim>& data,
+                                               const SolverOptions& options, const BoundaryDiscretization<dim>& fine,
+                                               std::string& skipped) {
   const int N = st.grid.nx();
   if (N % 2 != 0) {
-    report.skipped = "N is odd";
-    return {};
+    skipped = "N is odd";
+    return std::nullopt;
   }
   if (N / 2 < minimum_nested_grid) {
-    report.skipped = "N/2 is below " + std::to_string(minimum_nested_grid);
-    return {};
+    skipped = "N/2 is below " + std::to_string(minimum_nested_grid);
+    return std::nullopt;
   }
   BasicProblem<dim> coarse;
   static_cast<BasicContactData<dim>&>(coarse) = data;
@@ -330,6 +331,8 @@ ActiveSet nested_start(const State<dim>& st, const BasicContactData<dim>& data, 
   coarse.box = st.grid.box(), coarse.boundary = st.grid.boundary(), coarse.N = N / 2, coarse.c = st.c;
   coarse.f = st.f, coarse.f_vectorized = st.f_vectorized;
   SolverOptions coarse_options = options;
+  coarse_options.error_estimate = false;
+  if constexpr (dim == 2) coarse_options.condition_number = false;
   if (options.multipliers > 0)
     coarse_options.multipliers = std::max(minimum_multipliers, int(std::lround(options.multipliers / 4.0)));
   coarse_options.offset = fine.spacing().offset / 2;  // δ = offset·s, and s doubles
@@ -340,26 +343,35 @@ ActiveSet nested_start(const State<dim>& st, const BasicContactData<dim>& data, 
   bool stop_asked = false;  // a data callback may turn an interrupt into invalid_argument (Python's Ctrl-C)
   const auto check = [&execution, &stop_asked] { return stop_asked = stop_asked || execution.interrupt_requested(); };
   try {
-    const BasicSolution<dim> s = solve(coarse, coarse_options, progress, check);
-    if (!s.newton.converged) {
-      report.skipped = "the solve on the grid of N/2 did not converge: " + s.newton.failure;
-      return {};
-    }
-    report.N = coarse.N;
-    report.multipliers = s.options.multipliers;
-    report.newton_steps = s.newton.iterations;
-    report.active = int(std::count(s.newton.active.begin(), s.newton.active.end(), 1));
-    return nearest_flags<dim>(s.points(), s.newton.active, fine.points(), execution);
+    BasicSolution<dim> s = solve(coarse, coarse_options, progress, check);
+    if (s.newton.converged) return s;
+    skipped = "the solve on the grid of N/2 did not converge: " + s.newton.failure;
   } catch (const Interrupted&) {
     throw;
   } catch (const std::runtime_error& e) {  // e.g. an empty patch
     if (stop_asked) throw Interrupted();
-    report.skipped = std::string("the solve on the grid of N/2 failed: ") + e.what();
+    skipped = std::string("the solve on the grid of N/2 failed: ") + e.what();
   } catch (const std::invalid_argument& e) {  // a grid too coarse for the boundary or the box
     if (stop_asked) throw Interrupted();
-    report.skipped = std::string("the grid of N/2 does not take the problem: ") + e.what();
+    skipped = std::string("the grid of N/2 does not take the problem: ") + e.what();
   }
-  return {};
+  return std::nullopt;
+}
+
+/// The nested start from the coarse solve: its active set carried to this grid's points (each takes
+/// the flag of the nearest coarse point), or nothing when there is no coarse solve.
+template <int dim>
+ActiveSet nested_start(const State<dim>& st, const std::optional<BasicSolution<dim>>& coarse,
+                       const std::string& skipped, const BoundaryDiscretization<dim>& fine, NestedStart& report) {
+  if (!coarse) {
+    report.skipped = skipped;
+    return {};
+  }
+  report.N = coarse->grid.nx();
+  report.multipliers = coarse->options.multipliers;
+  report.newton_steps = coarse->newton.iterations;
+  report.active = int(std::count(coarse->newton.active.begin(), coarse->newton.active.end(), 1));
+  return nearest_flags<dim>(coarse->points(), coarse->newton.active, fine.points(), st.execution);
 }
 
 /// Step 5: semismooth Newton on λ with the Schur blocks; where the far field was interpolated, on S̃
@@ -462,6 +474,86 @@ void errors(const State<dim>& st, const BoundaryDiscretization<dim>& boundary, c
   (void)st;
 }
 
+/// Step 9: the integrals over ω of û and f (docs/math.md, "Quantities"), and with a coarse solve
+/// ‖û − û_{N/2}‖²_{L²(ω)} in the same pass (`difference2`; û_{N/2} interpolated at the points).
+template <int dim>
+DomainQuantities domain_quantities(const State<dim>& st, const BoundaryDiscretization<dim>& boundary,
+                                   const GridVector& u, int quadrature, const BasicSolution<dim>* coarse,
+                                   double& difference2) {
+  const typename Fields<dim>::Vectorized f = st.f_vectorized ? st.f_vectorized : vectorize(st.f);
+  constexpr int K = 7;  // |ω|, ∫û, ∫û², ∫|∇û|², ∫f, ∫fû, ∫(û − û_{N/2})²
+  std::vector<std::array<double, K>> sums(std::size_t(st.execution.threads()), std::array<double, K>{});
+  std::vector<std::vector<double>> f_at(sums.size()), coarse_at(sums.size());
+  boundary.for_each_omega_sample(u, quadrature, [&](int thread, const OmegaSamples<dim>& row) {
+    std::vector<double>& fv = f_at[std::size_t(thread)];
+    std::vector<double>& cv = coarse_at[std::size_t(thread)];
+    evaluate_at(f, row.x, fv);
+    if (coarse) sample_q1_at<dim>(coarse->grid, coarse->u, row.x, cv);
+    std::array<double, K> r{};  // per row, then per thread
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      const double w = row.weight[k], v = row.value[k];
+      double grad2 = 0;
+      for (int d = 0; d < dim; ++d) grad2 += row.gradient[d][k] * row.gradient[d][k];
+      r[0] += w, r[1] += w * v, r[2] += w * v * v, r[3] += w * grad2, r[4] += w * fv[k], r[5] += w * fv[k] * v;
+      if (coarse) r[6] += w * (v - cv[k]) * (v - cv[k]);
+    }
+    for (int c = 0; c < K; ++c) sums[std::size_t(thread)][std::size_t(c)] += r[std::size_t(c)];
+  });
+  std::array<double, K> t{};
+  for (const auto& s : sums)
+    for (int c = 0; c < K; ++c) t[std::size_t(c)] += s[std::size_t(c)];
+  if (!std::isfinite(t[4]) || !std::isfinite(t[5])) throw std::invalid_argument("data.f: not finite somewhere in ω");
+  DomainQuantities q;
+  q.volume = t[0], q.integral_u = t[1], q.integral_u2 = t[2], q.integral_grad2 = t[3];
+  q.integral_f = t[4], q.integral_fu = t[5];
+  q.energy = 0.5 * q.integral_grad2 + 0.5 * st.c * q.integral_u2 - q.integral_fu;
+  q.flux = st.c * q.integral_u - q.integral_f;
+  difference2 = t[6];
+  return q;
+}
+
+/// Step 10: the error estimate from the solve on the grid of N/2 (docs/math.md, "The error estimate"):
+/// Richardson's |Q_N − Q_{N/2}|/(2^p − 1), p = 2 for û, the force and the energy, p = 1 for the contact
+/// measure (whole points enter and leave the contact set).
+template <int dim>
+ErrorEstimate error_estimate(const BasicSolution<dim>& coarse, const BasicSolution<dim>& fine, double difference2) {
+  constexpr double second_order = 3, first_order = 1;  // 2^p − 1
+  ErrorEstimate e;
+  e.N = coarse.grid.nx();
+  e.l2_omega = std::sqrt(difference2) / second_order;
+  const double norm = std::sqrt(fine.domain->integral_u2);
+  e.rel_l2_omega = norm > 0 ? e.l2_omega / norm : e.l2_omega;
+  e.force = std::abs(fine.domain->flux - coarse.domain->flux) / second_order;
+  e.energy = std::abs(fine.domain->energy - coarse.domain->energy) / second_order;
+  e.integral_u = std::abs(fine.domain->integral_u - coarse.domain->integral_u) / second_order;
+  e.measure = std::abs(contact_summary(fine).measure - contact_summary(coarse).measure) / first_order;
+  return e;
+}
+
+/// The warnings of the estimate and of the independent ∂u/∂n (docs/math.md, "The error estimate").
+template <int dim>
+void accuracy_warnings(BasicSolution<dim>& sol) {
+  char line[320];
+  if (sol.estimate && sol.estimate->skipped.empty() && sol.estimate->rel_l2_omega > estimate_warning) {
+    std::snprintf(line, sizeof line,
+                  "domain.N: the estimated error of u is %.2g %% of its L2(omega) norm (from the solve at N = %d): "
+                  "refine the grid for results to %g %%",
+                  100 * sol.estimate->rel_l2_omega, sol.estimate->N, 100 * estimate_warning);
+    sol.warnings.push_back(line);
+  }
+  if (sol.check && !sol.normal_derivative.empty()) {
+    double largest = 0;
+    for (double v : sol.normal_derivative) largest = std::max(largest, std::abs(v));
+    if (largest > 0 && sol.check->max_difference > disagreement_warning * largest) {
+      std::snprintf(line, sizeof line,
+                    "domain.N: the independent du/dn differs from the enforced one by %.2g %% of its largest value: "
+                    "the contact set and force are resolved to about that; refine the grid",
+                    100 * sol.check->max_difference / largest);
+      sol.warnings.push_back(line);
+    }
+  }
+}
+
 }  // namespace
 
 template <int dim>
@@ -476,11 +568,23 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
   BoundarySetup<dim>& setup = boundary_setup<dim>(st, data, options, clock, sol.reused_curve);  // 1–2
   st.execution.throw_if_interrupted();
   ActiveSet start;
-  if (dim == 3 && options.nested_start > 0 && st.grid.nx() >= options.nested_start) {  // nested start
-    sol.nested_start.emplace();
-    start = nested_start<dim>(st, data, options, *setup.boundary, *sol.nested_start);
-    clock.mark("nested_start");
-    sol.nested_start->seconds = sol.timings.phases.back().second;
+  const bool nested = dim == 3 && options.nested_start > 0 && st.grid.nx() >= options.nested_start;
+  const bool estimate = options.error_estimate && compute_field;
+  std::optional<BasicSolution<dim>> coarse;
+  std::string skipped;
+  if (nested || estimate) {  // the same problem on the grid of N/2
+    coarse = coarse_solve<dim>(st, data, options, *setup.boundary, skipped);
+    clock.mark(nested ? "nested_start" : "coarse_solve");
+    if (nested) {
+      sol.nested_start.emplace();
+      start = nested_start<dim>(st, coarse, skipped, *setup.boundary, *sol.nested_start);
+      sol.nested_start->seconds = sol.timings.phases.back().second;
+    }
+    if (estimate) {
+      sol.estimate.emplace();
+      sol.estimate->skipped = skipped;
+      sol.estimate->seconds = sol.timings.phases.back().second;
+    }
     st.execution.throw_if_interrupted();
   }
   load_and_u0<dim>(st, clock, sol.fast_solves);  // 0
@@ -513,6 +617,20 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
   if ((data.exact || data.exact_vectorized) && compute_field) {  // 8
     errors<dim>(st, boundary, data, options, sol);
     clock.mark("errors");
+  }
+  if (compute_field) {  // 9–10
+    double difference2 = 0;
+    const BasicSolution<dim>* from = coarse && coarse->domain ? &*coarse : nullptr;
+    sol.domain = domain_quantities<dim>(st, boundary, sol.u, options.error_quadrature, from, difference2);
+    if (from) {
+      const double seconds = sol.estimate->seconds;
+      sol.estimate = error_estimate<dim>(*from, sol, difference2);
+      sol.estimate->seconds = seconds;
+    } else if (sol.estimate && sol.estimate->skipped.empty()) {
+      sol.estimate->skipped = "the solve on the grid of N/2 made no field";
+    }
+    clock.mark("quantities");
+    accuracy_warnings<dim>(sol);
   }
   sol.options = options;
   sol.options.multipliers = boundary.spacing().m;

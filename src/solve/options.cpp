@@ -290,7 +290,8 @@ void data_and_solver_specs(std::vector<OptionSpec>& specs) {
   }
 }
 
-/// The rest of [solver]: memory, quadrature, the far field, the nested start, the condition number.
+/// The rest of [solver]: memory, quadrature, the far field, the nested start, the error estimate, the
+/// condition number.
 void more_solver_specs(std::vector<OptionSpec>& specs) {
   specs.push_back(number("solver", "max_memory", &SolverOptions::max_memory, 0.0, false, 1e6, false,
                          "GiB a solve may use (checked against an estimate before any grid array is made); "
@@ -315,6 +316,15 @@ void more_solver_specs(std::vector<OptionSpec>& specs) {
                            "grid of N/2 (0: never)");
     n.dims = {3};
     specs.push_back(n);
+  }
+  {
+    OptionSpec e = member(std::string("solver"), std::string("error_estimate"), OptionType::boolean,
+                          &SolverOptions::error_estimate,
+                          "estimate the errors of u, the force, the contact measure and the energy from the same "
+                          "problem solved on the grid of N/2 (the nested start's solve where there is one)");
+    e.rule = "true or false";
+    e.violation = [](const OptionValue&, int) { return std::string(); };
+    specs.push_back(e);
   }
   {
     OptionSpec c = member(std::string("solver"), std::string("condition_number"), OptionType::boolean,

@@ -24,10 +24,12 @@ ContactSummary contact_summary(const BasicSolution<dim>& s) {
     c.max_gap = std::max(c.max_gap, gap);
     if (s.newton.active[i] == 1) {
       ++c.points;
-      c.force += s.normal_derivative[i] * part[i];
+      c.force_patches += s.normal_derivative[i] * part[i];
       c.measure += part[i];
     }
   }
+  c.force_from_domain = s.domain.has_value();
+  c.force = s.domain ? s.domain->flux : c.force_patches;
   c.lambda = s.lambda_total;
   return c;
 }

@@ -216,6 +216,11 @@ std::optional<std::vector<double>> SurfaceDiscretization::independent_normal_der
   return std::nullopt;
 }
 
+void SurfaceDiscretization::for_each_omega_sample(const GridVector& u, int quadrature,
+                                        const OmegaSampleVisitor<3>& visit) const {
+  fictus::for_each_omega_sample(u, grid_, *gamma_, quadrature, execution_, visit);
+}
+
 ErrorNorms SurfaceDiscretization::errors(const GridVector& u, const std::vector<double>& trace, const Data& data,
                                          int quadrature) const {
   const VectorizedField3 exact = data.exact_vectorized ? data.exact_vectorized : vectorize(data.exact);

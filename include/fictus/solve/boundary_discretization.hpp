@@ -72,6 +72,9 @@ class BoundaryDiscretization {
   /// ∂u/∂n at the points by a rule independent of C_γ, and its name; nullopt where there is none.
   virtual std::optional<std::vector<double>> independent_normal_derivative(const GridVector& u,
                                                                            std::string& rule) const = 0;
+  /// u at the quadrature points of ω, a row at a time (the integrals over ω of a solution).
+  virtual void for_each_omega_sample(const GridVector& u, int quadrature,
+                                     const OmegaSampleVisitor<dim>& visit) const = 0;
   /// Errors of u against the exact solution of `data` in ω and on γ (`trace`: B_γu).
   virtual ErrorNorms errors(const GridVector& u, const std::vector<double>& trace, const Data& data,
                             int quadrature) const = 0;

@@ -5,6 +5,7 @@
 // so quadrature error is far below the discretization error. The geometry is only named here: a
 // curve's cut cells (curve_grid_intersection.hpp), a surface (surface.hpp) and its patches.
 #include <array>
+#include <cstddef>
 #include <functional>
 #include <vector>
 
@@ -53,6 +54,34 @@ ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surfac
 ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,
                           const std::vector<double>& trace, const VectorizedField3& exact,
                           const GradientField3& exact_gradient, int q = 3, const Execution& execution = Execution{});
+
+/// û sampled at the quadrature points of ω (whole cells by Gauss points, cells cut by γ by the rules
+/// that follow γ), one cell row at a time: what every integral over ω of a solution is made of.
+template <int dim>
+struct OmegaSamples {
+  std::array<std::vector<double>, dim> x;         // the points, one array per coordinate
+  std::vector<double> weight;                     // their quadrature weights
+  std::vector<double> value;                      // û there
+  std::array<std::vector<double>, dim> gradient;  // ∇û there
+  std::size_t size() const { return weight.size(); }
+};
+/// Called from `execution.threads()` threads at once, `thread` in [0, threads): keep sums per thread.
+template <int dim>
+using OmegaSampleVisitor = std::function<void(int thread, const OmegaSamples<dim>& row)>;
+void for_each_omega_sample(const GridVector& u_h, const CurveGridIntersection& gamma, int q, const Execution& execution,
+                           const OmegaSampleVisitor<2>& visit);
+void for_each_omega_sample(const GridVector& u_h, const Grid3& grid, const Surface& gamma, int q,
+                           const Execution& execution, const OmegaSampleVisitor<3>& visit);
+
+/// The Q1 field u_h of `grid` at the points x (one array per coordinate; points outside the box take
+/// the nearest cell's extension), into `out`.
+template <int dim>
+void sample_q1_at(const Grid<dim>& grid, const GridVector& u_h, const std::array<std::vector<double>, dim>& x,
+                  std::vector<double>& out);
+
+/// f at the points x (one array per coordinate), into `out`.
+void evaluate_at(const VectorizedField& f, const std::array<std::vector<double>, 2>& x, std::vector<double>& out);
+void evaluate_at(const VectorizedField3& f, const std::array<std::vector<double>, 3>& x, std::vector<double>& out);
 
 /// The coordinates of points as three arrays (for fields evaluated in batches).
 std::array<std::vector<double>, 3> coordinates(const std::vector<Point3>& points);
