@@ -122,17 +122,16 @@ void print_summary(const fictus::BasicSolution<dim>& s) {
         "max |difference| %.2e\n",
         s.check->rule.c_str(), s.check->min_normal_derivative, s.check->max_complementarity, s.check->max_difference);
   const fictus::ContactSummary c = fictus::contact_summary(s);
-  std::printf("contact: %ld points, %s %.6g, force %.9g (%s; patch sum %.9g)\n", c.points,
-              dim == 2 ? "length" : "area", c.measure, c.force,
-              c.force_from_domain ? "c int u - int f over omega" : "patch sum", c.force_patches);
+  std::printf("contact: %ld points, %s %.6g, force %.9g (%s; patch sum %.9g)\n", c.points, dim == 2 ? "length" : "area",
+              c.measure, c.force, c.force_from_domain ? "c int u - int f over omega" : "patch sum", c.force_patches);
   if (s.domain)
     std::printf("over omega: int u %.9g, int |grad u|^2 %.9g, energy %.9g\n", s.domain->integral_u,
                 s.domain->integral_grad2, s.domain->energy);
   if (s.estimate && s.estimate->skipped.empty())
     std::printf(
         "estimated errors (from N = %d): u %.2e relative in L2(omega), force %.2e, contact %s %.2e, energy %.2e\n",
-        s.estimate->N, s.estimate->rel_l2_omega, s.estimate->force, dim == 2 ? "length" : "area",
-        s.estimate->measure, s.estimate->energy);
+        s.estimate->N, s.estimate->rel_l2_omega, s.estimate->force, dim == 2 ? "length" : "area", s.estimate->measure,
+        s.estimate->energy);
   else if (s.estimate)
     std::printf("no error estimate (%s)\n", s.estimate->skipped.c_str());
   if (s.errors)

@@ -88,7 +88,10 @@ json errors_json(const ErrorNorms& e, const std::optional<PointErrors>& point_er
             {"rel_l2_omega", e.rel_l2_omega},
             {"rel_h1_omega", e.rel_h1_omega},
             {"rel_h1semi_omega", e.rel_h1semi_omega},
-            {"rel_l2_gamma", e.rel_l2_gamma}};
+            {"rel_l2_gamma", e.rel_l2_gamma},
+            {"integral_u", e.integral_u},
+            {"force", e.force},
+            {"energy", e.energy}};
   if (point_errors) {
     j["max_trace_at_points"] = point_errors->max_trace;
     j["max_normal_derivative_at_points"] = point_errors->max_normal_derivative;
@@ -142,8 +145,9 @@ json inner_json(const BasicSolution<dim>& s) {
 }
 
 json domain_json(const DomainQuantities& d) {
-  return {{"volume", d.volume},           {"integral_u", d.integral_u}, {"integral_u2", d.integral_u2},
-          {"integral_grad2", d.integral_grad2}, {"integral_f", d.integral_f}, {"integral_fu", d.integral_fu},
+  return {{"volume", d.volume},           {"integral_u", d.integral_u},
+          {"integral_u2", d.integral_u2}, {"integral_grad2", d.integral_grad2},
+          {"integral_f", d.integral_f},   {"integral_fu", d.integral_fu},
           {"energy", d.energy},           {"flux", d.flux}};
 }
 

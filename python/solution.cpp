@@ -170,6 +170,7 @@ py::object errors(const BasicSolution<dim>& s) {
   d["l2_gamma"] = e.l2_gamma, d["rel_l2_omega"] = e.rel_l2_omega;
   d["rel_h1_omega"] = e.rel_h1_omega, d["rel_h1semi_omega"] = e.rel_h1semi_omega;
   d["rel_l2_gamma"] = e.rel_l2_gamma;
+  d["integral_u"] = e.integral_u, d["force"] = e.force, d["energy"] = e.energy;
   if (const auto& pe = s.point_errors) {
     d["max_trace_at_points"] = pe->max_trace;
     d["max_normal_derivative_at_points"] = pe->max_normal_derivative;

@@ -240,7 +240,15 @@ def test_parameters_and_the_contact_summary_match_the_cli(tmp_path):
         text = handle.read().replace("N = 256", "N = 128").replace("height = 0.0", "height = 0.02")
     s = fictus.Problem.from_toml(text).solve()
     for key, value in results["contact"].items():
-        assert s.contact_summary[key] == pytest.approx(value, rel=1e-12, abs=1e-15), key
+        if isinstance(value, str):
+            assert s.contact_summary[key] == value, key
+        else:
+            assert s.contact_summary[key] == pytest.approx(value, rel=1e-12, abs=1e-15), key
+    for key, value in results["domain"].items():
+        assert s.domain[key] == pytest.approx(value, rel=1e-12, abs=1e-15), key
+    for key, value in results["estimate"].items():
+        if key != "seconds":
+            assert s.estimate[key] == pytest.approx(value, rel=1e-9, abs=1e-15), key
     assert s.contact_summary["points"] == int(s.contact.sum())
     d = fictus.Problem.from_dict({**CIRCLE, "parameters": {"a": 0.05},
                                   "data": {"f": "-1", "g": "a * x"}}).solve()
@@ -258,6 +266,8 @@ def test_surface_problem_matches_the_cli(tmp_path):
     assert results["dim"] == 3 and s.multipliers == results["multipliers"] == 129
     assert s.iterations == results["newton"]["iterations"]
     assert abs(s.errors["rel_l2_omega"] - results["errors"]["rel_l2_omega"]) < 1e-12
+    assert s.estimate["N"] == results["estimate"]["N"] == 32
+    assert s.domain["flux"] == pytest.approx(results["domain"]["flux"], rel=1e-12) == results["contact"]["force"]
     assert np.allclose(s.lambda_, [float(p["lambda"]) for p in points], rtol=1e-12, atol=1e-12)
     assert s.u.shape == (65, 65, 65) and s.points.shape == (129, 3)
     assert list(s.contact) == [p["contact"] == "1" for p in points]

@@ -191,7 +191,7 @@ std::vector<double> CurveDiscretization::obstacle(const Data& data) const {
 }
 
 void CurveDiscretization::for_each_omega_sample(const GridVector& u, int quadrature,
-                                        const OmegaSampleVisitor<2>& visit) const {
+                                                const OmegaSampleVisitor<2>& visit) const {
   fictus::for_each_omega_sample(u, *gamma_geometry_, quadrature, execution_, visit);
 }
 

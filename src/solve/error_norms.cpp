@@ -147,6 +147,8 @@ ErrorNorms norms_from(const std::array<double, 4>& omega, double boundary_error,
   n.rel_h1semi_omega = relative(n.h1semi_omega, std::sqrt(omega[3]));
   n.rel_h1_omega = relative(n.h1_omega, std::sqrt(omega[2] + omega[3]));
   n.rel_l2_gamma = relative(n.l2_gamma, std::sqrt(boundary_norm));
+  n.exact_l2_omega = std::sqrt(omega[2]);
+  n.exact_h1semi_omega = std::sqrt(omega[3]);
   return n;
 }
 
@@ -290,9 +292,9 @@ void sample_q1_at(const Grid<dim>& grid, const GridVector& u_h, const std::array
 }
 
 template void sample_q1_at<2>(const Grid<2>&, const GridVector&, const std::array<std::vector<double>, 2>&,
-                           std::vector<double>&);
+                              std::vector<double>&);
 template void sample_q1_at<3>(const Grid<3>&, const GridVector&, const std::array<std::vector<double>, 3>&,
-                           std::vector<double>&);
+                              std::vector<double>&);
 
 ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,
                           const std::vector<double>& trace, const VectorizedField3& exact,

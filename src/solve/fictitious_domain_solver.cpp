@@ -305,15 +305,16 @@ ActiveSet nearest_flags(const std::vector<Point<dim>>& from, const ActiveSet& fl
 
 namespace {
 
-/// The same problem on the grid of N/2 (m/4 points when m is given; Γ at the same distance δ from γ;
-/// no error integrals and no estimate of its own), for the nested start and the error estimate; or
+/// The same problem on the grid of N/2 as a user would solve it there (the options as given: m/2^(dim−1)
+/// points when m is given, δ by the offset rule of that grid; no error integrals and no estimate of its
+/// own), for the nested start and the error estimate: with δ ∝ h on both grids the two solves lie on
+/// the method's path of convergence, as Richardson's estimate needs. Or
 /// nothing, with `skipped` saying why: the coarse grid checks the box's margin (2h), the boundary's reach
 /// and δ ≥ 4h with its own h, and may refuse what this grid takes. Its steps are reported as
 /// "N/2 <step>"; an interrupt asked there ends this solve too.
 template <int dim>
 std::optional<BasicSolution<dim>> coarse_solve(const State<dim>& st, const BasicContactData<dim>& data,
-                                               const SolverOptions& options, const BoundaryDiscretization<dim>& fine,
-                                               std::string& skipped) {
+                                               const SolverOptions& options, std::string& skipped) {
   const int N = st.grid.nx();
   if (N % 2 != 0) {
     skipped = "N is odd";
@@ -334,8 +335,8 @@ std::optional<BasicSolution<dim>> coarse_solve(const State<dim>& st, const Basic
   coarse_options.error_estimate = false;
   if constexpr (dim == 2) coarse_options.condition_number = false;
   if (options.multipliers > 0)
-    coarse_options.multipliers = std::max(minimum_multipliers, int(std::lround(options.multipliers / 4.0)));
-  coarse_options.offset = fine.spacing().offset / 2;  // δ = offset·s, and s doubles
+    coarse_options.multipliers =
+        std::max(minimum_multipliers, int(std::lround(options.multipliers / (dim == 2 ? 2.0 : 4.0))));
   const Execution& execution = st.execution;
   const auto progress = [&execution](const std::string& phase, double seconds) {
     execution.report("N/2 " + phase, seconds);
@@ -479,16 +480,19 @@ void errors(const State<dim>& st, const BoundaryDiscretization<dim>& boundary, c
 template <int dim>
 DomainQuantities domain_quantities(const State<dim>& st, const BoundaryDiscretization<dim>& boundary,
                                    const GridVector& u, int quadrature, const BasicSolution<dim>* coarse,
-                                   double& difference2) {
+                                   const typename Fields<dim>::Vectorized& exact, double& difference2,
+                                   std::array<double, 2>& exact_integrals) {
   const typename Fields<dim>::Vectorized f = st.f_vectorized ? st.f_vectorized : vectorize(st.f);
-  constexpr int K = 7;  // |ω|, ∫û, ∫û², ∫|∇û|², ∫f, ∫fû, ∫(û − û_{N/2})²
+  constexpr int K = 9;  // |ω|, ∫û, ∫û², ∫|∇û|², ∫f, ∫fû, ∫(û − û_{N/2})², ∫u, ∫fu (u: the exact solution)
   std::vector<std::array<double, K>> sums(std::size_t(st.execution.threads()), std::array<double, K>{});
-  std::vector<std::vector<double>> f_at(sums.size()), coarse_at(sums.size());
+  std::vector<std::vector<double>> f_at(sums.size()), coarse_at(sums.size()), exact_at(sums.size());
   boundary.for_each_omega_sample(u, quadrature, [&](int thread, const OmegaSamples<dim>& row) {
     std::vector<double>& fv = f_at[std::size_t(thread)];
     std::vector<double>& cv = coarse_at[std::size_t(thread)];
+    std::vector<double>& ev = exact_at[std::size_t(thread)];
     evaluate_at(f, row.x, fv);
     if (coarse) sample_q1_at<dim>(coarse->grid, coarse->u, row.x, cv);
+    if (exact) evaluate_at(exact, row.x, ev);
     std::array<double, K> r{};  // per row, then per thread
     for (std::size_t k = 0; k < row.size(); ++k) {
       const double w = row.weight[k], v = row.value[k];
@@ -496,6 +500,7 @@ DomainQuantities domain_quantities(const State<dim>& st, const BoundaryDiscretiz
       for (int d = 0; d < dim; ++d) grad2 += row.gradient[d][k] * row.gradient[d][k];
       r[0] += w, r[1] += w * v, r[2] += w * v * v, r[3] += w * grad2, r[4] += w * fv[k], r[5] += w * fv[k] * v;
       if (coarse) r[6] += w * (v - cv[k]) * (v - cv[k]);
+      if (exact) r[7] += w * ev[k], r[8] += w * fv[k] * ev[k];
     }
     for (int c = 0; c < K; ++c) sums[std::size_t(thread)][std::size_t(c)] += r[std::size_t(c)];
   });
@@ -509,6 +514,7 @@ DomainQuantities domain_quantities(const State<dim>& st, const BoundaryDiscretiz
   q.energy = 0.5 * q.integral_grad2 + 0.5 * st.c * q.integral_u2 - q.integral_fu;
   q.flux = st.c * q.integral_u - q.integral_f;
   difference2 = t[6];
+  exact_integrals = {t[7], t[8]};
   return q;
 }
 
@@ -530,28 +536,16 @@ ErrorEstimate error_estimate(const BasicSolution<dim>& coarse, const BasicSoluti
   return e;
 }
 
-/// The warnings of the estimate and of the independent ∂u/∂n (docs/math.md, "The error estimate").
+/// The warning of the estimate (docs/math.md, "The error estimate").
 template <int dim>
-void accuracy_warnings(BasicSolution<dim>& sol) {
+void estimate_warning_line(BasicSolution<dim>& sol) {
+  if (!sol.estimate || !sol.estimate->skipped.empty() || !(sol.estimate->rel_l2_omega > estimate_warning)) return;
   char line[320];
-  if (sol.estimate && sol.estimate->skipped.empty() && sol.estimate->rel_l2_omega > estimate_warning) {
-    std::snprintf(line, sizeof line,
-                  "domain.N: the estimated error of u is %.2g %% of its L2(omega) norm (from the solve at N = %d): "
-                  "refine the grid for results to %g %%",
-                  100 * sol.estimate->rel_l2_omega, sol.estimate->N, 100 * estimate_warning);
-    sol.warnings.push_back(line);
-  }
-  if (sol.check && !sol.normal_derivative.empty()) {
-    double largest = 0;
-    for (double v : sol.normal_derivative) largest = std::max(largest, std::abs(v));
-    if (largest > 0 && sol.check->max_difference > disagreement_warning * largest) {
-      std::snprintf(line, sizeof line,
-                    "domain.N: the independent du/dn differs from the enforced one by %.2g %% of its largest value: "
-                    "the contact set and force are resolved to about that; refine the grid",
-                    100 * sol.check->max_difference / largest);
-      sol.warnings.push_back(line);
-    }
-  }
+  std::snprintf(line, sizeof line,
+                "domain.N: the estimated error of u is %.2g %% of its L2(omega) norm (from the solve at N = %d): "
+                "refine the grid for results to %g %%",
+                100 * sol.estimate->rel_l2_omega, sol.estimate->N, 100 * estimate_warning);
+  sol.warnings.push_back(line);
 }
 
 }  // namespace
@@ -573,7 +567,7 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
   std::optional<BasicSolution<dim>> coarse;
   std::string skipped;
   if (nested || estimate) {  // the same problem on the grid of N/2
-    coarse = coarse_solve<dim>(st, data, options, *setup.boundary, skipped);
+    coarse = coarse_solve<dim>(st, data, options, skipped);
     clock.mark(nested ? "nested_start" : "coarse_solve");
     if (nested) {
       sol.nested_start.emplace();
@@ -621,7 +615,18 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
   if (compute_field) {  // 9–10
     double difference2 = 0;
     const BasicSolution<dim>* from = coarse && coarse->domain ? &*coarse : nullptr;
-    sol.domain = domain_quantities<dim>(st, boundary, sol.u, options.error_quadrature, from, difference2);
+    std::array<double, 2> exact{};  // ∫u, ∫fu of the exact solution
+    typename Fields<dim>::Vectorized exact_u;
+    if (sol.errors) exact_u = data.exact_vectorized ? data.exact_vectorized : vectorize(data.exact);
+    sol.domain = domain_quantities<dim>(st, boundary, sol.u, quantity_quadrature, from, exact_u, difference2, exact);
+    if (sol.errors) {
+      ErrorNorms& e = *sol.errors;
+      const double energy = 0.5 * e.exact_h1semi_omega * e.exact_h1semi_omega +
+                            0.5 * st.c * e.exact_l2_omega * e.exact_l2_omega - exact[1];
+      e.integral_u = sol.domain->integral_u - exact[0];
+      e.force = st.c * e.integral_u;
+      e.energy = sol.domain->energy - energy;
+    }
     if (from) {
       const double seconds = sol.estimate->seconds;
       sol.estimate = error_estimate<dim>(*from, sol, difference2);
@@ -630,7 +635,7 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
       sol.estimate->skipped = "the solve on the grid of N/2 made no field";
     }
     clock.mark("quantities");
-    accuracy_warnings<dim>(sol);
+    estimate_warning_line<dim>(sol);
   }
   sol.options = options;
   sol.options.multipliers = boundary.spacing().m;

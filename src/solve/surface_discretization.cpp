@@ -217,7 +217,7 @@ std::optional<std::vector<double>> SurfaceDiscretization::independent_normal_der
 }
 
 void SurfaceDiscretization::for_each_omega_sample(const GridVector& u, int quadrature,
-                                        const OmegaSampleVisitor<3>& visit) const {
+                                                  const OmegaSampleVisitor<3>& visit) const {
   fictus::for_each_omega_sample(u, grid_, *gamma_, quadrature, execution_, visit);
 }
 

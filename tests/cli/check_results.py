@@ -50,7 +50,19 @@ def main(folder):
     assert math.isclose(sum(arcs), results["boundary"]["measure"], rel_tol=1e-9), (sum(arcs), results["boundary"])
     force = sum(float(c[9]) * float(c[6]) for c in columns if c[11] == "1")
     measure = sum(float(c[6]) for c in columns if c[11] == "1")
-    assert math.isclose(force, contact["force"], rel_tol=1e-9), (force, contact["force"])
+    assert math.isclose(force, contact["force_patches"], rel_tol=1e-9), (force, contact["force_patches"])
+    # The force from the domain identity, c∫û − ∫f, and the readings' patch sum: two rules for one number.
+    domain = results["domain"]
+    assert contact["force_rule"] == "domain" and contact["force"] == domain["flux"], (contact, domain)
+    c = results["options"]["c"]
+    assert math.isclose(domain["flux"], c * domain["integral_u"] - domain["integral_f"], rel_tol=1e-12, abs_tol=1e-15)
+    assert math.isclose(contact["force"], contact["force_patches"], rel_tol=0.05), contact
+    energy = 0.5 * domain["integral_grad2"] + 0.5 * c * domain["integral_u2"] - domain["integral_fu"]
+    assert math.isclose(domain["energy"], energy, rel_tol=1e-12, abs_tol=1e-15), domain
+    estimate = results["estimate"]
+    assert estimate["N"] == n // 2 and estimate["seconds"] > 0, estimate
+    for key in ("l2_omega", "rel_l2_omega", "force", "measure", "energy", "integral_u"):
+        assert math.isfinite(estimate[key]) and estimate[key] >= 0, f"estimate.{key} = {estimate[key]}"
     assert math.isclose(measure, contact["measure"], rel_tol=1e-9), (measure, contact["measure"])
     assert len(rows) == results["multipliers"] + 1
     print("results.json and points.csv OK")

@@ -39,8 +39,7 @@ class CurveDiscretization final : public BoundaryDiscretization<2> {
   void finish_field(const std::vector<double>& lambda, GridVector& u) const override;
   std::optional<std::vector<double>> independent_normal_derivative(const GridVector& u,
                                                                    std::string& rule) const override;
-  void for_each_omega_sample(const GridVector& u, int quadrature,
-                             const OmegaSampleVisitor<2>& visit) const override;
+  void for_each_omega_sample(const GridVector& u, int quadrature, const OmegaSampleVisitor<2>& visit) const override;
   ErrorNorms errors(const GridVector& u, const std::vector<double>& trace, const Data& data,
                     int quadrature) const override;
   /// ∂u/∂n of the exact solution from its gradient when given, else by a one-sided second-order

@@ -21,6 +21,10 @@ struct PatchedSurface;
 struct ErrorNorms {
   double l2_omega = 0, h1semi_omega = 0, h1_omega = 0, l2_gamma = 0;
   double rel_l2_omega = 0, rel_h1semi_omega = 0, rel_h1_omega = 0, rel_l2_gamma = 0;
+  double exact_l2_omega = 0, exact_h1semi_omega = 0;  // ‖u‖_{L²(ω)}, |u|_{H¹(ω)} of the exact solution
+  // The errors of the quantities (DomainQuantities) against the exact solution's, signed: ∫û − ∫u, the
+  // force's (c∫_ω (û − u): ∫f cancels) and the energy's J(û) − J(u). Set by the solver.
+  double integral_u = 0, force = 0, energy = 0;
 };
 
 /// Central differences of u with step 1e-6·(box width) where no gradient is given.

@@ -39,11 +39,11 @@ inline constexpr double far_field_hand_on = 0.05;
 inline constexpr double far_field_gmres_tolerance = 1e-13;
 /// The nested start's coarse grid has at least this many cells along x (solver.nested_start).
 inline constexpr int minimum_nested_grid = 8;
+/// Gauss points per direction of the integrals over ω of a solution (DomainQuantities): 2 integrate
+/// û², |∇û|² and the difference of two grids' fields exactly on whole cells, and f, fû to O(h⁴).
+inline constexpr int quantity_quadrature = 2;
 /// A warning when the estimated error of û passes this fraction of ‖û‖_{L²(ω)} (solver.error_estimate).
 inline constexpr double estimate_warning = 0.01;
-/// A warning when the independent ∂u/∂n differs from the enforced one by more than this fraction of
-/// the largest reading.
-inline constexpr double disagreement_warning = 0.05;
 
 template <int dim>
 class FictitiousDomainSolver {

@@ -81,29 +81,29 @@ struct FluxBalanceUse {
 /// (docs/math.md, "Quantities"): the energy J(û) = ½∫|∇û|² + ½c∫û² − ∫fû and the flux through γ,
 /// ∫_γ ∂u/∂n = ∫_ω (cu − f), which is the contact force (the free part of γ carries none).
 struct DomainQuantities {
-  double volume = 0;     // |ω| by the same rule (area in 2-D)
-  double integral_u = 0;  // ∫_ω û
-  double integral_u2 = 0;  // ∫_ω û²
+  double volume = 0;          // |ω| by the same rule (area in 2-D)
+  double integral_u = 0;      // ∫_ω û
+  double integral_u2 = 0;     // ∫_ω û²
   double integral_grad2 = 0;  // ∫_ω |∇û|²
-  double integral_f = 0;  // ∫_ω f
-  double integral_fu = 0;  // ∫_ω f û
-  double energy = 0;      // J(û)
-  double flux = 0;        // c∫_ω û − ∫_ω f
+  double integral_f = 0;      // ∫_ω f
+  double integral_fu = 0;     // ∫_ω f û
+  double energy = 0;          // J(û)
+  double flux = 0;            // c∫_ω û − ∫_ω f
 };
 
 /// Errors estimated from the same problem solved on the grid of N/2 (docs/math.md, "The error
 /// estimate"): for each quantity Q, |Q_N − Q_{N/2}|/(2^p − 1) with p its order (2; 1 for the contact
 /// measure), and ‖û_N − û_{N/2}‖_{L²(ω)}/3 for û; or, when that solve could not be made, why.
 struct ErrorEstimate {
-  int N = 0;                    // the coarse grid's
-  double l2_omega = 0;          // ‖û − u‖_{L²(ω)}
-  double rel_l2_omega = 0;      // the same over ‖û‖_{L²(ω)}
-  double force = 0;             // |force − exact force|
-  double measure = 0;           // |contact measure − exact|
-  double energy = 0;            // |J(û) − J(u)|
-  double integral_u = 0;        // |∫û − ∫u|
-  double seconds = 0;           // the coarse solve (shared with the nested start where there is one)
-  std::string skipped;          // non-empty: no estimate, and why
+  int N = 0;                // the coarse grid's
+  double l2_omega = 0;      // ‖û − u‖_{L²(ω)}
+  double rel_l2_omega = 0;  // the same over ‖û‖_{L²(ω)}
+  double force = 0;         // |force − exact force|
+  double measure = 0;       // |contact measure − exact|
+  double energy = 0;        // |J(û) − J(u)|
+  double integral_u = 0;    // |∫û − ∫u|
+  double seconds = 0;       // the coarse solve (shared with the nested start where there is one)
+  std::string skipped;      // non-empty: no estimate, and why
 };
 
 /// The points of γ a solution's values belong to, and the boundary carrying λ.
@@ -160,7 +160,7 @@ struct BasicSolution : SolutionBoundary<dim> {
   std::optional<NestedStart> nested_start;
   std::optional<FluxBalanceUse> flux_balance;
   SignoriniCheck signorini;
-  std::optional<IndependentCheck> check;  // with the field only
+  std::optional<IndependentCheck> check;   // with the field only
   std::optional<DomainQuantities> domain;  // with the field only
   std::optional<ErrorEstimate> estimate;   // with solver.error_estimate and the field
   std::optional<ErrorNorms> errors;
@@ -177,9 +177,9 @@ using SurfaceSolution = BasicSolution<3>;
 struct ContactSummary {
   long points = 0;     // points in contact (the active set)
   double measure = 0;  // length (2-D) or area (3-D) of the contact set: Σ over the contact points of their part
-  double force = 0;    // total contact force ∫ ∂u/∂n over the contact set: the flux c∫_ω û − ∫_ω f where the
-                       // field was computed (DomainQuantities), else force_patches
-  double force_patches = 0;  // the same as Σ_active (C_γû)_i·part_i: from the readings, a check of `force`
+  double force = 0;  // total contact force ∫ ∂u/∂n over the contact set: the flux c∫_ω û − ∫_ω f where the
+                     // field was computed (DomainQuantities), else force_patches
+  double force_patches = 0;        // the same as Σ_active (C_γû)_i·part_i: from the readings, a check of `force`
   bool force_from_domain = false;  // `force` is the domain identity
   double lambda = 0;   // ∫_Γ λ = Σ λ_i·|Γ_i| (BasicSolution::lambda_total): non-smooth, the jump [∂û/∂n]
                        // integrated over γ (it includes the fictitious field outside ω: not the

@@ -65,8 +65,7 @@ class SurfaceDiscretization final : public BoundaryDiscretization<3> {
   /// None in 3-D yet.
   std::optional<std::vector<double>> independent_normal_derivative(const GridVector& u,
                                                                    std::string& rule) const override;
-  void for_each_omega_sample(const GridVector& u, int quadrature,
-                             const OmegaSampleVisitor<3>& visit) const override;
+  void for_each_omega_sample(const GridVector& u, int quadrature, const OmegaSampleVisitor<3>& visit) const override;
   ErrorNorms errors(const GridVector& u, const std::vector<double>& trace, const Data& data,
                     int quadrature) const override;
   /// ∂u/∂n of the exact solution from its gradient when given, else central differences (step 1e-6·box width).
