@@ -145,11 +145,9 @@ void print_summary(const fictus::BasicSolution<dim>& s) {
 
 /// With any VTK file among `files`, solution.vtm naming them all (one file opens the run in ParaView).
 void add_multiblock(std::vector<fictus::cli::OutputFile>& files) {
-  static const std::vector<std::pair<std::string, std::string>> blocks = {{"solution.vti", "field"},
-                                                                          {"curves.vtp", "gamma"},
-                                                                          {"offset_curve.vtp", "Gamma"},
-                                                                          {"surface.vtp", "gamma"},
-                                                                          {"offset_surface.vtp", "Gamma"}};
+  static const std::vector<std::pair<std::string, std::string>> blocks = {
+      {"solution.vti", "field"}, {"curves.vtp", "gamma"},         {"offset_curve.vtp", "Gamma"},
+      {"surface.vtp", "gamma"},  {"offset_surface.vtp", "Gamma"}, {"contact_boundary.vtp", "contact boundary"}};
   std::vector<std::pair<std::string, std::string>> named;  // (block, file)
   for (const auto& [file, block] : blocks)
     if (std::any_of(files.begin(), files.end(), [&](const auto& f) { return f.name == file; }))
@@ -228,6 +226,8 @@ std::vector<fictus::cli::OutputFile> output_files(const fictus::BasicProblemSpec
     else if (name == "solution.vti")
       files.push_back({name, [&](std::ostream& out) { fictus::cli::write_vti(out, spec.problem, s); }});
     if (name != boundary_file) continue;
+    files.push_back(
+        {"contact_boundary.vtp", [&](std::ostream& out) { fictus::cli::write_contact_boundary_vtp(out, s); }});
     if constexpr (dim == 2) {
       files.push_back({name, [&](std::ostream& out) { fictus::cli::write_curve_vtp(out, s); }});
       if (s.delta > 0)

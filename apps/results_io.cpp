@@ -205,12 +205,19 @@ json solution_to_json(const BasicProblem<dim>& problem, const BasicSolution<dim>
   const ContactSummary contact = contact_summary(s);
   j["contact"] = {{"points", contact.points},
                   {"measure", contact.measure},
+                  {"measure_points", contact.measure_points},
                   {"force", contact.force},
                   {"force_patches", contact.force_patches},
                   {"force_rule", contact.force_from_domain ? "domain" : "patches"},
                   {"lambda_integral", contact.lambda},
                   {"min_gap", contact.min_gap},
                   {"max_gap", contact.max_gap}};
+  j["contact"]["boundary"] = json::array();
+  for (const Point<dim>& x : s.contact_boundary) {
+    json p = json::array();
+    for (int d = 0; d < dim; ++d) p.push_back(x[d]);
+    j["contact"]["boundary"].push_back(p);
+  }
   j["domain"] = s.domain ? domain_json(*s.domain) : json(nullptr);
   j["estimate"] = s.estimate ? estimate_json(*s.estimate) : json(nullptr);
   j["flux_balance"] = s.flux_balance ? json{{"scatter", s.flux_balance->scatter},

@@ -201,10 +201,13 @@ int run_sweep_in(const std::string& text, const SweepArguments& args, const Opti
   const Family family = family_of(args, base);
   if (dim == 2 && flags.given("condition_number") && base.options.condition_number)
     throw std::invalid_argument("solver.condition_number: not computed in a sweep (solve one problem for cond(S))");
+  if (flags.given("error_estimate") && base.options.error_estimate)
+    throw std::invalid_argument("solver.error_estimate: not computed in a sweep (solve one member for its estimate)");
   for (const std::string& w : base.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
   if (!args.out.empty()) check_output_folder(args.out, {"sweep.csv", "sweep.json"});
   SolverOptions options = base.options;
   if constexpr (dim == 2) options.condition_number = false;  // not a column of the sweep
+  options.error_estimate = false;  // nor is the estimate: a member's N/2 solve would not reuse the blocks
   check_memory(base.problem, options);
   const auto setup_start = std::chrono::steady_clock::now();
   FictitiousDomainSolver<dim> solver(base.problem, options);
@@ -228,7 +231,7 @@ int run_sweep_in(const std::string& text, const SweepArguments& args, const Opti
     try {
       const BasicProblem<dim> problem = member(family, base, args, text, flags, v);
       if (family.changes_load) solver.replace_load(problem);
-      s = solver.solve(problem, options, false);  // boundary quantities only
+      s = solver.solve(problem, options);  // with the field, for the force c∫û − ∫f
     } catch (const std::invalid_argument& e) {
       std::ostringstream at;
       at.precision(12);

@@ -177,12 +177,11 @@ void write_image(std::ostream& out, std::array<int, 3> n, Point3 origin, Point3 
   write_appended(out, xml.str(), data.arrays, threads);
 }
 
-/// PolyData of `points` (3 coordinates each) with lines or triangles (`cells` of `corners` points
-/// each, by point index), and point and cell data.
+/// PolyData of `points` (3 coordinates each) with cells of `kind` ("Verts", "Lines" or "Polys": the
+/// points of cell k, by index, are connectivity[offsets[k − 1] … offsets[k]]), and point and cell data.
 void write_poly(std::ostream& out, const std::vector<double>& points, const std::vector<std::int64_t>& connectivity,
-                const std::vector<std::int64_t>& offsets, bool lines, const DataArrays& point_data,
+                const std::vector<std::int64_t>& offsets, const char* kind, const DataArrays& point_data,
                 const DataArrays& cell_data, int threads) {
-  const char* kind = lines ? "Lines" : "Polys";
   std::string xml = header("PolyData") + "  <PolyData>\n    <Piece NumberOfPoints=\"" +
                     std::to_string(points.size() / 3) + "\" NumberOf" + kind + "=\"" + std::to_string(offsets.size()) +
                     "\">\n      <PointData>\n" + point_data.xml + "      </PointData>\n      <CellData>\n" +
@@ -242,7 +241,7 @@ void write_closed_line(std::ostream& out, const std::vector<Point2>& p, const Da
     connectivity.push_back(std::int64_t(i));
   }
   connectivity.push_back(0);
-  write_poly(out, points, connectivity, {std::int64_t(m + 1)}, true, point_data, {}, threads);
+  write_poly(out, points, connectivity, {std::int64_t(m + 1)}, "Lines", point_data, {}, threads);
 }
 
 }  // namespace
@@ -353,7 +352,7 @@ void write_patched(std::ostream& out, const PatchedSurface& surface,
     cell_data.add("Float64", per_patch[k].first,
                   computed<double>(T, [&v, &patch](std::size_t t) { return v[std::size_t(patch[t])]; }));
   }
-  write_poly(out, points, connectivity, offsets, false, point_data, cell_data, threads);
+  write_poly(out, points, connectivity, offsets, "Polys", point_data, cell_data, threads);
 }
 
 }  // namespace
@@ -370,6 +369,21 @@ void write_surface_vtp(std::ostream& out, const SurfaceSolution& s) {
 void write_offset_surface_vtp(std::ostream& out, const SurfaceSolution& s) {
   write_patched(out, s.Gamma, {{"lambda", &s.lambda}}, s.options.threads);
 }
+
+template <int dim>
+void write_contact_boundary_vtp(std::ostream& out, const BasicSolution<dim>& s) {
+  std::vector<double> points;
+  std::vector<std::int64_t> connectivity, offsets;
+  for (const Point<dim>& x : s.contact_boundary) {
+    for (int d = 0; d < 3; ++d) points.push_back(d < dim ? x[d] : 0.0);
+    connectivity.push_back(std::int64_t(offsets.size()));
+    offsets.push_back(std::int64_t(offsets.size() + 1));
+  }
+  write_poly(out, points, connectivity, offsets, "Verts", {}, {}, s.options.threads);
+}
+
+template void write_contact_boundary_vtp(std::ostream&, const BasicSolution<2>&);
+template void write_contact_boundary_vtp(std::ostream&, const BasicSolution<3>&);
 
 void write_vtm(std::ostream& out, const std::vector<std::pair<std::string, std::string>>& blocks) {
   out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"vtkMultiBlockDataSet\" version=\"1.0\" "

@@ -9,6 +9,8 @@
 //   surface.vtp          3-D: γ's triangles with shared points, the values of each patch as cell data
 //                        and their area-weighted means at the points as point data;
 //   offset_surface.vtp   3-D, smooth variant: Γ's triangles with λ;
+//   contact_boundary.vtp where the contact ends on γ, one vertex per active–free pair of neighbouring
+//                        points (the contact set resolved inside the points' parts, docs/math.md);
 //   solution.vtm         a multiblock file naming the others: opens a whole run in ParaView.
 #include <ostream>
 #include <string>
@@ -40,6 +42,10 @@ void write_vti(std::ostream& out, const SurfaceProblem& problem, const SurfaceSo
 void write_surface_vtp(std::ostream& out, const SurfaceSolution& solution);
 /// 3-D, smooth variant: Γ's triangles, cell data patch, normal and lambda, point data lambda.
 void write_offset_surface_vtp(std::ostream& out, const SurfaceSolution& solution);
+
+/// Both dimensions: the points of solution.contact_boundary as vertices.
+template <int dim>
+void write_contact_boundary_vtp(std::ostream& out, const BasicSolution<dim>& solution);
 
 /// A vtkMultiBlockDataSet file naming (block name, file name) pairs, the files beside it.
 void write_vtm(std::ostream& out, const std::vector<std::pair<std::string, std::string>>& blocks);

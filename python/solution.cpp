@@ -127,6 +127,11 @@ py::dict contact(const BasicSolution<dim>& s) {
   py::dict d;
   d["points"] = c.points;
   d["measure"] = c.measure;
+  d["measure_points"] = c.measure_points;
+  py::array_t<double> ends({py::ssize_t(s.contact_boundary.size()), py::ssize_t(dim)});
+  for (std::size_t k = 0; k < s.contact_boundary.size(); ++k)
+    for (int a = 0; a < dim; ++a) ends.mutable_at(py::ssize_t(k), py::ssize_t(a)) = s.contact_boundary[k][a];
+  d["boundary"] = ends;  // the located contact ends, one row per point
   d["force"] = c.force;
   d["force_patches"] = c.force_patches;
   d["force_rule"] = c.force_from_domain ? "domain" : "patches";

@@ -307,8 +307,9 @@ namespace {
 
 /// The same problem on the grid of N/2 as a user would solve it there (the options as given: m/2^(dim−1)
 /// points when m is given, δ by the offset rule of that grid; no error integrals and no estimate of its
-/// own), for the nested start and the error estimate: with δ ∝ h on both grids the two solves lie on
-/// the method's path of convergence, as Richardson's estimate needs. Or
+/// own; an offset given that does not fit there is replaced by that grid's rule), for the nested start
+/// and the error estimate: with δ ∝ h on both grids the two solves lie on the method's path of
+/// convergence, as Richardson's estimate needs. Or
 /// nothing, with `skipped` saying why: the coarse grid checks the box's margin (2h), the boundary's reach
 /// and δ ≥ 4h with its own h, and may refuse what this grid takes. Its steps are reported as
 /// "N/2 <step>"; an interrupt asked there ends this solve too.
@@ -344,8 +345,16 @@ std::optional<BasicSolution<dim>> coarse_solve(const State<dim>& st, const Basic
   bool stop_asked = false;  // a data callback may turn an interrupt into invalid_argument (Python's Ctrl-C)
   const auto check = [&execution, &stop_asked] { return stop_asked = stop_asked || execution.interrupt_requested(); };
   try {
-    BasicSolution<dim> s = solve(coarse, coarse_options, progress, check);
-    if (s.newton.converged) return s;
+    std::optional<BasicSolution<dim>> made;
+    try {
+      made.emplace(solve(coarse, coarse_options, progress, check));
+    } catch (const std::invalid_argument& e) {  // an offset given for this grid may not fit on that one:
+      if (coarse_options.offset == 0 || std::string(e.what()).rfind("formulation.offset", 0) != 0 || stop_asked) throw;
+      coarse_options.offset = 0;  // then δ by that grid's own rule
+      made.emplace(solve(coarse, coarse_options, progress, check));
+    }
+    BasicSolution<dim>& s = *made;
+    if (s.newton.converged) return std::move(s);
     skipped = "the solve on the grid of N/2 did not converge: " + s.newton.failure;
   } catch (const Interrupted&) {
     throw;
@@ -607,6 +616,7 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
                                  sol.newton.normal_derivative.data() + sol.newton.normal_derivative.size());
   }
   signorini_checks<dim>(boundary, sol);  // 7
+  resolve_contact<dim>(sol);
   if (compute_field) clock.mark("check");
   if ((data.exact || data.exact_vectorized) && compute_field) {  // 8
     errors<dim>(st, boundary, data, options, sol);

@@ -1,8 +1,11 @@
 #include "fictus/solve/solution.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
+#include <tuple>
 
 namespace fictus {
 
@@ -25,13 +28,94 @@ ContactSummary contact_summary(const BasicSolution<dim>& s) {
     if (s.newton.active[i] == 1) {
       ++c.points;
       c.force_patches += s.normal_derivative[i] * part[i];
-      c.measure += part[i];
+      c.measure_points += part[i];
     }
   }
+  c.measure = s.contact_measure;
   c.force_from_domain = s.domain.has_value();
   c.force = s.domain ? s.domain->flux : c.force_patches;
   c.lambda = s.lambda_total;
   return c;
+}
+
+template <>
+std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<2>& b) {
+  const Collocation& c = b.collocation;
+  std::vector<NeighbourPair> pairs;
+  for (int i = 0; i < c.m && c.m > 1; ++i) {
+    const int j = (i + 1) % c.m;
+    const double d = j > i ? c.s[std::size_t(j)] - c.s[std::size_t(i)] : c.length - c.s[std::size_t(i)] + c.s[0];
+    pairs.push_back({i, j, d, 1.0});
+  }
+  return pairs;
+}
+
+template <>
+std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<3>& b) {
+  // Vertices by their coordinates (a triangulation's shared vertices are the same doubles), then each
+  // edge with its triangles' patches: an edge between two patches is part of their border.
+  std::map<std::tuple<double, double, double>, int> vertex;
+  const auto id = [&vertex](const Point3& p) {
+    return vertex.emplace(std::make_tuple(p.x, p.y, p.z), int(vertex.size())).first->second;
+  };
+  std::map<std::pair<int, int>, std::pair<int, double>> edge_patch;  // edge → (first patch, length)
+  std::map<std::pair<int, int>, double> border;                      // (patch i < j) → shared length
+  const PatchedSurface& s = b.gamma;
+  for (std::size_t t = 0; t < s.triangles.size(); ++t) {
+    const Point3 v[3] = {s.triangles[t].a, s.triangles[t].b, s.triangles[t].c};
+    const int ids[3] = {id(v[0]), id(v[1]), id(v[2])};
+    for (int e = 0; e < 3; ++e) {
+      const int a = ids[e], c = ids[(e + 1) % 3];
+      const std::pair<int, int> key{std::min(a, c), std::max(a, c)};
+      const auto [it, first] = edge_patch.emplace(key, std::make_pair(s.patch_of[t], norm(v[e] - v[(e + 1) % 3])));
+      if (!first && it->second.first != s.patch_of[t]) {
+        const int p = it->second.first, q = s.patch_of[t];
+        border[{std::min(p, q), std::max(p, q)}] += it->second.second;
+      }
+    }
+  }
+  std::vector<NeighbourPair> pairs;
+  for (const auto& [key, length] : border)
+    pairs.push_back(
+        {key.first, key.second, norm(s.point[std::size_t(key.first)] - s.point[std::size_t(key.second)]), length});
+  return pairs;
+}
+
+double contact_end_fraction(double q, double r, double d) {
+  if (!(q > 0)) return 0.0;
+  if (!(r > 0) || !(d > 0)) return 1.0;
+  const double rho = q * d / (1.5 * r);
+  double lo = 0, hi = 1;  // √θ/(1 − θ)^{3/2} increases from 0 to ∞ on (0, 1)
+  for (int k = 0; k < 60; ++k) {
+    const double theta = 0.5 * (lo + hi);
+    (std::sqrt(theta) / std::pow(1 - theta, 1.5) < rho ? lo : hi) = theta;
+  }
+  return 0.5 * (lo + hi);
+}
+
+template <int dim>
+void resolve_contact(BasicSolution<dim>& s) {
+  const std::vector<double>& part = s.weights();
+  double measure = 0, total = 0;
+  for (int i = 0; i < s.n_points(); ++i) {
+    total += part[std::size_t(i)];
+    if (s.newton.active[std::size_t(i)] == 1) measure += part[std::size_t(i)];
+  }
+  s.contact_boundary.clear();
+  // The part of d between the points that each owns, in proportion to their parts' sizes.
+  const auto size = [&part](int i) { return dim == 2 ? part[std::size_t(i)] : std::sqrt(part[std::size_t(i)]); };
+  for (const NeighbourPair& p : neighbour_pairs<dim>(s)) {
+    const bool i_active = s.newton.active[std::size_t(p.i)] == 1, j_active = s.newton.active[std::size_t(p.j)] == 1;
+    if (i_active == j_active) continue;
+    const int a = i_active ? p.i : p.j, b = i_active ? p.j : p.i;
+    const double q = s.normal_derivative[std::size_t(a)], r = s.trace[std::size_t(b)] - s.g[std::size_t(b)];
+    const double theta = contact_end_fraction(q, r, p.distance);
+    const double owned = p.distance * size(a) / (size(a) + size(b));
+    measure += (theta * p.distance - owned) * p.border;
+    s.contact_boundary.push_back(s.points()[std::size_t(a)] +
+                                 theta * (s.points()[std::size_t(b)] - s.points()[std::size_t(a)]));
+  }
+  s.contact_measure = std::clamp(measure, 0.0, total);
 }
 
 template <int dim>
@@ -55,6 +139,8 @@ std::string describe_newton_failure(const BasicSolution<dim>& s) {
 template ContactSummary contact_summary(const BasicSolution<2>&);
 template ContactSummary contact_summary(const BasicSolution<3>&);
 template std::string describe_newton_failure(const BasicSolution<2>&);
+template void resolve_contact(BasicSolution<2>&);
+template void resolve_contact(BasicSolution<3>&);
 template std::string describe_newton_failure(const BasicSolution<3>&);
 
 }  // namespace fictus

@@ -74,13 +74,22 @@ def main(folder):
         with open(f"{folder}/{name}", "rb") as handle:
             head = handle.read(2048)
         assert b'compressor="vtkZLibDataCompressor"' in head and b'format="ascii"' not in head, name
-    # solution.vtm opens the run: the field, γ and (smooth) Γ as blocks
+    # contact_boundary.vtp: the contact ends located between neighbouring points, as vertices
+    ends = vtkXMLPolyDataReader()
+    ends.SetFileName(f"{folder}/contact_boundary.vtp")
+    ends.Update()
+    with open(f"{folder}/results.json") as handle:
+        located = json.load(handle)["contact"]["boundary"]
+    points = vtk_to_numpy(ends.GetOutput().GetPoints().GetData())
+    assert ends.GetOutput().GetNumberOfVerts() == len(located) >= 2, located
+    assert np.allclose(points[:, :2], np.array(located), rtol=0, atol=1e-15)
+    # solution.vtm opens the run: the field, γ, (smooth) Γ and the contact boundary as blocks
     multi = vtkXMLMultiBlockDataReader()
     multi.SetFileName(f"{folder}/solution.vtm")
     multi.Update()
     blocks = multi.GetOutput()
     names = [blocks.GetMetaData(k).Get(blocks.NAME()) for k in range(blocks.GetNumberOfBlocks())]
-    assert names == ["field", "gamma"] + (["Gamma"] if smooth else []), names
+    assert names == ["field", "gamma"] + (["Gamma"] if smooth else []) + ["contact boundary"], names
     assert blocks.GetBlock(1).GetNumberOfPoints() == m
     print(f"{folder}: VTK files OK")
 

@@ -59,6 +59,7 @@ WALK = {
     "far_field": False,
     "flux_balance": False,
     "nested_start": 28,
+    "error_estimate": False,
     "condition_number": False,
 }
 

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "fictus/solve/fictitious_domain_solver.hpp"
 #include "fictus/boundary/omega_quadrature.hpp"
 #include "fictus/boundary/surface.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
 #include "fictus/solve/surface_discretization.hpp"
 
 namespace manufactured3d {

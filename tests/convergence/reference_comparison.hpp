@@ -62,8 +62,9 @@ inline fictus::Point2 boundary_point(const Reference& r, double theta) {
 }
 
 struct Comparison {
-  fictus::LevelResult level;      // relative errors against the reference
-  double end_error_spacings = 0;  // largest distance of a reference contact end to fictus's, in s = L/m
+  fictus::LevelResult level;               // relative errors against the reference
+  double end_error_spacings = 0;           // largest distance of a reference contact end to fictus's, in s = L/m
+  double resolved_end_error_spacings = 0;  // the same for the ends located inside the arcs (contact_boundary)
 };
 
 inline Comparison compare(const Reference& r, const fictus::Solution& s) {
@@ -107,11 +108,17 @@ inline Comparison compare(const Reference& r, const fictus::Solution& s) {
   for (int i = 0; i < m; ++i)
     if (s.newton.active[i] != s.newton.active[(i + 1) % m])
       ends.push_back(0.5 * (s.collocation.point[i] + s.collocation.point[(i + 1) % m]));
-  for (double theta : r.ends) {
-    double best = 1e300;
-    for (const fictus::Point2& e : ends) best = std::min(best, fictus::norm(e - boundary_point(r, theta)));
-    c.end_error_spacings = std::max(c.end_error_spacings, best / s.collocation.spacing);
-  }
+  const auto largest_distance = [&](const std::vector<fictus::Point2>& found) {
+    double largest = 0;
+    for (double theta : r.ends) {
+      double best = 1e300;
+      for (const fictus::Point2& e : found) best = std::min(best, fictus::norm(e - boundary_point(r, theta)));
+      largest = std::max(largest, best / s.collocation.spacing);
+    }
+    return largest;
+  };
+  c.end_error_spacings = largest_distance(ends);
+  c.resolved_end_error_spacings = largest_distance(s.contact_boundary);
   return c;
 }
 

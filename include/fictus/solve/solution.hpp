@@ -163,6 +163,10 @@ struct BasicSolution : SolutionBoundary<dim> {
   std::optional<IndependentCheck> check;   // with the field only
   std::optional<DomainQuantities> domain;  // with the field only
   std::optional<ErrorEstimate> estimate;   // with solver.error_estimate and the field
+  // The contact set resolved inside the points' parts (docs/math.md, "The contact set"): where γ leaves
+  // contact between an active point and its free neighbour, and the measure that follows.
+  std::vector<Point<dim>> contact_boundary;  // one point per active–free pair of neighbours
+  double contact_measure = 0;                // length (2-D) or area (3-D)
   std::optional<ErrorNorms> errors;
   std::optional<PointErrors> point_errors;
   Timings timings;
@@ -172,11 +176,32 @@ struct BasicSolution : SolutionBoundary<dim> {
 using Solution = BasicSolution<2>;
 using SurfaceSolution = BasicSolution<3>;
 
+/// Neighbouring points of γ: consecutive points of a curve, patches sharing a triangle edge of a surface.
+struct NeighbourPair {
+  int i = 0, j = 0;
+  double distance = 0;  // between x_i and x_j (along the curve in 2-D, the chord in 3-D)
+  double border = 0;    // the measure of the parts' common border: 1 in 2-D, the shared edges' length in 3-D
+};
+template <int dim>
+std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<dim>& boundary);
+
+/// Where the contact ends between an active point (its reading q > 0) and its free neighbour (gap r > 0)
+/// a distance d away, as the fraction θ of d from the active point: the generic Signorini end, gap
+/// K·t^{3/2} on the free side and ∂u/∂n = (3/2)K·t^{1/2} on the contact side (t: distance to the end),
+/// through both values: √θ/(1 − θ)^{3/2} = q·d/(1.5·r).
+double contact_end_fraction(double q, double r, double d);
+
+/// Sets solution.contact_boundary and solution.contact_measure from the per-point values.
+template <int dim>
+void resolve_contact(BasicSolution<dim>& solution);
+
 /// The contact in numbers, from the per-point values of a solution (point i owns the part
 /// weights()[i] of γ: an arc length in 2-D, a patch area in 3-D).
 struct ContactSummary {
-  long points = 0;     // points in contact (the active set)
-  double measure = 0;  // length (2-D) or area (3-D) of the contact set: Σ over the contact points of their part
+  long points = 0;            // points in contact (the active set)
+  double measure = 0;         // length (2-D) or area (3-D) of the contact set, resolved inside the parts
+                              // (BasicSolution::contact_measure)
+  double measure_points = 0;  // the same as Σ over the contact points of their part
   double force = 0;  // total contact force ∫ ∂u/∂n over the contact set: the flux c∫_ω û − ∫_ω f where the
                      // field was computed (DomainQuantities), else force_patches
   double force_patches = 0;        // the same as Σ_active (C_γû)_i·part_i: from the readings, a check of `force`
