@@ -218,6 +218,8 @@ json solution_to_json(const BasicProblem<dim>& problem, const BasicSolution<dim>
     for (int d = 0; d < dim; ++d) p.push_back(x[d]);
     j["contact"]["boundary"].push_back(p);
   }
+  j["contact"]["boundary_lines"] = json::array();  // 3-D: consecutive points of contact.boundary
+  for (const auto& line : s.contact_boundary_lines) j["contact"]["boundary_lines"].push_back({line[0], line[1]});
   j["domain"] = s.domain ? domain_json(*s.domain) : json(nullptr);
   j["estimate"] = s.estimate ? estimate_json(*s.estimate) : json(nullptr);
   j["flux_balance"] = s.flux_balance ? json{{"scatter", s.flux_balance->scatter},

@@ -177,22 +177,34 @@ void write_image(std::ostream& out, std::array<int, 3> n, Point3 origin, Point3 
   write_appended(out, xml.str(), data.arrays, threads);
 }
 
-/// PolyData of `points` (3 coordinates each) with cells of `kind` ("Verts", "Lines" or "Polys": the
-/// points of cell k, by index, are connectivity[offsets[k − 1] … offsets[k]]), and point and cell data.
-void write_poly(std::ostream& out, const std::vector<double>& points, const std::vector<std::int64_t>& connectivity,
-                const std::vector<std::int64_t>& offsets, const char* kind, const DataArrays& point_data,
-                const DataArrays& cell_data, int threads) {
+/// One kind of cells of a PolyData: "Verts", "Lines" or "Polys"; the points of cell k, by index, are
+/// connectivity[offsets[k − 1] … offsets[k]].
+struct PolyCells {
+  const char* kind;
+  std::vector<std::int64_t> connectivity, offsets;
+};
+
+/// PolyData of `points` (3 coordinates each) with the cells of `sections` (in VTK's order: verts,
+/// lines, polys), and point and cell data.
+void write_poly(std::ostream& out, const std::vector<double>& points, const std::vector<PolyCells>& sections,
+                const DataArrays& point_data, const DataArrays& cell_data, int threads) {
+  std::string counts, cells;
+  for (const PolyCells& c : sections) {
+    counts += std::string(" NumberOf") + c.kind + "=\"" + std::to_string(c.offsets.size()) + "\"";
+    cells += std::string("      <") + c.kind + ">\n" + array_xml("Int64", "connectivity") +
+             array_xml("Int64", "offsets") + "      </" + c.kind + ">\n";
+  }
   std::string xml = header("PolyData") + "  <PolyData>\n    <Piece NumberOfPoints=\"" +
-                    std::to_string(points.size() / 3) + "\" NumberOf" + kind + "=\"" + std::to_string(offsets.size()) +
-                    "\">\n      <PointData>\n" + point_data.xml + "      </PointData>\n      <CellData>\n" +
-                    cell_data.xml + "      </CellData>\n      <Points>\n" + array_xml("Float64", "points", 3) +
-                    "      </Points>\n      <" + kind + ">\n" + array_xml("Int64", "connectivity") +
-                    array_xml("Int64", "offsets") + "      </" + kind + ">\n    </Piece>\n  </PolyData>\n";
+                    std::to_string(points.size() / 3) + "\"" + counts + ">\n      <PointData>\n" + point_data.xml +
+                    "      </PointData>\n      <CellData>\n" + cell_data.xml + "      </CellData>\n      <Points>\n" +
+                    array_xml("Float64", "points", 3) + "      </Points>\n" + cells + "    </Piece>\n  </PolyData>\n";
   std::vector<Appended> arrays = point_data.arrays;
   arrays.insert(arrays.end(), cell_data.arrays.begin(), cell_data.arrays.end());
   arrays.push_back(values_of(points));
-  arrays.push_back(values_of(connectivity));
-  arrays.push_back(values_of(offsets));
+  for (const PolyCells& c : sections) {
+    arrays.push_back(values_of(c.connectivity));
+    arrays.push_back(values_of(c.offsets));
+  }
   write_appended(out, xml, arrays, threads);
 }
 
@@ -241,7 +253,7 @@ void write_closed_line(std::ostream& out, const std::vector<Point2>& p, const Da
     connectivity.push_back(std::int64_t(i));
   }
   connectivity.push_back(0);
-  write_poly(out, points, connectivity, {std::int64_t(m + 1)}, "Lines", point_data, {}, threads);
+  write_poly(out, points, {{"Lines", connectivity, {std::int64_t(m + 1)}}}, point_data, {}, threads);
 }
 
 }  // namespace
@@ -352,7 +364,7 @@ void write_patched(std::ostream& out, const PatchedSurface& surface,
     cell_data.add("Float64", per_patch[k].first,
                   computed<double>(T, [&v, &patch](std::size_t t) { return v[std::size_t(patch[t])]; }));
   }
-  write_poly(out, points, connectivity, offsets, "Polys", point_data, cell_data, threads);
+  write_poly(out, points, {{"Polys", connectivity, offsets}}, point_data, cell_data, threads);
 }
 
 }  // namespace
@@ -373,13 +385,17 @@ void write_offset_surface_vtp(std::ostream& out, const SurfaceSolution& s) {
 template <int dim>
 void write_contact_boundary_vtp(std::ostream& out, const BasicSolution<dim>& s) {
   std::vector<double> points;
-  std::vector<std::int64_t> connectivity, offsets;
+  PolyCells verts{"Verts", {}, {}}, lines{"Lines", {}, {}};
   for (const Point<dim>& x : s.contact_boundary) {
     for (int d = 0; d < 3; ++d) points.push_back(d < dim ? x[d] : 0.0);
-    connectivity.push_back(std::int64_t(offsets.size()));
-    offsets.push_back(std::int64_t(offsets.size() + 1));
+    verts.connectivity.push_back(std::int64_t(verts.offsets.size()));
+    verts.offsets.push_back(std::int64_t(verts.offsets.size() + 1));
   }
-  write_poly(out, points, connectivity, offsets, "Verts", {}, {}, s.options.threads);
+  for (const auto& [a, b] : s.contact_boundary_lines) {
+    lines.connectivity.insert(lines.connectivity.end(), {a, b});
+    lines.offsets.push_back(std::int64_t(lines.connectivity.size()));
+  }
+  write_poly(out, points, {verts, lines}, {}, {}, s.options.threads);
 }
 
 template void write_contact_boundary_vtp(std::ostream&, const BasicSolution<2>&);

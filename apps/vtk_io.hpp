@@ -10,7 +10,8 @@
 //                        and their area-weighted means at the points as point data;
 //   offset_surface.vtp   3-D, smooth variant: Γ's triangles with λ;
 //   contact_boundary.vtp where the contact ends on γ, one vertex per active–free pair of neighbouring
-//                        points (the contact set resolved inside the points' parts, docs/math.md);
+//                        points (the contact set resolved inside the points' parts, docs/math.md), and
+//                        in 3-D the lines joining consecutive ones;
 //   solution.vtm         a multiblock file naming the others: opens a whole run in ParaView.
 #include <ostream>
 #include <string>
@@ -43,7 +44,8 @@ void write_surface_vtp(std::ostream& out, const SurfaceSolution& solution);
 /// 3-D, smooth variant: Γ's triangles, cell data patch, normal and lambda, point data lambda.
 void write_offset_surface_vtp(std::ostream& out, const SurfaceSolution& solution);
 
-/// Both dimensions: the points of solution.contact_boundary as vertices.
+/// Both dimensions: the points of solution.contact_boundary as vertices and (3-D) the lines of
+/// solution.contact_boundary_lines.
 template <int dim>
 void write_contact_boundary_vtp(std::ostream& out, const BasicSolution<dim>& solution);
 

@@ -60,7 +60,7 @@ Run run(int N, fictus::Variant variant, fictus::InnerSolver inner, int threads,
   o.inner = inner;
   o.threads = threads;
   o.condition_number = false;
-  o.error_estimate = false;  // the paper's method, as the tables time it
+  o.error_estimate = false;    // the paper's method, as the tables time it
   o.krylov_tolerance = 1e-12;  // so that both paths give λ to ~1e-9 (cond S up to 1e4)
   std::fprintf(stderr, "  N = %d, %s, %s, %d thread(s)...\n", N, fictus::to_string(variant), fictus::to_string(inner),
                threads);

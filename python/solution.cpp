@@ -132,6 +132,11 @@ py::dict contact(const BasicSolution<dim>& s) {
   for (std::size_t k = 0; k < s.contact_boundary.size(); ++k)
     for (int a = 0; a < dim; ++a) ends.mutable_at(py::ssize_t(k), py::ssize_t(a)) = s.contact_boundary[k][a];
   d["boundary"] = ends;  // the located contact ends, one row per point
+  py::array_t<long long> lines({py::ssize_t(s.contact_boundary_lines.size()), py::ssize_t(2)});
+  for (std::size_t k = 0; k < s.contact_boundary_lines.size(); ++k)
+    for (int a = 0; a < 2; ++a)
+      lines.mutable_at(py::ssize_t(k), py::ssize_t(a)) = s.contact_boundary_lines[k][std::size_t(a)];
+  d["boundary_lines"] = lines;  // 3-D: the rows of consecutive ends
   d["force"] = c.force;
   d["force_patches"] = c.force_patches;
   d["force_rule"] = c.force_from_domain ? "domain" : "patches";

@@ -242,8 +242,11 @@ def test_parameters_and_the_contact_summary_match_the_cli(tmp_path):
     for key, value in results["contact"].items():
         if isinstance(value, str):
             assert s.contact_summary[key] == value, key
-        elif isinstance(value, list):  # the contact ends, one row per point
-            np.testing.assert_allclose(s.contact_summary[key], np.array(value), rtol=1e-12, atol=1e-15)
+        elif isinstance(value, list):  # the contact ends, one row per point, and (3-D) their lines
+            got = np.asarray(s.contact_summary[key])
+            assert got.shape[0] == len(value), key
+            if value:
+                np.testing.assert_allclose(got, np.array(value), rtol=1e-12, atol=1e-15)
         else:
             assert s.contact_summary[key] == pytest.approx(value, rel=1e-12, abs=1e-15), key
     for key, value in results["domain"].items():

@@ -1,10 +1,12 @@
 #include "fictus/solve/solution.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <set>
 #include <tuple>
 
 namespace fictus {
@@ -45,22 +47,28 @@ std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<2>& b) {
   for (int i = 0; i < c.m && c.m > 1; ++i) {
     const int j = (i + 1) % c.m;
     const double d = j > i ? c.s[std::size_t(j)] - c.s[std::size_t(i)] : c.length - c.s[std::size_t(i)] + c.s[0];
-    pairs.push_back({i, j, d, 1.0});
+    pairs.push_back({i, j, d, 1.0, {}});
   }
   return pairs;
 }
 
 template <>
 std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<3>& b) {
-  // Vertices by their coordinates (a triangulation's shared vertices are the same doubles), then each
-  // edge with its triangles' patches: an edge between two patches is part of their border.
-  std::map<std::tuple<double, double, double>, int> vertex;
-  const auto id = [&vertex](const Point3& p) {
-    return vertex.emplace(std::make_tuple(p.x, p.y, p.z), int(vertex.size())).first->second;
+  // Vertices by their coordinates rounded to 1e-9 of the surface's extent (a triangulation made face by
+  // face computes a shared vertex once per face, equal only to round-off), then each edge with its
+  // triangles' patches: an edge between two patches is part of their border.
+  const PatchedSurface& s = b.gamma;
+  double extent = 0;
+  for (const Triangle3& t : s.triangles)
+    for (const Point3& p : {t.a, t.b, t.c}) extent = std::max({extent, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  const double unit = 1e-9 * std::max(extent, 1e-300);
+  std::map<std::tuple<long long, long long, long long>, int> vertex;
+  const auto id = [&vertex, unit](const Point3& p) {
+    const auto key = std::make_tuple(std::llround(p.x / unit), std::llround(p.y / unit), std::llround(p.z / unit));
+    return vertex.emplace(key, int(vertex.size())).first->second;
   };
   std::map<std::pair<int, int>, std::pair<int, double>> edge_patch;  // edge → (first patch, length)
-  std::map<std::pair<int, int>, double> border;                      // (patch i < j) → shared length
-  const PatchedSurface& s = b.gamma;
+  std::map<std::pair<int, int>, NeighbourPair> border;               // (patch i < j) → their pair
   for (std::size_t t = 0; t < s.triangles.size(); ++t) {
     const Point3 v[3] = {s.triangles[t].a, s.triangles[t].b, s.triangles[t].c};
     const int ids[3] = {id(v[0]), id(v[1]), id(v[2])};
@@ -70,14 +78,18 @@ std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<3>& b) {
       const auto [it, first] = edge_patch.emplace(key, std::make_pair(s.patch_of[t], norm(v[e] - v[(e + 1) % 3])));
       if (!first && it->second.first != s.patch_of[t]) {
         const int p = it->second.first, q = s.patch_of[t];
-        border[{std::min(p, q), std::max(p, q)}] += it->second.second;
+        NeighbourPair& pair = border[{std::min(p, q), std::max(p, q)}];
+        pair.border += it->second.second;
+        pair.corners.insert(pair.corners.end(), {a, c});
       }
     }
   }
   std::vector<NeighbourPair> pairs;
-  for (const auto& [key, length] : border)
-    pairs.push_back(
-        {key.first, key.second, norm(s.point[std::size_t(key.first)] - s.point[std::size_t(key.second)]), length});
+  for (auto& [key, pair] : border) {
+    pair.i = key.first, pair.j = key.second;
+    pair.distance = norm(s.point[std::size_t(key.first)] - s.point[std::size_t(key.second)]);
+    pairs.push_back(std::move(pair));
+  }
   return pairs;
 }
 
@@ -102,6 +114,8 @@ void resolve_contact(BasicSolution<dim>& s) {
     if (s.newton.active[std::size_t(i)] == 1) measure += part[std::size_t(i)];
   }
   s.contact_boundary.clear();
+  s.contact_boundary_lines.clear();
+  std::map<int, std::vector<int>> at_corner;  // 3-D: a mesh vertex → the located ends whose border has it
   // The part of d between the points that each owns, in proportion to their parts' sizes.
   const auto size = [&part](int i) { return dim == 2 ? part[std::size_t(i)] : std::sqrt(part[std::size_t(i)]); };
   for (const NeighbourPair& p : neighbour_pairs<dim>(s)) {
@@ -112,9 +126,19 @@ void resolve_contact(BasicSolution<dim>& s) {
     const double theta = contact_end_fraction(q, r, p.distance);
     const double owned = p.distance * size(a) / (size(a) + size(b));
     measure += (theta * p.distance - owned) * p.border;
+    for (int corner : p.corners) at_corner[corner].push_back(int(s.contact_boundary.size()));
     s.contact_boundary.push_back(s.points()[std::size_t(a)] +
                                  theta * (s.points()[std::size_t(b)] - s.points()[std::size_t(a)]));
   }
+  // Two ends whose borders meet at a vertex of the triangulation are consecutive along the contact
+  // boundary: a segment joins them (where more meet, as at a patch corner, each to the next).
+  std::set<std::array<int, 2>> lines;
+  for (auto& [corner, ends] : at_corner) {
+    std::sort(ends.begin(), ends.end());
+    ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+    for (std::size_t k = 0; k + 1 < ends.size(); ++k) lines.insert({ends[k], ends[k + 1]});
+  }
+  s.contact_boundary_lines.assign(lines.begin(), lines.end());
   s.contact_measure = std::clamp(measure, 0.0, total);
 }
 

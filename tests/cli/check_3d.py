@@ -82,6 +82,19 @@ def main():
         offset.SetFileName(os.path.join(folder, "offset_surface.vtp"))
         offset.Update()
         assert offset.GetOutput().GetCellData().GetArray("lambda") is not None
+    # contact_boundary.vtp: the located contact ends as vertices, joined into closed polylines (every
+    # end has two neighbours along the line but a few where several patch borders meet)
+    ends = vtkXMLPolyDataReader()
+    ends.SetFileName(os.path.join(folder, "contact_boundary.vtp"))
+    ends.Update()
+    located, lines = r["contact"]["boundary"], r["contact"]["boundary_lines"]
+    assert ends.GetOutput().GetNumberOfVerts() == len(located) >= 3, len(located)
+    assert ends.GetOutput().GetNumberOfLines() == len(lines) >= len(located) - 1, (len(lines), len(located))
+    degree = [0] * len(located)
+    for a, b in lines:
+        degree[a] += 1
+        degree[b] += 1
+    assert sum(d == 2 for d in degree) >= 0.8 * len(located) and min(degree) >= 1, sorted(degree)
     multi = vtkXMLMultiBlockDataReader()
     multi.SetFileName(os.path.join(folder, "solution.vtm"))
     multi.Update()

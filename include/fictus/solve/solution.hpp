@@ -2,6 +2,7 @@
 // What a solve returns, one type for both dimensions: the field û on the grid, the values at the m
 // points of γ (λ, g, B_γû, C_γû, contact flags), Newton's report, checks, errors and timings. The
 // points are a curve's collocation points in 2-D and a surface's patches in 3-D (SolutionBoundary).
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <memory>
@@ -165,8 +166,9 @@ struct BasicSolution : SolutionBoundary<dim> {
   std::optional<ErrorEstimate> estimate;   // with solver.error_estimate and the field
   // The contact set resolved inside the points' parts (docs/math.md, "The contact set"): where γ leaves
   // contact between an active point and its free neighbour, and the measure that follows.
-  std::vector<Point<dim>> contact_boundary;  // one point per active–free pair of neighbours
-  double contact_measure = 0;                // length (2-D) or area (3-D)
+  std::vector<Point<dim>> contact_boundary;                // one point per active–free pair of neighbours
+  std::vector<std::array<int, 2>> contact_boundary_lines;  // 3-D: consecutive points of contact_boundary
+  double contact_measure = 0;                              // length (2-D) or area (3-D)
   std::optional<ErrorNorms> errors;
   std::optional<PointErrors> point_errors;
   Timings timings;
@@ -179,8 +181,9 @@ using SurfaceSolution = BasicSolution<3>;
 /// Neighbouring points of γ: consecutive points of a curve, patches sharing a triangle edge of a surface.
 struct NeighbourPair {
   int i = 0, j = 0;
-  double distance = 0;  // between x_i and x_j (along the curve in 2-D, the chord in 3-D)
-  double border = 0;    // the measure of the parts' common border: 1 in 2-D, the shared edges' length in 3-D
+  double distance = 0;       // between x_i and x_j (along the curve in 2-D, the chord in 3-D)
+  double border = 0;         // the measure of the parts' common border: 1 in 2-D, the shared edges' length in 3-D
+  std::vector<int> corners;  // 3-D: the triangulation's vertices (by index) at the ends of the border's edges
 };
 template <int dim>
 std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<dim>& boundary);
