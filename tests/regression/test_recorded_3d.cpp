@@ -58,6 +58,7 @@ fictus::SurfaceSolution solve(const Case3d& c) {
   spec.options.variant = c.variant;
   spec.options.offset = 0;  // the default rule for δ (a file's offset need not fit at N = 64)
   spec.options.threads = 2;
+  spec.options.error_estimate = false;  // not among the recorded answers (tests/convergence/test_quantities.cpp)
   return fictus::solve(spec.problem, spec.options);
 }
 
