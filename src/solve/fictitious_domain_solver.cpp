@@ -557,6 +557,65 @@ void estimate_warning_line(BasicSolution<dim>& sol) {
   sol.warnings.push_back(line);
 }
 
+/// Before the load: the same problem on the grid of N/2 where the nested start (3-D, N at or above
+/// solver.nested_start) or the error estimate (with the field) wants it; the nested start's active set
+/// into `start`, the reports into `sol`.
+template <int dim>
+std::optional<BasicSolution<dim>> coarse_step(const State<dim>& st, const BasicContactData<dim>& data,
+                                              const SolverOptions& options, bool compute_field,
+                                              const BoundaryDiscretization<dim>& boundary, PhaseClock& clock,
+                                              ActiveSet& start, BasicSolution<dim>& sol) {
+  const bool nested = dim == 3 && options.nested_start > 0 && st.grid.nx() >= options.nested_start;
+  const bool estimate = options.error_estimate && compute_field;
+  if (!nested && !estimate) return std::nullopt;
+  std::string skipped;
+  std::optional<BasicSolution<dim>> coarse = coarse_solve<dim>(st, data, options, skipped);
+  clock.mark(nested ? "nested_start" : "coarse_solve");
+  const double seconds = sol.timings.phases.back().second;
+  if (nested) {
+    sol.nested_start.emplace();
+    start = nested_start<dim>(st, coarse, skipped, boundary, *sol.nested_start);
+    sol.nested_start->seconds = seconds;
+  }
+  if (estimate) {
+    sol.estimate.emplace();
+    sol.estimate->skipped = skipped;
+    sol.estimate->seconds = seconds;
+  }
+  st.execution.throw_if_interrupted();
+  return coarse;
+}
+
+/// Steps 9–10: the integrals over ω, the quantities' errors against an exact solution, the estimate
+/// from the coarse solve and its warning.
+template <int dim>
+void quantities_step(const State<dim>& st, const BoundaryDiscretization<dim>& boundary,
+                     const BasicContactData<dim>& data, const std::optional<BasicSolution<dim>>& coarse,
+                     BasicSolution<dim>& sol) {
+  double difference2 = 0;
+  const BasicSolution<dim>* from = sol.estimate && coarse && coarse->domain ? &*coarse : nullptr;
+  std::array<double, 2> exact{};  // ∫u, ∫fu of the exact solution
+  typename Fields<dim>::Vectorized exact_u;
+  if (sol.errors) exact_u = data.exact_vectorized ? data.exact_vectorized : vectorize(data.exact);
+  sol.domain = domain_quantities<dim>(st, boundary, sol.u, quantity_quadrature, from, exact_u, difference2, exact);
+  if (sol.errors) {
+    ErrorNorms& e = *sol.errors;
+    const double energy =
+        0.5 * e.exact_h1semi_omega * e.exact_h1semi_omega + 0.5 * st.c * e.exact_l2_omega * e.exact_l2_omega - exact[1];
+    e.integral_u = sol.domain->integral_u - exact[0];
+    e.force = st.c * e.integral_u;
+    e.energy = sol.domain->energy - energy;
+  }
+  if (from) {
+    const double seconds = sol.estimate->seconds;
+    sol.estimate = error_estimate<dim>(*from, sol, difference2);
+    sol.estimate->seconds = seconds;
+  } else if (sol.estimate && sol.estimate->skipped.empty()) {
+    sol.estimate->skipped = "the solve on the grid of N/2 made no field";
+  }
+  estimate_warning_line<dim>(sol);
+}
+
 }  // namespace
 
 template <int dim>
@@ -571,25 +630,8 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
   BoundarySetup<dim>& setup = boundary_setup<dim>(st, data, options, clock, sol.reused_curve);  // 1–2
   st.execution.throw_if_interrupted();
   ActiveSet start;
-  const bool nested = dim == 3 && options.nested_start > 0 && st.grid.nx() >= options.nested_start;
-  const bool estimate = options.error_estimate && compute_field;
-  std::optional<BasicSolution<dim>> coarse;
-  std::string skipped;
-  if (nested || estimate) {  // the same problem on the grid of N/2
-    coarse = coarse_solve<dim>(st, data, options, skipped);
-    clock.mark(nested ? "nested_start" : "coarse_solve");
-    if (nested) {
-      sol.nested_start.emplace();
-      start = nested_start<dim>(st, coarse, skipped, *setup.boundary, *sol.nested_start);
-      sol.nested_start->seconds = sol.timings.phases.back().second;
-    }
-    if (estimate) {
-      sol.estimate.emplace();
-      sol.estimate->skipped = skipped;
-      sol.estimate->seconds = sol.timings.phases.back().second;
-    }
-    st.execution.throw_if_interrupted();
-  }
+  const std::optional<BasicSolution<dim>> coarse =
+      coarse_step<dim>(st, data, options, compute_field, *setup.boundary, clock, start, sol);
   load_and_u0<dim>(st, clock, sol.fast_solves);  // 0
   st.execution.throw_if_interrupted();
   const bool made = !setup.schur;
@@ -623,29 +665,8 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
     clock.mark("errors");
   }
   if (compute_field) {  // 9–10
-    double difference2 = 0;
-    const BasicSolution<dim>* from = coarse && coarse->domain ? &*coarse : nullptr;
-    std::array<double, 2> exact{};  // ∫u, ∫fu of the exact solution
-    typename Fields<dim>::Vectorized exact_u;
-    if (sol.errors) exact_u = data.exact_vectorized ? data.exact_vectorized : vectorize(data.exact);
-    sol.domain = domain_quantities<dim>(st, boundary, sol.u, quantity_quadrature, from, exact_u, difference2, exact);
-    if (sol.errors) {
-      ErrorNorms& e = *sol.errors;
-      const double energy = 0.5 * e.exact_h1semi_omega * e.exact_h1semi_omega +
-                            0.5 * st.c * e.exact_l2_omega * e.exact_l2_omega - exact[1];
-      e.integral_u = sol.domain->integral_u - exact[0];
-      e.force = st.c * e.integral_u;
-      e.energy = sol.domain->energy - energy;
-    }
-    if (from) {
-      const double seconds = sol.estimate->seconds;
-      sol.estimate = error_estimate<dim>(*from, sol, difference2);
-      sol.estimate->seconds = seconds;
-    } else if (sol.estimate && sol.estimate->skipped.empty()) {
-      sol.estimate->skipped = "the solve on the grid of N/2 made no field";
-    }
+    quantities_step<dim>(st, boundary, data, coarse, sol);
     clock.mark("quantities");
-    estimate_warning_line<dim>(sol);
   }
   sol.options = options;
   sol.options.multipliers = boundary.spacing().m;

@@ -88,4 +88,25 @@ INSTANTIATE_TEST_SUITE_P(Manufactured, Quantities,
                            return info.param.name.substr(13) + "_" + fictus::to_string(info.param.variant);
                          });
 
+// The nested start makes the N/2 solve without the estimate: nothing of the estimate is then reported,
+// and with it the same coarse solve serves both.
+TEST(Quantities, NestedStartWithAndWithoutTheEstimate) {
+  const std::string path = std::string(FICTUS_SOURCE_DIR) + "/examples/manufactured_sphere.toml";
+  fictus::BasicProblemSpec<3> spec = fictus::parse_problem<3>(fictus::read_problem_text(path), path);
+  spec.problem.N = 64;
+  spec.options.threads = 2;
+  spec.options.nested_start = 64;
+  spec.options.error_estimate = false;
+  const fictus::SurfaceSolution without = fictus::solve(spec.problem, spec.options);
+  ASSERT_TRUE(without.newton.converged && without.nested_start && without.domain);
+  EXPECT_TRUE(without.nested_start->skipped.empty()) << without.nested_start->skipped;
+  EXPECT_FALSE(without.estimate.has_value());
+  spec.options.error_estimate = true;
+  const fictus::SurfaceSolution with = fictus::solve(spec.problem, spec.options);
+  ASSERT_TRUE(with.estimate && with.estimate->skipped.empty());
+  EXPECT_EQ(with.estimate->N, 32);
+  EXPECT_EQ(with.timings["coarse_solve"], 0.0);  // the nested start's solve, not a second one
+  EXPECT_EQ(with.lambda, without.lambda);
+}
+
 }  // namespace
