@@ -309,10 +309,9 @@ namespace {
 /// points when m is given, δ by the offset rule of that grid; no error integrals and no estimate of its
 /// own; an offset given that does not fit there is replaced by that grid's rule), for the nested start
 /// and the error estimate: with δ ∝ h on both grids the two solves lie on the method's path of
-/// convergence, as Richardson's estimate needs. Or
-/// nothing, with `skipped` saying why: the coarse grid checks the box's margin (2h), the boundary's reach
-/// and δ ≥ 4h with its own h, and may refuse what this grid takes. Its steps are reported as
-/// "N/2 <step>"; an interrupt asked there ends this solve too.
+/// convergence, as Richardson's estimate needs. Or nothing, with `skipped` saying why: the coarse grid
+/// checks the box's margin (2h), the boundary's reach and δ ≥ 4h with its own h, and may refuse what
+/// this grid takes. Its steps are reported as "N/2 <step>"; an interrupt asked there ends this solve too.
 template <int dim>
 std::optional<BasicSolution<dim>> coarse_solve(const State<dim>& st, const BasicContactData<dim>& data,
                                                const SolverOptions& options, std::string& skipped) {

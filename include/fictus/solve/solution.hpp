@@ -194,7 +194,7 @@ std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<dim>& boundary
 /// through both values: √θ/(1 − θ)^{3/2} = q·d/(1.5·r).
 double contact_end_fraction(double q, double r, double d);
 
-/// Sets solution.contact_boundary and solution.contact_measure from the per-point values.
+/// Sets solution.contact_boundary, contact_boundary_lines and contact_measure from the per-point values.
 template <int dim>
 void resolve_contact(BasicSolution<dim>& solution);
 
