@@ -109,10 +109,17 @@ void print_summary(const fictus::BasicSolution<dim>& s) {
   std::printf("%sN = %d (h = %.3g), n = %zu nodes, m = %d%s, variant %s, inner solver %s\n", dim == 3 ? "3-D, " : "",
               s.grid.nx(), s.grid.h(), s.grid.n_nodes(), s.n_points(), dim == 3 ? " patches" : "",
               fictus::to_string(s.options.variant), fictus::to_string(s.options.inner));
-  std::printf("Newton: %d steps, %s, %ld active of %d; fast solves %zu, Krylov iterations %d\n", s.newton.iterations,
-              s.newton.converged ? "converged" : "NOT converged",
-              long(std::count(s.newton.active.begin(), s.newton.active.end(), 1)), s.n_points(), s.fast_solves,
-              s.inner_iterations);
+  const fictus::ContactSummary c = fictus::contact_summary(s);
+  std::printf("Newton: %d steps, %s, %ld active of %ld%s; fast solves %zu, Krylov iterations %d\n", s.newton.iterations,
+              s.newton.converged ? "converged" : "NOT converged", c.points, c.signorini.points,
+              c.signorini.points < s.n_points() ? " Signorini points" : "", s.fast_solves, s.inner_iterations);
+  const char* measure = dim == 2 ? "length" : "area";
+  if (c.dirichlet.points > 0 || c.neumann.points > 0)
+    std::printf(
+        "parts of gamma: Signorini %ld points (%s %.6g), Dirichlet %ld (%.6g, flux %.6g), Neumann %ld (%.6g, flux "
+        "%.6g)\n",
+        c.signorini.points, measure, c.signorini.measure, c.dirichlet.points, c.dirichlet.measure, c.dirichlet.flux,
+        c.neumann.points, c.neumann.measure, c.neumann.flux);
   print_solver_extras(s);
   std::printf("Signorini checks: min gap %.2e, min du/dn %.2e, max |complementarity| %.2e\n", s.signorini.min_gap,
               s.signorini.min_normal_derivative, s.signorini.max_complementarity);
@@ -121,10 +128,9 @@ void print_summary(const fictus::BasicSolution<dim>& s) {
         "  with an independent du/dn (%s): min du/dn %.2e, max |complementarity| %.2e, "
         "max |difference| %.2e\n",
         s.check->rule.c_str(), s.check->min_normal_derivative, s.check->max_complementarity, s.check->max_difference);
-  const fictus::ContactSummary c = fictus::contact_summary(s);
-  std::printf("contact: %ld points, %s %.6g (whole points %.6g), force %.9g (%s; patch sum %.9g)\n", c.points,
-              dim == 2 ? "length" : "area", c.measure, c.measure_points, c.force,
-              c.force_from_domain ? "c int u - int f over omega" : "patch sum", c.force_patches);
+  std::printf("contact: %ld points, %s %.6g (whole points %.6g), force %.9g (%s; patch sum %.9g)\n", c.points, measure,
+              c.measure, c.measure_points, c.force, c.force_from_domain ? "c int u - int f over omega" : "patch sum",
+              c.force_patches);
   if (s.domain)
     std::printf("over omega: int u %.9g, int |grad u|^2 %.9g, energy %.9g\n", s.domain->integral_u,
                 s.domain->integral_grad2, s.domain->energy);

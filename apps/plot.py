@@ -149,6 +149,10 @@ def plot_solution(folder):
         ax.plot(closed(p["Gamma_x"]), closed(p["Gamma_y"]), "--", color="tab:orange", lw=1, label="Γ")
     contact = p["contact"] > 0
     ax.plot(p["x"][contact], p["y"][contact], "r.", ms=4, label="contact")
+    for code, marker, colour, label in PARTS:  # mixed conditions: the Dirichlet and Neumann parts
+        part = p.get("condition", np.zeros_like(p["x"])) == code
+        if np.any(part):
+            ax.plot(p["x"][part], p["y"][part], marker, color=colour, ms=4, label=label)
     # s = 0: the first point, and an arrow along γ in the direction of increasing s
     ax.plot(p["x"][0], p["y"][0], "o", mfc="none", mec="k", ms=8, label="s = 0")
     step = max(1, len(p["x"]) // 24)
@@ -170,6 +174,8 @@ def lambda_label(variant):
 
 
 PRESSURE = "∂u/∂n: contact\npressure where u = g"
+# The parts of γ under other conditions than Signorini's (points.csv `condition`): code, marker, colour, label.
+PARTS = ((1, "s", "tab:blue", "Dirichlet: u = u_D"), (2, "^", "tab:green", "Neumann: ∂u/∂n = q"))
 
 
 def plot_profiles(folder, with_lambda):
@@ -187,6 +193,10 @@ def plot_profiles(folder, with_lambda):
         plain(ax.yaxis)
         ax.plot(p["s"], values, "k.-", ms=3, lw=0.8)
         ax.plot(p["s"][contact], values[contact], "r.", ms=4)
+        for code, marker, colour, label in PARTS:
+            part = p.get("condition", np.zeros_like(p["s"])) == code
+            if np.any(part):
+                ax.plot(p["s"][part], values[part], marker, color=colour, ms=3, label=label)
         ax.axhline(0.0, color="gray", lw=0.5, zorder=0)
         ax.set_ylabel(label, fontsize=9)
     check = p.get("dudn_check")
@@ -194,7 +204,9 @@ def plot_profiles(folder, with_lambda):
         axes[1].plot(p["s"], check, "--", color="tab:blue", lw=0.8, label="independent estimate")
         axes[1].plot([], [], "k.-", ms=3, lw=0.8, label="enforced (C_γ û)")
         axes[1].legend(fontsize=7, loc="best")
-    axes[-1].set_xlabel("arc length s along γ from s = 0 (red: contact)")
+    mixed = np.any(p.get("condition", np.zeros_like(p["s"])) > 0)
+    axes[-1].set_xlabel("arc length s along γ from s = 0 (red: contact" +
+                        ("; blue squares: Dirichlet, green triangles: Neumann)" if mixed else ")"))
     fig.suptitle("Signorini conditions along γ" + (f" ({variant} variant)" if variant else ""))
     fig.savefig(os.path.join(folder, "profiles.png"), dpi=120)
     plt.close(fig)
@@ -321,6 +333,8 @@ def plot_surface(folder, with_lambda):
         elif os.path.exists(os.path.join(folder, "offset_surface.vtp")):
             lam_surface = read_vtp(os.path.join(folder, "offset_surface.vtp"))
             fields.append((lam_surface[2]["lambda"], lambda_label(variant).replace("\n", " "), "coolwarm"))
+    if "condition" in cells and np.any(cells["condition"] > 0):  # mixed conditions: the parts of γ
+        fields.append((cells["condition"], "parts of γ: 0 Signorini, 1 Dirichlet, 2 Neumann", "viridis"))
     views = [(25, -60, "front"), (-25, 120, "back")]
     fig, axes = plt.subplots(len(fields), 2, figsize=(11, 4.6 * len(fields)), squeeze=False,
                              constrained_layout=True)

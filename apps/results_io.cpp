@@ -218,6 +218,12 @@ json solution_to_json(const BasicProblem<dim>& problem, const BasicSolution<dim>
     for (int d = 0; d < dim; ++d) p.push_back(x[d]);
     j["contact"]["boundary"].push_back(p);
   }
+  const auto part_json = [](const PartSummary& p) {
+    return json{{"points", p.points}, {"measure", p.measure}, {"flux", p.flux}};
+  };
+  j["conditions"] = {{"signorini", part_json(contact.signorini)},
+                     {"dirichlet", part_json(contact.dirichlet)},
+                     {"neumann", part_json(contact.neumann)}};
   j["contact"]["boundary_lines"] = json::array();  // 3-D: consecutive points of contact.boundary
   for (const auto& line : s.contact_boundary_lines) j["contact"]["boundary_lines"].push_back({line[0], line[1]});
   j["domain"] = s.domain ? domain_json(*s.domain) : json(nullptr);
@@ -365,7 +371,7 @@ std::string points_csv(const BasicSolution<dim>& s) {
   out << "i" << (dim == 2 ? ",s" : "");
   for (int d = 0; d < dim; ++d) out << ',' << axis[d];
   for (int d = 0; d < dim; ++d) out << ",n" << axis[d];
-  out << ",weight,g,u,dudn,lambda,contact";
+  out << ",weight,g,u,dudn,lambda,contact,condition";
   for (int d = 0; d < dim; ++d) out << ",Gamma_" << axis[d];
   out << ",dudn_check\n";
   const bool check = s.check && int(s.check->normal_derivative.size()) == s.n_points();
@@ -380,7 +386,7 @@ std::string points_csv(const BasicSolution<dim>& s) {
     for (int d = 0; d < dim; ++d) out << ',' << s.points()[i][d];
     for (int d = 0; d < dim; ++d) out << ',' << s.normals()[i][d];
     out << ',' << s.weights()[i] << ',' << s.g[i] << ',' << s.trace[i] << ',' << s.normal_derivative[i] << ','
-        << s.lambda[i] << ',' << int(s.newton.active[i]);
+        << s.lambda[i] << ',' << int(s.in_contact(i)) << ',' << int(s.condition(i));
     for (int d = 0; d < dim; ++d) out << ',' << G[d];
     out << ',';
     if (check) out << s.check->normal_derivative[i];

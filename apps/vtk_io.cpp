@@ -260,11 +260,12 @@ void write_closed_line(std::ostream& out, const std::vector<Point2>& p, const Da
 
 void write_curve_vtp(std::ostream& out, const Solution& s) {
   const std::size_t m = std::size_t(s.collocation.m);
-  std::vector<double> normal, gap(m), contact(m);
+  std::vector<double> normal, gap(m), contact(m), condition(m);
   for (std::size_t i = 0; i < m; ++i) {
     normal.insert(normal.end(), {s.collocation.normal[i].x, s.collocation.normal[i].y, 0.0});
     gap[i] = s.trace[i] - s.g[i];
-    contact[i] = double(s.newton.active[i]);
+    contact[i] = double(s.in_contact(int(i)));
+    condition[i] = double(s.condition(int(i)));
   }
   DataArrays data;
   data.add("Float64", "s", values_of(s.collocation.s));
@@ -275,6 +276,7 @@ void write_curve_vtp(std::ostream& out, const Solution& s) {
     data.add("Float64", "dudn_check", values_of(s.check->normal_derivative));
   data.add("Float64", "gap", values_of(gap));
   data.add("Float64", "contact", values_of(contact));
+  data.add("Float64", "condition", values_of(condition));
   if (s.options.variant == Variant::nonsmooth) data.add("Float64", "lambda", values_of(s.lambda));
   data.add("Float64", "normal", values_of(normal), 3);
   write_closed_line(out, s.collocation.point, data, s.options.threads);
@@ -370,10 +372,15 @@ void write_patched(std::ostream& out, const PatchedSurface& surface,
 }  // namespace
 
 void write_surface_vtp(std::ostream& out, const SurfaceSolution& s) {
-  std::vector<double> gap(s.trace.size()), contact(s.trace.size());
-  for (std::size_t p = 0; p < gap.size(); ++p) gap[p] = s.trace[p] - s.g[p], contact[p] = double(s.newton.active[p]);
+  std::vector<double> gap(s.trace.size()), contact(s.trace.size()), condition(s.trace.size());
+  for (std::size_t p = 0; p < gap.size(); ++p) {
+    gap[p] = s.trace[p] - s.g[p];
+    contact[p] = double(s.in_contact(int(p)));
+    condition[p] = double(s.condition(int(p)));
+  }
   std::vector<std::pair<std::string, const std::vector<double>*>> values = {
-      {"g", &s.g}, {"u", &s.trace}, {"dudn", &s.normal_derivative}, {"gap", &gap}, {"contact", &contact}};
+      {"g", &s.g},   {"u", &s.trace},       {"dudn", &s.normal_derivative},
+      {"gap", &gap}, {"contact", &contact}, {"condition", &condition}};
   if (s.options.variant == Variant::nonsmooth) values.push_back({"lambda", &s.lambda});
   write_patched(out, s.gamma, values, s.options.threads);
 }

@@ -193,8 +193,8 @@ std::map<std::string, py::function> take_callables(py::dict data) {
 
 namespace {
 
-const std::vector<std::string> section_names = {"domain", "geometry", "formulation", "data",
-                                                "solver", "output",   "parameters"};
+const std::vector<std::string> section_names = {"domain",     "geometry", "formulation", "data",
+                                                "conditions", "solver",   "output",      "parameters"};
 
 /// A MeshSurface from a float array (n, 3) of vertices and an integer array (k, 3) of triangles.
 std::shared_ptr<const Surface> mesh_from_arrays(py::handle vertices, py::handle faces, double resolution) {

@@ -143,6 +143,13 @@ py::dict contact(const BasicSolution<dim>& s) {
   d["lambda_integral"] = c.lambda;
   d["min_gap"] = c.min_gap;
   d["max_gap"] = c.max_gap;
+  py::dict parts;
+  for (const auto& [name, part] : {std::pair<const char*, const PartSummary*>{"signorini", &c.signorini},
+                                   {"dirichlet", &c.dirichlet},
+                                   {"neumann", &c.neumann}})
+    parts[name] =
+        py::dict(py::arg("points") = part->points, py::arg("measure") = part->measure, py::arg("flux") = part->flux);
+  d["conditions"] = parts;
   return d;
 }
 
@@ -300,12 +307,22 @@ void bind_solution(py::module_& m) {
           "the multipliers (controls on Γ in the smooth variant)")
       .def_property_readonly("contact",
                              [](const PySolution& p) {
-                               const auto& active = on(
-                                   p, [](const auto& s) -> const auto& { return s.newton.active; });
-                               py::array_t<bool> a(py::ssize_t(active.size()));
-                               for (std::size_t i = 0; i < active.size(); ++i) a.mutable_data()[i] = active[i] == 1;
-                               return a;
+                               return on(p, [](const auto& s) {
+                                 py::array_t<bool> a(py::ssize_t(s.n_points()));
+                                 for (int i = 0; i < s.n_points(); ++i) a.mutable_data()[i] = s.in_contact(i);
+                                 return a;
+                               });
                              })
+      .def_property_readonly(
+          "condition",
+          [](const PySolution& p) {
+            return on(p, [](const auto& s) {
+              py::array_t<int> a(py::ssize_t(s.n_points()));
+              for (int i = 0; i < s.n_points(); ++i) a.mutable_data()[i] = int(s.condition(i));
+              return a;
+            });
+          },
+          "each point's condition: 0 Signorini, 1 Dirichlet, 2 Neumann")
       .def_property_readonly("gamma_points", &gamma_points,
                              "the points of Γ carrying λ (= points in the non-smooth variant)")
       .def_property_readonly(

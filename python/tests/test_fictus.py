@@ -515,3 +515,28 @@ def test_one_problem_and_solution_type_in_both_dimensions(tmp_path, monkeypatch)
     assert type(p) is fictus.Problem and p.dim == 3 and p.N == 32
     mesh = p.solve()
     assert mesh.dim == 3 and mesh.converged and 0 < mesh.contact.sum() < mesh.multipliers
+
+
+@pytest.mark.parametrize("name, replace", [("mixed_heating.toml", ("N = 512", "N = 256")),
+                                           ("mixed_heating_3d.toml", ("N = 96", "N = 48"))])
+def test_mixed_conditions_match_the_cli(tmp_path, name, replace):
+    path = os.path.join(EXAMPLES, name)
+    results, points = cli_solve(tmp_path, path, "--N", replace[1].split()[-1], "--error_estimate", "false")
+    with open(path) as handle:
+        text = handle.read().replace(*replace)
+    s = (fictus.SurfaceProblem if "3d" in name else fictus.Problem).from_toml(
+        text + "\n[solver]\nerror_estimate = false\n").solve()
+    for part in ("signorini", "dirichlet", "neumann"):
+        assert results["conditions"][part]["points"] > 0, part
+        for key, value in results["conditions"][part].items():
+            assert s.contact_summary["conditions"][part][key] == pytest.approx(value, rel=1e-12, abs=1e-12), (part, key)
+    condition = np.array([int(p["condition"]) for p in points])
+    np.testing.assert_array_equal(s.condition, condition)
+    assert s.contact_summary["points"] == int(s.contact.sum()) == results["contact"]["points"]
+    assert not np.any(s.contact[condition > 0])  # contact only on the Signorini part
+    # the fixed rows hold: u = u_D = 0 on the Dirichlet part, du/dn = 0 on the Neumann part
+    assert np.max(np.abs(s.u_gamma[condition == 1])) < 1e-8
+    assert np.max(np.abs(s.dudn[condition == 2])) < 1e-8
+    with pytest.raises(ValueError, match="conditions.neumann: overlaps conditions.dirichlet"):
+        fictus.Problem(geometry={"shape": "circle", "center": [0.5, 0.5], "radius": 0.3}, f="1", g="0", N=64,
+                       conditions={"dirichlet": "x < 0.5", "u": "0", "neumann": "y < 0.5"}).solve()

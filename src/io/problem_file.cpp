@@ -395,6 +395,46 @@ void read_data(TableReader& data, const ExpressionMaker& expression, DomainSetti
   data.finish();
 }
 
+/// [conditions]: the Dirichlet and Neumann parts of γ and their values (docs/problem_files.md, "Mixed
+/// conditions"); the rest of γ is Signorini. Parts in x, y (, z); the flux may name the outward normal.
+template <int dim>
+void read_conditions(TableReader& table, const ExpressionMaker& expression, BasicProblem<dim>& p) {
+  const std::vector<std::string> at =
+      dim == 2 ? std::vector<std::string>{"x", "y"} : std::vector<std::string>{"x", "y", "z"};
+  std::vector<std::string> with_normal = at;
+  for (const std::string& axis : at) with_normal.push_back("n" + axis);
+  const auto field = [&](const char* key) -> std::function<double(const Point<dim>&)> {
+    const Expression e = expression(table.string(key, ""), at, std::string("conditions.") + key);
+    return [e](const Point<dim>& x) {
+      if constexpr (dim == 2)
+        return e({x[0], x[1]});
+      else
+        return e({x[0], x[1], x[2]});
+    };
+  };
+  for (const char* key : {"dirichlet", "u", "neumann", "flux"}) table.string(key, "");  // the keys known here
+  PartConditions<dim>& c = p.conditions;
+  if (table.has("dirichlet")) c.dirichlet = field("dirichlet");
+  if (table.has("neumann")) c.neumann = field("neumann");
+  if (table.has("u")) {
+    if (!c.dirichlet) fail("conditions.u", "given without conditions.dirichlet (the part where u takes it)");
+    c.u = field("u");
+  } else if (c.dirichlet) {
+    fail("conditions.u", "missing: the Dirichlet part needs the value of u there");
+  }
+  if (table.has("flux")) {
+    if (!c.neumann) fail("conditions.flux", "given without conditions.neumann (the part where the flux is given)");
+    const Expression e = expression(table.string("flux", ""), with_normal, "conditions.flux");
+    c.flux = [e](const Point<dim>& x, const Point<dim>& n) {
+      if constexpr (dim == 2)
+        return e({x[0], x[1], n[0], n[1]});
+      else
+        return e({x[0], x[1], x[2], n[0], n[1], n[2]});
+    };
+  }
+  table.finish();
+}
+
 /// [output]: the folder and the files (the names of the dimension).
 OutputOptions read_output(TableReader& output, int dim) {
   OutputOptions out;
@@ -424,6 +464,7 @@ std::string echo_json(const toml::table& root, const toml::table& geometry_table
                               std::filesystem::absolute(mesh_path(file->get(), source)).lexically_normal().string());
   echo.insert("geometry", geometry);
   if (const toml::table* d = subtable(root, "data")) echo.insert("data", *d);
+  if (const toml::table* c = subtable(root, "conditions")) echo.insert("conditions", *c);
   if (!parameters.empty()) {
     toml::table in_effect;
     for (const auto& [name, value] : parameters) in_effect.insert(name, value);
@@ -434,8 +475,8 @@ std::string echo_json(const toml::table& root, const toml::table& geometry_table
   return json.str();
 }
 
-const std::vector<std::string> sections = {"domain", "geometry", "formulation", "data",
-                                           "solver", "output",   "parameters"};
+const std::vector<std::string> sections = {"domain",     "geometry", "formulation", "data",
+                                           "conditions", "solver",   "output",      "parameters"};
 
 }  // namespace
 
@@ -465,8 +506,9 @@ BasicProblemSpec<dim> parse_problem(const std::string& text, const std::string& 
   const toml::table root = parse_toml(text, source);
   for (const auto& [k, v] : root)
     if (std::find(sections.begin(), sections.end(), std::string(k.str())) == sections.end())
-      fail(std::string(k.str()), "unknown section (domain, geometry, formulation, data, solver, output, parameters)" +
-                                     did_you_mean(k.str(), sections));
+      fail(std::string(k.str()),
+           "unknown section (domain, geometry, formulation, data, conditions, solver, output, parameters)" +
+               did_you_mean(k.str(), sections));
   if (problem_dimension(text, source) != dim)
     fail("domain.dim", "a " + std::to_string(problem_dimension(text, source)) + "-D problem read as a " +
                            std::to_string(dim) + "-D one");
@@ -498,6 +540,8 @@ BasicProblemSpec<dim> parse_problem(const std::string& text, const std::string& 
   formulation.finish();
   TableReader data(subtable(root, "data"), "data");
   read_data<dim>(data, expression, domain, spec);
+  TableReader conditions(subtable(root, "conditions"), "conditions");
+  read_conditions<dim>(conditions, expression, p);
   TableReader solver(subtable(root, "solver"), "solver");
   solver.read_options(domain, spec.options);
   solver.finish();

@@ -383,6 +383,64 @@ ActiveSet nested_start(const State<dim>& st, const std::optional<BasicSolution<d
   return nearest_flags<dim>(coarse->points(), coarse->newton.active, fine.points(), st.execution);
 }
 
+/// The value of a condition at a point: finite and within the solver's scale, else an error naming `key`.
+template <int dim>
+double condition_value(double value, const char* key, const Point<dim>& x) {
+  if (!std::isfinite(value))
+    throw std::invalid_argument(std::string(key) + ": not finite at the point " + detail::format_point(x));
+  if (std::abs(value) > largest_scale)
+    throw std::invalid_argument(std::string(key) + ": " + format_number(value) + " at the point " +
+                                detail::format_point(x) + " is beyond " + format_number(largest_scale) +
+                                ": rescale the problem (u, f and g by one factor)");
+  return value;
+}
+
+/// Step 4: g at the points and, with mixed conditions, each point's condition (docs/math.md, "Mixed
+/// conditions"): u_D takes g's place at the Dirichlet points (the value of their B rows), q is kept for
+/// the Neumann ones. Throws naming the key where a part holds at no point, two parts claim one point, a
+/// value is not finite, or the Neumann part is all of γ with c = 0 (u then fixed up to a constant).
+template <int dim>
+void obstacle_and_conditions(const BoundaryDiscretization<dim>& boundary, const BasicContactData<dim>& data, double c,
+                             BasicSolution<dim>& sol) {
+  sol.g = boundary.obstacle(data);
+  sol.conditions = {};
+  const PartConditions<dim>& parts = data.conditions;
+  if (!parts.mixed()) return;
+  if (parts.dirichlet && !parts.u)
+    throw std::invalid_argument("conditions.u: not given (the Dirichlet part needs u there)");
+  const int m = boundary.n_points();
+  const std::vector<Point<dim>>&x = boundary.points(), &n = boundary.normals();
+  PointConditions pc;
+  pc.kind.assign(std::size_t(m), PointCondition::signorini);
+  pc.flux = Eigen::VectorXd::Zero(m);
+  int dirichlet = 0, neumann = 0;
+  for (int i = 0; i < m; ++i) {
+    const Point<dim>& p = x[std::size_t(i)];
+    const bool in_d = parts.dirichlet && condition_value(parts.dirichlet(p), "conditions.dirichlet", p) != 0;
+    const bool in_n = parts.neumann && condition_value(parts.neumann(p), "conditions.neumann", p) != 0;
+    if (in_d && in_n)
+      throw std::invalid_argument("conditions.neumann: overlaps conditions.dirichlet at the point " +
+                                  detail::format_point(p) + " of gamma (a point takes one condition)");
+    if (in_d) {
+      sol.g[std::size_t(i)] = condition_value(parts.u(p), "conditions.u", p);
+      pc.kind[std::size_t(i)] = PointCondition::dirichlet;
+      ++dirichlet;
+    } else if (in_n) {
+      pc.flux(i) = parts.flux ? condition_value(parts.flux(p, n[std::size_t(i)]), "conditions.flux", p) : 0.0;
+      pc.kind[std::size_t(i)] = PointCondition::neumann;
+      ++neumann;
+    }
+  }
+  const std::string points = " of the " + std::to_string(m) + " points of gamma (m = formulation.multipliers)";
+  if (parts.dirichlet && dirichlet == 0) throw std::invalid_argument("conditions.dirichlet: holds at none" + points);
+  if (parts.neumann && neumann == 0) throw std::invalid_argument("conditions.neumann: holds at none" + points);
+  if (neumann == m && c == 0)
+    throw std::invalid_argument(
+        "conditions.neumann: covers all of gamma with c = 0, which fixes u only up to a constant (give c > 0, or a "
+        "Dirichlet or Signorini part)");
+  sol.conditions = std::move(pc);
+}
+
 /// Step 5: semismooth Newton on λ with the Schur blocks; where the far field was interpolated, on S̃
 /// until the active set has nearly settled, then on the exact S preconditioned by S̃ from there.
 template <int dim>
@@ -393,6 +451,7 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
   const int m = setup.boundary->n_points();
   if (setup.exact) first.hand_on_at_changes = std::max(1, int(far_field_hand_on * m));
   if (!start.empty()) first.start_active = &start;
+  if (!sol.conditions.kind.empty()) first.conditions = &sol.conditions;
   const ConstantMode* mode = setup.mode ? &*setup.mode : nullptr;
   const Eigen::VectorXd g = to_eigen(sol.g);
   const std::size_t before = setup.schur->fast_solves(), exact_before = setup.exact ? setup.exact->fast_solves() : 0;
@@ -402,6 +461,7 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
     polish.relative_tolerance = far_field_gmres_tolerance;
     const PreconditionedSchur preconditioned(static_cast<const ExplicitSchur&>(*setup.schur), *setup.exact, polish);
     NewtonOptions from_there = newton_options;  // solver.max_newton caps both runs together
+    from_there.conditions = first.conditions;
     from_there.start = &sol.newton;
     from_there.max_iterations = std::max(1, newton_options.max_iterations - sol.newton.iterations);
     NewtonResult second = solve_semismooth_newton(preconditioned, setup.b0, setup.c0, g, from_there, mode);
@@ -451,7 +511,7 @@ void field(const State<dim>& st, const BoundarySetup<dim>& setup, BasicSolution<
 template <int dim>
 void signorini_checks(const BoundaryDiscretization<dim>& boundary, BasicSolution<dim>& sol) {
   const int m = boundary.n_points();
-  sol.signorini = detail::signorini_check(sol.trace, sol.normal_derivative, sol.g);
+  sol.signorini = detail::signorini_check(sol.trace, sol.normal_derivative, sol.g, sol.conditions.kind);
   if (sol.u.empty()) return;
   IndependentCheck check;
   std::optional<std::vector<double>> d = boundary.independent_normal_derivative(sol.u, check.rule);
@@ -460,11 +520,13 @@ void signorini_checks(const BoundaryDiscretization<dim>& boundary, BasicSolution
   double sum = 0.0;
   for (int i = 0; i < m; ++i) {
     const double gap = sol.trace[i] - sol.g[i], difference = (*d)[i] - sol.normal_derivative[i];
-    check.min_normal_derivative = std::min(check.min_normal_derivative, (*d)[i]);
-    check.max_complementarity = std::max(check.max_complementarity, std::abs(gap * (*d)[i]));
     check.max_difference = std::max(check.max_difference, std::abs(difference));
     sum += difference * difference;
+    if (sol.condition(i) != PointCondition::signorini) continue;
+    check.min_normal_derivative = std::min(check.min_normal_derivative, (*d)[i]);
+    check.max_complementarity = std::max(check.max_complementarity, std::abs(gap * (*d)[i]));
   }
+  if (!std::isfinite(check.min_normal_derivative)) check.min_normal_derivative = 0;
   check.rms_difference = std::sqrt(sum / m);
   check.normal_derivative = std::move(*d);
   sol.check = std::move(check);
@@ -537,7 +599,7 @@ ErrorEstimate error_estimate(const BasicSolution<dim>& coarse, const BasicSoluti
   e.l2_omega = std::sqrt(difference2) / second_order;
   const double norm = std::sqrt(fine.domain->integral_u2);
   e.rel_l2_omega = norm > 0 ? e.l2_omega / norm : e.l2_omega;
-  e.force = std::abs(fine.domain->flux - coarse.domain->flux) / second_order;
+  e.force = std::abs(contact_summary(fine).force - contact_summary(coarse).force) / second_order;
   e.energy = std::abs(fine.domain->energy - coarse.domain->energy) / second_order;
   e.integral_u = std::abs(fine.domain->integral_u - coarse.domain->integral_u) / second_order;
   e.measure = std::abs(contact_summary(fine).measure - contact_summary(coarse).measure) / first_order;
@@ -627,6 +689,7 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
   BasicSolution<dim> sol(st.grid);
   PhaseClock clock(sol.timings, st.execution);
   BoundarySetup<dim>& setup = boundary_setup<dim>(st, data, options, clock, sol.reused_curve);  // 1–2
+  obstacle_and_conditions<dim>(*setup.boundary, data, st.c, sol);                               // 4
   st.execution.throw_if_interrupted();
   ActiveSet start;
   const std::optional<BasicSolution<dim>> coarse =
@@ -641,7 +704,6 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
   boundary.describe(sol);
   sol.delta = boundary.delta();
   sol.flux_balance = boundary.flux_balance(setup.shift);
-  sol.g = boundary.obstacle(data);                      // 4
   newton<dim>(st, setup, options, start, sol);          // 5
   if (!keep) setup.schur.reset(), setup.exact.reset();  // S_B, S_C and the kept LU: freed before the field
   clock.mark("newton");

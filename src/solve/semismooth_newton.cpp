@@ -27,14 +27,21 @@ ActiveSet starting_active_set(const Eigen::VectorXd& b0, const Eigen::VectorXd& 
     result.lambda = options.start->lambda;
     result.alpha = options.start->alpha;
   }
+  if (const PointConditions* fixed = options.conditions) {
+    if (Eigen::Index(fixed->kind.size()) != m || fixed->flux.size() != m)
+      throw std::invalid_argument("solve_semismooth_newton: the conditions are of another size");
+    for (int i = 0; i < m; ++i)
+      if (fixed->fixed(i)) active[std::size_t(i)] = fixed->row(i);
+  }
   return active;
 }
 
 /// Step 2: the traces b = B_γu, c = C_γu at the new λ (stored in `result`), the shifted readings
-/// c − ρ(b − g), the residual ‖F‖∞ of F = c − max(0, c − ρ(b − g)) and the scale it is judged against.
+/// c − ρ(b − g), the residual ‖F‖∞ of F = c − max(0, c − ρ(b − g)) (at fixed points ρ(b − g) or c − q)
+/// and the scale it is judged against.
 Eigen::VectorXd residual(const SchurComplement& schur, const Eigen::VectorXd& b0, const Eigen::VectorXd& c0,
-                         const Eigen::VectorXd& g, double rho, const ConstantMode* mode, NewtonResult& result,
-                         double& scale) {
+                         const Eigen::VectorXd& g, double rho, const ConstantMode* mode, const PointConditions* fixed,
+                         NewtonResult& result, double& scale) {
   Eigen::VectorXd sb, sc;
   schur.apply(result.lambda, sb, sc);
   Eigen::VectorXd b = b0 + sb, c = c0 + sc;
@@ -45,9 +52,16 @@ Eigen::VectorXd residual(const SchurComplement& schur, const Eigen::VectorXd& b0
   result.trace = b;
   result.normal_derivative = c;
   Eigen::VectorXd shifted = c - rho * (b - g);
-  const Eigen::VectorXd F = c - shifted.cwiseMax(0.0);
+  Eigen::VectorXd F = c - shifted.cwiseMax(0.0);
+  double flux = 0;
+  if (fixed) {
+    for (Eigen::Index i = 0; i < F.size(); ++i)
+      if (fixed->fixed(int(i))) F(i) = fixed->row(int(i)) ? rho * (b(i) - g(i)) : c(i) - fixed->flux(i);
+    flux = fixed->flux.lpNorm<Eigen::Infinity>();
+  }
   result.residual = F.lpNorm<Eigen::Infinity>();
-  scale = std::max({b.lpNorm<Eigen::Infinity>(), c.lpNorm<Eigen::Infinity>(), g.lpNorm<Eigen::Infinity>(), 1e-300});
+  scale =
+      std::max({b.lpNorm<Eigen::Infinity>(), c.lpNorm<Eigen::Infinity>(), g.lpNorm<Eigen::Infinity>(), flux, 1e-300});
   return shifted;
 }
 
@@ -65,23 +79,24 @@ NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::
   ActiveSet active = starting_active_set(b0, c0, g, options, result);  // 0. Start.
   std::vector<ActiveSet> seen{active};
 
+  const PointConditions* fixed = options.conditions;
   Eigen::VectorXd d(m);
   for (int k = 0; k < options.max_iterations; ++k) {
     if (options.between_steps) options.between_steps();
     // 1. Linear solve for the current active set.
-    for (int i = 0; i < m; ++i) d(i) = active[i] ? g(i) - b0(i) : -c0(i);
+    for (int i = 0; i < m; ++i) d(i) = active[i] ? g(i) - b0(i) : (fixed ? fixed->flux(i) : 0.0) - c0(i);
     const LinearSolveReport linear = schur.solve(active, d, mode, result.lambda, result.alpha);
     ++result.iterations;
 
     // 2. Residual at the new λ.
     double scale = 0;
-    const Eigen::VectorXd shifted = residual(schur, b0, c0, g, rho, mode, result, scale);
+    const Eigen::VectorXd shifted = residual(schur, b0, c0, g, rho, mode, fixed, result, scale);
 
     // 3. New active set.
     ActiveSet next(m);
     int changed = 0;
     for (int i = 0; i < m; ++i) {
-      next[i] = shifted(i) > 0;
+      next[i] = fixed && fixed->fixed(i) ? fixed->row(i) : shifted(i) > 0;
       changed += next[i] != active[i];
     }
     result.history.push_back(

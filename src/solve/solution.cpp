@@ -24,18 +24,27 @@ ContactSummary contact_summary(const BasicSolution<dim>& s) {
   c.max_gap = -c.min_gap;
   const std::vector<double>& part = s.weights();
   for (int i = 0; i < s.n_points(); ++i) {
+    const PointCondition kind = s.condition(i);
+    PartSummary& in = kind == PointCondition::dirichlet ? c.dirichlet
+                      : kind == PointCondition::neumann ? c.neumann
+                                                        : c.signorini;
+    ++in.points;
+    in.measure += part[i];
+    in.flux += s.normal_derivative[i] * part[i];
+    if (kind != PointCondition::signorini) continue;
     const double gap = s.trace[i] - s.g[i];
     c.min_gap = std::min(c.min_gap, gap);
     c.max_gap = std::max(c.max_gap, gap);
-    if (s.newton.active[i] == 1) {
+    if (s.in_contact(i)) {
       ++c.points;
       c.force_patches += s.normal_derivative[i] * part[i];
       c.measure_points += part[i];
     }
   }
+  if (c.signorini.points == 0) c.min_gap = c.max_gap = 0;
   c.measure = s.contact_measure;
-  c.force_from_domain = s.domain.has_value();
-  c.force = s.domain ? s.domain->flux : c.force_patches;
+  c.force_from_domain = s.domain.has_value() && c.dirichlet.points == 0 && c.neumann.points == 0;
+  c.force = c.force_from_domain ? s.domain->flux : c.force_patches;
   c.lambda = s.lambda_total;
   return c;
 }
@@ -110,8 +119,8 @@ void resolve_contact(BasicSolution<dim>& s) {
   const std::vector<double>& part = s.weights();
   double measure = 0, total = 0;
   for (int i = 0; i < s.n_points(); ++i) {
-    total += part[std::size_t(i)];
-    if (s.newton.active[std::size_t(i)] == 1) measure += part[std::size_t(i)];
+    if (s.condition(i) == PointCondition::signorini) total += part[std::size_t(i)];
+    if (s.in_contact(i)) measure += part[std::size_t(i)];
   }
   s.contact_boundary.clear();
   s.contact_boundary_lines.clear();
@@ -119,7 +128,8 @@ void resolve_contact(BasicSolution<dim>& s) {
   // The part of d between the points that each owns, in proportion to their parts' sizes.
   const auto size = [&part](int i) { return dim == 2 ? part[std::size_t(i)] : std::sqrt(part[std::size_t(i)]); };
   for (const NeighbourPair& p : neighbour_pairs<dim>(s)) {
-    const bool i_active = s.newton.active[std::size_t(p.i)] == 1, j_active = s.newton.active[std::size_t(p.j)] == 1;
+    if (s.condition(p.i) != PointCondition::signorini || s.condition(p.j) != PointCondition::signorini) continue;
+    const bool i_active = s.in_contact(p.i), j_active = s.in_contact(p.j);
     if (i_active == j_active) continue;
     const int a = i_active ? p.i : p.j, b = i_active ? p.j : p.i;
     const double q = s.normal_derivative[std::size_t(a)], r = s.trace[std::size_t(b)] - s.g[std::size_t(b)];

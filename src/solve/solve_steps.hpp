@@ -120,16 +120,19 @@ inline GmresOptions gmres_options(const SolverOptions& options, int m, const Exe
 }
 
 /// The discrete Signorini conditions at the points: gap = B_γû − g ≥ 0, C_γû ≥ 0, their product 0.
+/// (at the Signorini points: `kind` empty, or the points it marks signorini; 0 where there are none).
 inline SignoriniCheck signorini_check(const std::vector<double>& trace, const std::vector<double>& normal_derivative,
-                                      const std::vector<double>& g) {
+                                      const std::vector<double>& g, const std::vector<PointCondition>& kind = {}) {
   SignoriniCheck s;
   s.min_gap = s.min_normal_derivative = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < g.size(); ++i) {
+    if (!kind.empty() && kind[i] != PointCondition::signorini) continue;
     const double gap = trace[i] - g[i], dn = normal_derivative[i];
     s.min_gap = std::min(s.min_gap, gap);
     s.min_normal_derivative = std::min(s.min_normal_derivative, dn);
     s.max_complementarity = std::max(s.max_complementarity, std::abs(gap * dn));
   }
+  if (!std::isfinite(s.min_gap)) s.min_gap = s.min_normal_derivative = 0;
   return s;
 }
 

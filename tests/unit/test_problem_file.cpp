@@ -106,3 +106,45 @@ TEST(ProblemFile, ManufacturedExamplesMatchTheirCxxTwins) {
 }
 
 }  // namespace
+
+// [conditions]: the parts and values as functions of the point (and the normal for the flux), in both
+// dimensions; the section is echoed in results.json's problem; keys out of place are errors.
+TEST(ProblemFile, ConditionsSection) {
+  const std::string base2 =
+      "[geometry]\nshape = \"circle\"\ncenter = [0.5, 0.5]\nradius = 0.3\n[data]\nf = \"1\"\ng = \"0\"\n";
+  const fictus::ProblemSpec spec = fictus::parse_problem_text(
+      base2 + "[conditions]\ndirichlet = \"x < 0.3\"\nu = \"2*y\"\nneumann = \"x > 0.7\"\nflux = \"nx + 3*ny\"\n");
+  const fictus::PartConditions<2>& c = spec.problem.conditions;
+  ASSERT_TRUE(c.mixed() && c.dirichlet && c.neumann && c.u && c.flux);
+  EXPECT_EQ(c.dirichlet({0.25, 0.5}), 1.0);
+  EXPECT_EQ(c.dirichlet({0.35, 0.5}), 0.0);
+  EXPECT_DOUBLE_EQ(c.u({0.2, 0.4}), 0.8);
+  EXPECT_DOUBLE_EQ(c.flux({0.8, 0.5}, {0.6, 0.8}), 0.6 + 2.4);
+  EXPECT_NE(spec.input_json.find("\"conditions\""), std::string::npos);
+  EXPECT_FALSE(fictus::parse_problem_text(base2).problem.conditions.mixed());
+
+  const std::string base3 =
+      "[domain]\ndim = 3\n[geometry]\nshape = \"sphere\"\ncenter = [0.5, 0.5, 0.5]\n"
+      "radius = 0.3\n[data]\nf = \"1\"\ng = \"0\"\n";
+  const fictus::SurfaceProblemSpec spec3 =
+      fictus::parse_surface_problem_text(base3 + "[conditions]\nneumann = \"z > 0.5\"\nflux = \"x*nz\"\n");
+  const fictus::PartConditions<3>& c3 = spec3.problem.conditions;
+  ASSERT_TRUE(c3.neumann && c3.flux && !c3.dirichlet);
+  EXPECT_EQ(c3.neumann({0.5, 0.5, 0.6}), 1.0);
+  EXPECT_DOUBLE_EQ(c3.flux({0.5, 0.5, 0.6}, {0, 0, 1}), 0.5);
+
+  for (const auto& [extra, message] : std::vector<std::pair<std::string, std::string>>{
+           {"[conditions]\nu = \"1\"\n", "conditions.u: given without conditions.dirichlet"},
+           {"[conditions]\nflux = \"1\"\n", "conditions.flux: given without conditions.neumann"},
+           {"[conditions]\ndirichlet = \"x < 0.4\"\n", "conditions.u: missing"},
+           {"[conditions]\nneumann = \"x < 0.4\"\nflux = \"nz\"\n", "conditions.flux: cannot parse"},
+           {"[conditions]\ndirichlet = 1\nu = \"0\"\n", "conditions.dirichlet: expected a string"},
+           {"[condition]\n", "condition: unknown section"}}) {
+    try {
+      fictus::parse_problem_text(base2 + extra);
+      ADD_FAILURE() << "accepted: " << extra;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
+}

@@ -212,3 +212,54 @@ TEST(NewtonFactorization, UpdatesSolveAsAFreshLu) {
     EXPECT_EQ(schur.factorizations(), now + 1);
   }
 }
+
+// Mixed conditions: on a small S (symmetric, diagonally dominant) Dirichlet rows hold b = g and Neumann
+// rows c = q whatever the start; the Signorini rows satisfy their conditions; with only fixed rows one
+// linear solve does it.
+TEST(NewtonMixedConditions, FixedRowsHoldAndSignoriniRowsChoose) {
+  const int m = 12;
+  Eigen::MatrixXd S_B(m, m), S_C(m, m);
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      S_B(i, j) = (i == j ? 4.0 : 0.0) + 0.3 / (1 + std::abs(i - j));
+      S_C(i, j) = (i == j ? 3.0 : 0.0) + 0.2 / (1 + std::abs(i - j)) + 0.05 * ((i + j) % 3);
+    }
+  const fictus::ExplicitSchur schur(S_B, S_C);
+  Eigen::VectorXd b0(m), c0(m), g(m);
+  for (int i = 0; i < m; ++i) b0(i) = 0.1 * i - 0.5, c0(i) = 0.2 * std::sin(double(i)), g(i) = 0.05 * (i % 4);
+  fictus::PointConditions conditions;
+  conditions.kind.assign(m, fictus::PointCondition::signorini);
+  conditions.flux = Eigen::VectorXd::Zero(m);
+  for (int i : {0, 1, 2}) conditions.kind[std::size_t(i)] = fictus::PointCondition::dirichlet;
+  for (int i : {7, 8})
+    conditions.kind[std::size_t(i)] = fictus::PointCondition::neumann, conditions.flux(i) = 0.3 - i * 0.1;
+  for (const bool all : {true, false}) {
+    fictus::NewtonOptions o;
+    o.start_all_active = all;
+    o.conditions = &conditions;
+    const fictus::NewtonResult r = fictus::solve_semismooth_newton(schur, b0, c0, g, o);
+    ASSERT_TRUE(r.converged) << r.failure;
+    for (int i = 0; i < m; ++i) {
+      if (conditions.kind[std::size_t(i)] == fictus::PointCondition::dirichlet) {
+        EXPECT_EQ(r.active[std::size_t(i)], 1);
+        EXPECT_NEAR(r.trace(i), g(i), 1e-12);
+      } else if (conditions.kind[std::size_t(i)] == fictus::PointCondition::neumann) {
+        EXPECT_EQ(r.active[std::size_t(i)], 0);
+        EXPECT_NEAR(r.normal_derivative(i), conditions.flux(i), 1e-12);
+      } else {  // Signorini: u ≥ g, ∂u/∂n ≥ 0, complementarity
+        EXPECT_GE(r.trace(i) - g(i), -1e-12);
+        EXPECT_GE(r.normal_derivative(i), -1e-12);
+        EXPECT_LE(std::abs((r.trace(i) - g(i)) * r.normal_derivative(i)), 1e-12);
+      }
+    }
+  }
+  for (auto& kind : conditions.kind)  // no Signorini row left: linear, one step
+    if (kind == fictus::PointCondition::signorini) kind = fictus::PointCondition::dirichlet;
+  fictus::NewtonOptions o;
+  o.conditions = &conditions;
+  const fictus::NewtonResult r = fictus::solve_semismooth_newton(schur, b0, c0, g, o);
+  ASSERT_TRUE(r.converged);
+  EXPECT_EQ(r.iterations, 1);
+  conditions.kind.pop_back();
+  EXPECT_THROW(fictus::solve_semismooth_newton(schur, b0, c0, g, o), std::invalid_argument);
+}

@@ -1,7 +1,9 @@
 #pragma once
 // A Signorini problem on ω ⊂ Ω ⊂ R^dim (dim = 2 or 3), one type for both dimensions:
 //   −Δu + c·u = f in ω,  u ≥ g, ∂u/∂n ≥ 0, (∂u/∂n)(u − g) = 0 on γ = ∂ω,
-// γ a closed curve (dim = 2, curve.hpp) or a closed surface (dim = 3, surface.hpp).
+// γ a closed curve (dim = 2, curve.hpp) or a closed surface (dim = 3, surface.hpp); or, with mixed
+// conditions (PartConditions), u = u_D on a Dirichlet part and ∂u/∂n = q on a Neumann part of γ and
+// the Signorini conditions on the rest.
 #include <functional>
 #include <memory>
 #include <string>
@@ -34,12 +36,25 @@ struct ObstacleAlongBoundary<2> {
   std::function<double(double x, double y, double s)> g_along_curve;
 };
 
-/// What may change from one solve to the next on the same grid: γ, the obstacle and the exact
-/// solution (FictitiousDomainSolver::solve).
+/// Conditions other than Signorini's on parts of γ (docs/math.md, "Mixed conditions"). A point x of γ
+/// is in the Dirichlet part where dirichlet(x) ≠ 0 (there u = u_D(x)), in the Neumann part where
+/// neumann(x) ≠ 0 (there ∂u/∂n = q(x, n), n the outward normal), in no more than one of them, and in
+/// the Signorini part (the obstacle g) elsewhere. Unset `dirichlet` and `neumann`: all of γ is Signorini.
+template <int dim>
+struct PartConditions {
+  std::function<double(const Point<dim>&x)> dirichlet, neumann;          // where (non-zero: in the part)
+  std::function<double(const Point<dim>& x)> u;                          // u_D on the Dirichlet part
+  std::function<double(const Point<dim>& x, const Point<dim>& n)> flux;  // q on the Neumann part (unset: 0)
+  bool mixed() const { return bool(dirichlet) || bool(neumann); }
+};
+
+/// What may change from one solve to the next on the same grid: γ, the obstacle, the conditions on
+/// parts of γ and the exact solution (FictitiousDomainSolver::solve).
 template <int dim>
 struct BasicContactData : ObstacleAlongBoundary<dim> {
   std::shared_ptr<const typename BoundaryShape<dim>::type> gamma;  // γ, strictly inside Ω (a curve counter-clockwise)
   typename Fields<dim>::Scalar g;                                  // obstacle, sampled at the points on γ
+  PartConditions<dim> conditions;                                  // Dirichlet and Neumann parts (none: all Signorini)
   /// Optional batch forms (e.g. numpy callables), used instead of g and exact when set.
   typename Fields<dim>::Vectorized g_vectorized, exact_vectorized;
   typename Fields<dim>::Scalar exact;             // optional exact solution on ω (errors are computed if set)

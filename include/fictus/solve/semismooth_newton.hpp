@@ -14,6 +14,9 @@
 //      older set (cycling) or after max_iterations; hand on (NewtonOptions::hand_on_at_changes)
 //      when 𝒜' differs from 𝒜 in at most that many points, returning 𝒜' as the next set.
 // λ is not sign-constrained: the B/C rows carry the Signorini conditions.
+// Mixed conditions (NewtonOptions::conditions): a Dirichlet point keeps its B row (B_γu = g_i, g_i its
+// value u_D) and a Neumann point its C row (C_γu = q_i) in every step, with F_i = ρ(b − g)_i and
+// (c − q)_i; only the Signorini points change sides. With no Signorini point one step solves it.
 #include <functional>
 #include <string>
 #include <vector>
@@ -27,6 +30,19 @@ namespace fictus {
 
 struct NewtonResult;
 
+/// The condition at a point of γ (mixed conditions, docs/math.md): Signorini (its row chosen by the active
+/// set), or an equation always in force: Dirichlet (the B row) or Neumann (the C row).
+enum class PointCondition : char { signorini = 0, dirichlet = 1, neumann = 2 };
+
+/// The conditions at the points: each point's kind and q at the Neumann points (0 elsewhere).
+struct PointConditions {
+  std::vector<PointCondition> kind;
+  Eigen::VectorXd flux;
+  bool fixed(int i) const { return kind[std::size_t(i)] != PointCondition::signorini; }
+  /// The row a fixed point always takes (1: B, 0: C).
+  char row(int i) const { return kind[std::size_t(i)] == PointCondition::dirichlet ? 1 : 0; }
+};
+
 /// The Newton part of SolverOptions (its defaults).
 struct NewtonOptions {
   double rho = SolverOptions{}.rho;                 // ρ > 0 of the projection
@@ -36,6 +52,7 @@ struct NewtonOptions {
   std::function<void()> between_steps;                  // called before each linear solve (may throw)
   const NewtonResult* start = nullptr;                  // go on from an earlier run's active set, λ and α (not owned)
   const ActiveSet* start_active = nullptr;              // the first active set, with λ = 0 (not owned)
+  const PointConditions* conditions = nullptr;          // mixed conditions (not owned); nullptr: all Signorini
   /// Hand on (stop, not converged, `active` the next set to try) once a step changes at most this
   /// many points; negative: never.
   int hand_on_at_changes = -1;

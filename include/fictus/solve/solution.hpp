@@ -145,7 +145,16 @@ struct BasicSolution : SolutionBoundary<dim> {
   std::vector<std::string> warnings;  // what the solve changed to fit (one line each), for the user
   GridVector u;                       // û at the unknowns (empty when the field was not asked for)
   double delta = 0;                   // distance of Γ from γ
-  std::vector<double> lambda, g, trace, normal_derivative;  // per point: λ, g, B_γû, C_γû
+  std::vector<double> lambda, g, trace, normal_derivative;  // per point: λ, g (u_D at Dirichlet points), B_γû, C_γû
+  /// Mixed conditions: each point's condition and q at the Neumann points; kind empty: all Signorini.
+  PointConditions conditions;
+  PointCondition condition(int i) const {
+    return conditions.kind.empty() ? PointCondition::signorini : conditions.kind[std::size_t(i)];
+  }
+  /// A Signorini point in contact (Dirichlet points keep their B rows but are not in contact).
+  bool in_contact(int i) const {
+    return newton.active[std::size_t(i)] == 1 && condition(i) == PointCondition::signorini;
+  }
   double lambda_total = 0;  // Σ_i λ_i·|Γ_i| = 1ᵀB_Γᵀλ, the total load λ adds to the box (∫_Γ λ)
   double alpha = 0;         // constant added to û (singular A: periodic box, c = 0)
   NewtonResult newton;
@@ -198,22 +207,33 @@ double contact_end_fraction(double q, double r, double d);
 template <int dim>
 void resolve_contact(BasicSolution<dim>& solution);
 
+/// One part of γ under one condition: its points, its measure Σ part_i and the flux through it
+/// Σ (C_γû)_i·part_i.
+struct PartSummary {
+  long points = 0;
+  double measure = 0;
+  double flux = 0;
+};
+
 /// The contact in numbers, from the per-point values of a solution (point i owns the part
-/// weights()[i] of γ: an arc length in 2-D, a patch area in 3-D).
+/// weights()[i] of γ: an arc length in 2-D, a patch area in 3-D). With mixed conditions only the
+/// Signorini part has contact, and `force` is the patch sum (the domain identity gives the flux
+/// through all of γ).
 struct ContactSummary {
-  long points = 0;            // points in contact (the active set)
+  PartSummary signorini, dirichlet, neumann;  // the parts of γ (all of it Signorini without mixed conditions)
+  long points = 0;                            // points in contact (the active set)
   double measure = 0;         // length (2-D) or area (3-D) of the contact set, resolved inside the parts
                               // (BasicSolution::contact_measure)
   double measure_points = 0;  // the same as Σ over the contact points of their part
   double force = 0;  // total contact force ∫ ∂u/∂n over the contact set: the flux c∫_ω û − ∫_ω f where the
-                     // field was computed (DomainQuantities), else force_patches
+                     // field was computed (DomainQuantities) and all of γ is Signorini, else force_patches
   double force_patches = 0;        // the same as Σ_active (C_γû)_i·part_i: from the readings, a check of `force`
   bool force_from_domain = false;  // `force` is the domain identity
   double lambda = 0;   // ∫_Γ λ = Σ λ_i·|Γ_i| (BasicSolution::lambda_total): non-smooth, the jump [∂û/∂n]
                        // integrated over γ (it includes the fictitious field outside ω: not the
                        // contact force); smooth, the total control on Γ
-  double min_gap = 0;  // min_i (B_γû − g)_i  (≈ 0: the contact points)
-  double max_gap = 0;  // max_i (B_γû − g)_i  (the widest opening)
+  double min_gap = 0;  // min_i (B_γû − g)_i over the Signorini points (≈ 0: the contact points)
+  double max_gap = 0;  // max_i (B_γû − g)_i over the Signorini points (the widest opening)
 };
 template <int dim>
 ContactSummary contact_summary(const BasicSolution<dim>& solution);
