@@ -441,6 +441,37 @@ void obstacle_and_conditions(const BoundaryDiscretization<dim>& boundary, const 
   sol.conditions = std::move(pc);
 }
 
+/// With mixed conditions: where the Dirichlet part meets the Signorini part with the obstacle above
+/// u_D (u ≥ g on one side, u = u_D on the other), u jumps: its energy is infinite and the quantities do
+/// not converge with N. Judged at each Dirichlet–Signorini pair of neighbours from g − u_D at both points:
+/// their mean (the mismatch at the junction) beyond their difference (what one spacing explains). A
+/// warning names the first such junction.
+template <int dim>
+void junction_warning(const BoundaryDiscretization<dim>& boundary, const BasicContactData<dim>& data,
+                      BasicSolution<dim>& sol) {
+  if (!data.conditions.dirichlet || sol.conditions.kind.empty()) return;
+  const std::vector<double> g = boundary.obstacle(data);  // the obstacle at the Dirichlet points too
+  double scale = 0;
+  for (double v : sol.g) scale = std::max(scale, std::abs(v));
+  for (const NeighbourPair& pair : neighbour_pairs<dim>(sol)) {
+    const PointCondition a = sol.condition(pair.i), b = sol.condition(pair.j);
+    if (!((a == PointCondition::dirichlet && b == PointCondition::signorini) ||
+          (a == PointCondition::signorini && b == PointCondition::dirichlet)))
+      continue;
+    const Point<dim>&xi = sol.points()[std::size_t(pair.i)], &xj = sol.points()[std::size_t(pair.j)];
+    const double di = g[std::size_t(pair.i)] - data.conditions.u(xi),
+                 dj = g[std::size_t(pair.j)] - data.conditions.u(xj);
+    const double mismatch = 0.5 * (di + dj);
+    if (!(mismatch > std::abs(di - dj) + 1e-9 * scale)) continue;
+    sol.warnings.push_back("conditions.u: where the Dirichlet part meets the Signorini part near " +
+                           detail::format_point<dim>(0.5 * (xi + xj)) + ", the obstacle g lies " +
+                           format_number(mismatch) +
+                           " above u there: u jumps (its energy is infinite) and the quantities do not converge "
+                           "with N");
+    return;
+  }
+}
+
 /// Step 5: semismooth Newton on λ with the Schur blocks; where the far field was interpolated, on S̃
 /// until the active set has nearly settled, then on the exact S preconditioned by S̃ from there.
 template <int dim>
@@ -702,6 +733,7 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
   load_terms<dim>(st, setup);
   const BoundaryDiscretization<dim>& boundary = *setup.boundary;
   boundary.describe(sol);
+  junction_warning<dim>(boundary, data, sol);
   sol.delta = boundary.delta();
   sol.flux_balance = boundary.flux_balance(setup.shift);
   newton<dim>(st, setup, options, start, sol);          // 5

