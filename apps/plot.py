@@ -334,7 +334,7 @@ def plot_surface(folder, with_lambda):
             lam_surface = read_vtp(os.path.join(folder, "offset_surface.vtp"))
             fields.append((lam_surface[2]["lambda"], lambda_label(variant).replace("\n", " "), "coolwarm"))
     if "condition" in cells and np.any(cells["condition"] > 0):  # mixed conditions: the parts of γ
-        fields.append((cells["condition"], "parts of γ: 0 Signorini, 1 Dirichlet, 2 Neumann", "viridis"))
+        fields.append((cells["condition"], "parts of γ (0 S, 1 D, 2 N)", "viridis"))
     views = [(25, -60, "front"), (-25, 120, "back")]
     fig, axes = plt.subplots(len(fields), 2, figsize=(11, 4.6 * len(fields)), squeeze=False,
                              constrained_layout=True)
@@ -352,7 +352,9 @@ def plot_surface(folder, with_lambda):
         plain(bar.ax.yaxis)
         if values is cells["dudn"] or values is cells["gap"]:
             bar.ax.axhline(0.0, color="w", lw=1.0)  # the contact/free divide: ∂u/∂n = 0 or u = g
-    fig.suptitle("fictus: γ coloured by the contact pressure and the gap" + (f" ({variant} variant)" if variant else ""))
+    mixed = "condition" in cells and np.any(cells["condition"] > 0)
+    fig.suptitle("fictus: γ coloured by the contact pressure and the gap" + (f" ({variant} variant)" if variant else "") +
+                 ("\nparts of γ: 0 Signorini (S), 1 Dirichlet (D), 2 Neumann (N)" if mixed else ""))
     fig.savefig(os.path.join(folder, "surface.png"), dpi=110)
     plt.close(fig)
 

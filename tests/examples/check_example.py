@@ -2,7 +2,7 @@
 """Checks the results of an example solve: Newton converged, the discrete Signorini conditions hold,
 errors below bounds (where an exact solution exists), a non-trivial contact set, and optionally the
 same errors as another solve. Usage:
-  check_example.py DIR [--max-rel-l2 X] [--max-rel-h1 X] [--max-rel-l2-gamma X] [--compare DIR2]"""
+  check_example.py DIR [--max-rel-l2 X] [--max-rel-h1 X] [--max-rel-l2-gamma X] [--compare DIR2] [--mixed]"""
 import argparse
 import json
 
@@ -19,6 +19,7 @@ def main():
     parser.add_argument("--max-rel-h1", type=float)
     parser.add_argument("--max-rel-l2-gamma", type=float)
     parser.add_argument("--compare")
+    parser.add_argument("--mixed", action="store_true", help="mixed conditions: check the parts of gamma")
     args = parser.parse_args()
     r = load(args.dir)
     echo = r["problem"]  # what was solved: the problem file's geometry and data, or the built-in problem
@@ -30,6 +31,11 @@ def main():
     assert s["min_gap"] >= -tol and s["min_normal_derivative"] >= -tol and s["max_complementarity"] <= tol, s
     n_active, m = r["newton"]["n_active"], r["multipliers"]
     assert 0 < n_active < m, f"contact set is trivial: {n_active} of {m}"
+    if args.mixed:  # every part of γ is there, and the Signorini part has contact and free points
+        parts = r["conditions"]
+        assert all(parts[k]["points"] > 0 for k in ("signorini", "dirichlet", "neumann")), parts
+        assert 0 < r["contact"]["points"] < parts["signorini"]["points"], (r["contact"], parts)
+        assert not any("conditions.u" in w for w in r["warnings"]), r["warnings"]
     bounds = {"rel_l2_omega": args.max_rel_l2, "rel_h1_omega": args.max_rel_h1, "rel_l2_gamma": args.max_rel_l2_gamma}
     for key, bound in bounds.items():
         if bound is not None:
