@@ -23,7 +23,8 @@ pkg=$(dpkg-query -W -f='${Version}' freefem++ 2>/dev/null || true)
 
 problems=("$@")
 [ ${#problems[@]} -eq 0 ] && problems=(ellipse star peanut)
-for p in "${problems[@]}"; do
+[ "${MIXED:-0}" = only ] && problems=()
+for p in ${problems[@]+"${problems[@]}"}; do
   echo "== $p (log: $LOGDIR/$p.log)"
   FreeFem++ -nw -v 0 signorini.edp -problem "$p" -out "$p.json" -pkg "$pkg" > "$LOGDIR/$p.log" 2>&1
   grep -E '^LEVEL' "$LOGDIR/$p.log"
@@ -40,4 +41,25 @@ if [ "${GEN3D:-0}" = 1 ]; then
   echo "== ellipsoid3d (log: $LOGDIR/ellipsoid3d.log)"
   FreeFem++ -nw -v 0 signorini3d.edp -levels 4,6,8 -out ellipsoid3d.json -pkg "$pkg" > "$LOGDIR/ellipsoid3d.log" 2>&1
   grep -E '^LEVEL' "$LOGDIR/ellipsoid3d.log"
+fi
+
+# Mixed Dirichlet/Neumann/Signorini conditions (peanut_mixed.json and
+# ellipsoid3d_mixed.json, problems peanut_mixed.toml and ellipsoid3d_mixed.toml):
+# signorini_mixed.edp (2-D, as signorini.edp with the junctions of the parts as
+# mesh vertices and the mesh graded towards them) and signorini3d_mixed.edp
+# (3-D, as signorini3d.edp with the parts the images of two cube faces, nodes
+# graded towards the faces, CG instead of UMFPACK; levels m = 4,6,8,12,16).
+# Not run by default; regenerate with
+#   MIXED=1 ./generate.sh        (after the problems above)
+#   MIXED=only ./generate.sh     (only these two)
+# Measured on one core (shared with another job): peanut_mixed TIME2D
+# (1.2e6 P2 dofs on the last level, up to MEM2D of memory); ellipsoid3d_mixed
+# TIME3D (274625 P2 dofs on the last level, up to MEM3D).
+if [ "${MIXED:-0}" != 0 ]; then
+  echo "== peanut_mixed (log: $LOGDIR/peanut_mixed.log)"
+  FreeFem++ -nw -v 0 signorini_mixed.edp -problem peanut_mixed -out peanut_mixed.json -pkg "$pkg" > "$LOGDIR/peanut_mixed.log" 2>&1
+  grep -E '^LEVEL' "$LOGDIR/peanut_mixed.log"
+  echo "== ellipsoid3d_mixed (log: $LOGDIR/ellipsoid3d_mixed.log)"
+  FreeFem++ -nw -v 0 signorini3d_mixed.edp -levels 4,6,8,12,16 -out ellipsoid3d_mixed.json -pkg "$pkg" > "$LOGDIR/ellipsoid3d_mixed.log" 2>&1
+  grep -E '^LEVEL' "$LOGDIR/ellipsoid3d_mixed.log"
 fi
