@@ -102,11 +102,13 @@ inline Comparison compare(const Reference& r, const fictus::Solution& s) {
              std::sqrt(e0) / r.l2_omega,
              std::sqrt(e0 + e1) / std::hypot(r.l2_omega, r.h1semi_omega),
              std::sqrt(eg) / r.l2_gamma};
-  // Contact ends: fictus's lie between two collocation points of different status (the arc boundary).
+  // Contact ends: fictus's lie between two collocation points of different status (the arc boundary),
+  // both on the Signorini part (mixed conditions).
   std::vector<fictus::Point2> ends;
   const int m = s.collocation.m;
+  const auto signorini = [&s](int i) { return s.condition(i) == fictus::PointCondition::signorini; };
   for (int i = 0; i < m; ++i)
-    if (s.newton.active[i] != s.newton.active[(i + 1) % m])
+    if (signorini(i) && signorini((i + 1) % m) && s.in_contact(i) != s.in_contact((i + 1) % m))
       ends.push_back(0.5 * (s.collocation.point[i] + s.collocation.point[(i + 1) % m]));
   const auto largest_distance = [&](const std::vector<fictus::Point2>& found) {
     double largest = 0;
