@@ -294,6 +294,7 @@ KEYS = {"domain": ["box", "N", "boundary"],
         "geometry": ["shape", "center", "radius", "semi_axes", "angle", "vertices", "x", "y", "r"],
         "formulation": ["variant", "multipliers", "offset", "rho", "normal_derivative", "normal_shift"],
         "data": ["c", "f", "g", "exact"],
+        "conditions": ["dirichlet", "u", "neumann", "flux"],
         "solver": ["schur", "krylov_tolerance", "krylov_max_iterations", "newton_tolerance", "max_newton",
                    "start", "threads", "max_memory", "load_quadrature", "error_quadrature",
                    "condition_number"],
@@ -389,6 +390,13 @@ def mutate_document(rng, document):
             if rng.random() < 0.5 and count > 3:
                 vertices.insert(rng.randrange(count), copy.deepcopy(rng.choice(vertices)))
             document["geometry"] = {"shape": "polygon", "vertices": vertices}
+        elif action == 9 and rng.random() < 0.3:  # mixed conditions: parts of γ and their values
+            document.setdefault("conditions", {})
+            if isinstance(document["conditions"], dict):
+                key = rng.choice(KEYS["conditions"])
+                parts = ["x < 0.4", "y > 0.6", "x > 0.5 && y < 0.5", "z < 0.4", "nx > 0", "1", "0"]
+                document["conditions"][key] = rng.choice(parts + EXPRESSIONS if key in ("dirichlet", "neumann")
+                                                         else ["0", "1", "x + y", "nx", "nz"] + EXPRESSIONS)
         else:  # a data expression
             document.setdefault("data", {"f": "1", "g": "0"})
             if isinstance(document["data"], dict):

@@ -52,3 +52,7 @@ record huge_semi_axis --problem "$here/seeds/huge_semi_axis.toml" -- solve --N 9
 # turned curve lost its corners; solves now); an absurd rotation is refused
 record sweep_rotated_polygon --problem "$here/seeds/sweep_rotated_polygon.toml" -- sweep --rotate 0,1.0
 record sweep_rotate_1e300 --problem "$here/seeds/sweep_rotate_1e300.toml" -- sweep --rotate 1e+300 --normal_shift 1
+# Mixed conditions
+record mixed_heating --problem "$ex/mixed_heating.toml" -- solve --N 128
+record mixed_jump --problem "$root/tests/inputs/mixed_jump.toml" -- solve
+record mixed_overlap --problem "$bad/conditions_overlap.toml" -- solve
