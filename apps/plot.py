@@ -149,10 +149,10 @@ def plot_solution(folder):
         ax.plot(closed(p["Gamma_x"]), closed(p["Gamma_y"]), "--", color="tab:orange", lw=1, label="Γ")
     contact = p["contact"] > 0
     ax.plot(p["x"][contact], p["y"][contact], "r.", ms=4, label="contact")
-    for code, marker, colour, label in PARTS:  # mixed conditions: the Dirichlet and Neumann parts
+    for code, marker, colour, part_label in PARTS:  # mixed conditions: the Dirichlet and Neumann parts
         part = p.get("condition", np.zeros_like(p["x"])) == code
         if np.any(part):
-            ax.plot(p["x"][part], p["y"][part], marker, color=colour, ms=4, label=label)
+            ax.plot(p["x"][part], p["y"][part], marker, color=colour, ms=4, label=part_label)
     # s = 0: the first point, and an arrow along γ in the direction of increasing s
     ax.plot(p["x"][0], p["y"][0], "o", mfc="none", mec="k", ms=8, label="s = 0")
     step = max(1, len(p["x"]) // 24)
@@ -193,10 +193,10 @@ def plot_profiles(folder, with_lambda):
         plain(ax.yaxis)
         ax.plot(p["s"], values, "k.-", ms=3, lw=0.8)
         ax.plot(p["s"][contact], values[contact], "r.", ms=4)
-        for code, marker, colour, label in PARTS:
+        for code, marker, colour, part_label in PARTS:
             part = p.get("condition", np.zeros_like(p["s"])) == code
             if np.any(part):
-                ax.plot(p["s"][part], values[part], marker, color=colour, ms=3, label=label)
+                ax.plot(p["s"][part], values[part], marker, color=colour, ms=3, label=part_label)
         ax.axhline(0.0, color="gray", lw=0.5, zorder=0)
         ax.set_ylabel(label, fontsize=9)
     check = p.get("dudn_check")

@@ -44,7 +44,7 @@ def main(folder):
         assert math.isfinite(value) and 0 < value < 1, f"errors.{key} = {value}"
     with open(f"{folder}/points.csv") as handle:
         rows = handle.read().strip().splitlines()
-    assert rows[0] == "i,s,x,y,nx,ny,weight,g,u,dudn,lambda,contact,Gamma_x,Gamma_y,dudn_check"
+    assert rows[0] == "i,s,x,y,nx,ny,weight,g,u,dudn,lambda,contact,condition,Gamma_x,Gamma_y,dudn_check"
     columns = [row.split(",") for row in rows[1:]]
     arcs = [float(c[6]) for c in columns]
     assert math.isclose(sum(arcs), results["boundary"]["measure"], rel_tol=1e-9), (sum(arcs), results["boundary"])
