@@ -32,7 +32,7 @@ def main():
     with open(os.path.join(folder, "points.csv")) as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == m, (len(rows), m)
-    header = "i x y z nx ny nz weight g u dudn lambda contact Gamma_x Gamma_y Gamma_z dudn_check"
+    header = "i x y z nx ny nz weight g u dudn lambda contact condition Gamma_x Gamma_y Gamma_z dudn_check"
     assert list(rows[0].keys()) == header.split(), rows[0].keys()
     assert sum(int(row["contact"]) for row in rows) == r["contact"]["points"]
     assert abs(sum(float(row["weight"]) for row in rows) - r["boundary"]["measure"]) < 1e-9
