@@ -183,6 +183,7 @@ TEST(SurfaceSolver, NamesWhatIsWrongWithItsInput) {
   EXPECT_EQ(error_of(p, o).rfind("data.g: not finite", 0), 0u);
   p.g = [](double, double, double) { return 1e200; };
   EXPECT_EQ(error_of(p, o).rfind("data.g: 1e+200 is beyond", 0), 0u);
+  p.g = [](double, double, double) { return 0.0; };  // (g is checked before the load)
   p.f = [](double, double, double) { return 1e300; };
   EXPECT_EQ(error_of(p, o).rfind("data.f: u0 = A^-1 f reaches", 0), 0u);
   EXPECT_THROW(fictus::Ellipsoid({0, 0, 0}, {1, -1, 1}), std::invalid_argument);
