@@ -101,6 +101,14 @@ void print_solver_extras(const fictus::BasicSolution<dim>& s) {
     std::printf("Schur complement: %.1f%% of the pairs interpolated; the last %d Newton steps on the exact one\n",
                 100 * a.far_pairs / (a.far_pairs + a.near_pairs), s.far_field->exact_steps);
   }
+  if (s.schur_storage && s.schur_storage->kind == "hierarchical") {
+    const fictus::SchurStorage& t = *s.schur_storage;
+    std::printf(
+        "Schur complement: hierarchical, %.3g MiB (%.1f%% of dense), %.1f%% of the pairs interpolated, %.0f "
+        "factored blocks up to rank %d; %d block LUs, %d Krylov iterations\n",
+        t.bytes / 1048576, 100 * t.bytes / t.dense_bytes, 100 * t.far_fraction, t.low_rank_blocks, t.largest_rank,
+        s.factorizations, s.inner_iterations);
+  }
   if (s.condition_number) std::printf("condition number of the Newton matrix: %.3e\n", *s.condition_number);
 }
 

@@ -133,13 +133,27 @@ json inner_json(const BasicSolution<dim>& s) {
             {"fast_solves", s.fast_solves},
             {"krylov_iterations", s.inner_iterations},
             {"factorizations", s.factorizations},
-            {"far_field", nullptr}};  // null where no pair was interpolated, as every optional block
+            {"far_field", nullptr},  // null where no pair was interpolated, as every optional block
+            {"schur_storage", nullptr}};
   if (s.far_field) {
     const FarFieldReport& a = s.far_field->assembly;
     j["far_field"] = {{"far_fraction", a.far_pairs / (a.far_pairs + a.near_pairs)},
                       {"far_blocks", a.far_blocks},
                       {"near_blocks", a.near_blocks},
                       {"exact_steps", s.far_field->exact_steps}};
+  }
+  if (s.schur_storage) {
+    const SchurStorage& t = *s.schur_storage;
+    j["schur_storage"] = {{"kind", t.kind},
+                          {"bytes", t.bytes},
+                          {"dense_bytes", t.dense_bytes},
+                          {"compression", t.dense_bytes > 0 ? t.bytes / t.dense_bytes : 1.0},
+                          {"low_rank_blocks", t.low_rank_blocks},
+                          {"full_blocks", t.full_blocks},
+                          {"largest_rank", t.largest_rank},
+                          {"preconditioner_bytes", t.preconditioner_bytes},
+                          {"far_fraction", t.far_fraction},
+                          {"seconds", t.seconds_assembly}};
   }
   return j;
 }

@@ -15,6 +15,7 @@
 #include "fictus/grid/load_vector.hpp"
 #include "fictus/solve/boundary_discretization.hpp"
 #include "fictus/solve/curve_discretization.hpp"
+#include "fictus/solve/hierarchical_schur.hpp"
 #include "fictus/solve/options.hpp"
 #include "fictus/solve/schur_complement.hpp"
 #include "fictus/solve/surface_discretization.hpp"
@@ -35,7 +36,7 @@ bool same_boundary_options(const SolverOptions& a, const SolverOptions& b) {
   return a.variant == b.variant && a.multipliers == b.multipliers && a.offset == b.offset &&
          a.normal_derivative == b.normal_derivative && a.normal_shift == b.normal_shift && a.inner == b.inner &&
          a.krylov_tolerance == b.krylov_tolerance && a.krylov_max_iterations == b.krylov_max_iterations &&
-         a.flux_balance == b.flux_balance && a.far_field == b.far_field;
+         a.flux_balance == b.flux_balance && a.far_field == b.far_field && a.schur_storage == b.schur_storage;
 }
 
 template <int dim>
@@ -80,11 +81,13 @@ struct BoundarySetup {
   std::unique_ptr<SchurComplement> schur;
   std::unique_ptr<ImplicitSchur> exact;  // the exact S behind an interpolated far field
   std::optional<FarFieldReport> far_field;
-  std::size_t fast_solves = 0;       // made by the setup (2b), counted in the solve that made it
-  Eigen::VectorXd b0, c0;            // B_γu₀, C_γu₀ (+ the reading shift)
-  double shift = 0;                  // what the data's readings moved by (the flux balance)
-  std::optional<ConstantMode> mode;  // singular A only
-  int load_version = -1;             // the u₀ that b0, c0, shift and mode came from
+  std::optional<SchurStorage> storage;  // green
+  std::string storage_warning;          // why hierarchical storage was asked for and not used
+  std::size_t fast_solves = 0;          // made by the setup (2b), counted in the solve that made it
+  Eigen::VectorXd b0, c0;               // B_γu₀, C_γu₀ (+ the reading shift)
+  double shift = 0;                     // what the data's readings moved by (the flux balance)
+  std::optional<ConstantMode> mode;     // singular A only
+  int load_version = -1;                // the u₀ that b0, c0, shift and mode came from
 };
 
 template <int dim>
@@ -248,10 +251,42 @@ void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
     st.green = std::make_unique<GreenTable<dim>>(st.grid, st.c, st.execution);
     clock.mark("green_table");
   }
+  const int m = b.n_points();
+  bool hierarchical = options.schur_storage == SchurStorageKind::hierarchical ||
+                      (options.schur_storage == SchurStorageKind::automatic && m >= hierarchical_from_points);
+  if (hierarchical && st.fast->singular()) {  // the bordering (constants in A's null space) is dense only
+    hierarchical = false;
+    if (options.schur_storage == SchurStorageKind::hierarchical)
+      setup.storage_warning =
+          "solver.schur_storage: a periodic box with c = 0 (A singular) keeps the Schur complement dense";
+  }
+  if (hierarchical) {
+    GmresOptions inner = gmres;
+    inner.relative_tolerance = hierarchical_gmres_tolerance;
+    SolverOptions interpolated = options;  // the far field is what makes the blocks small
+    interpolated.far_field = true;
+    HierarchicalOptions h_options;
+    h_options.far_field = b.far_field(interpolated);
+    if (h_options.far_field.order == 0) h_options.far_field = default_far_field_3d;  // 2-D: the same rule
+    h_options.far_field.eta = hierarchical_far_field.eta;  // a partition for memory (hierarchical_schur.hpp)
+    h_options.far_field.leaf = hierarchical_far_field.leaf;
+    auto h = std::make_unique<HierarchicalSchur>(*st.green, b.B_gamma(), b.C_gamma(), b.loads(), st.execution,
+                                                 b.direct(), h_options, inner);
+    setup.storage = h->storage();
+    setup.schur = std::move(h);
+    if (!keep) st.green.reset();
+    setup.exact = std::make_unique<ImplicitSchur>(*st.fast, b.B_gamma(), b.C_gamma(), b.loads(), gmres, b.direct());
+    clock.mark("schur");
+    st.execution.throw_if_interrupted();
+    return;
+  }
   FarFieldReport report;
   setup.schur = std::make_unique<ExplicitSchur>(*st.green, b.B_gamma(), b.C_gamma(), b.loads(), st.execution,
                                                 b.direct(), b.far_field(options), &report);
   if (!keep) st.green.reset();
+  SchurStorage dense;
+  dense.bytes = dense.dense_bytes = 2.0 * 8.0 * double(m) * double(m);
+  setup.storage = dense;
   if (report.far_pairs > 0) {
     setup.far_field = report;
     setup.exact = std::make_unique<ImplicitSchur>(*st.fast, b.B_gamma(), b.C_gamma(), b.loads(), gmres, b.direct());
@@ -490,13 +525,18 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
   if (setup.exact) {
     GmresOptions polish = detail::gmres_options(options, m, st.execution);
     polish.relative_tolerance = far_field_gmres_tolerance;
-    const PreconditionedSchur preconditioned(static_cast<const ExplicitSchur&>(*setup.schur), *setup.exact, polish);
+    const auto* dense = dynamic_cast<const ExplicitSchur*>(setup.schur.get());
+    std::unique_ptr<SchurComplement> exact;  // the exact S, solved through the approximate one
+    if (dense)
+      exact = std::make_unique<PreconditionedSchur>(*dense, *setup.exact, polish);
+    else
+      exact = std::make_unique<RefinedSchur>(*setup.schur, *setup.exact, far_field_gmres_tolerance);
     NewtonOptions from_there = newton_options;  // solver.max_newton caps both runs together
     from_there.conditions = first.conditions;
     from_there.start = &sol.newton;
     from_there.max_iterations = std::max(1, newton_options.max_iterations - sol.newton.iterations);
-    NewtonResult second = solve_semismooth_newton(preconditioned, setup.b0, setup.c0, g, from_there, mode);
-    sol.far_field = FarFieldUse{*setup.far_field, second.iterations};
+    NewtonResult second = solve_semismooth_newton(*exact, setup.b0, setup.c0, g, from_there, mode);
+    if (setup.far_field) sol.far_field = FarFieldUse{*setup.far_field, second.iterations};
     second.iterations += sol.newton.iterations;
     second.history.insert(second.history.begin(), sol.newton.history.begin(), sol.newton.history.end());
     second.inner_failed = second.inner_failed || sol.newton.inner_failed;
@@ -506,6 +546,10 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
   sol.fast_solves += setup.schur->fast_solves() - before;
   if (const auto* dense = dynamic_cast<const ExplicitSchur*>(setup.schur.get()))
     sol.factorizations = dense->factorizations();
+  else if (const auto* h = dynamic_cast<const HierarchicalSchur*>(setup.schur.get()))
+    sol.factorizations = h->factorizations();
+  sol.schur_storage = setup.storage;
+  if (!setup.storage_warning.empty()) sol.warnings.push_back(setup.storage_warning);
   for (const NewtonStep& step : sol.newton.history) sol.inner_iterations += step.inner_iterations;
   if (options.condition_number && dim == 2) sol.condition_number = setup.schur->condition_number(sol.newton.active);
   sol.lambda.assign(sol.newton.lambda.data(), sol.newton.lambda.data() + sol.newton.lambda.size());

@@ -249,6 +249,57 @@ Eigen::MatrixXd green_block(const GreenTable<dim>& green, const SparseRows& R, c
 
 namespace {
 
+/// M ≈ A Bᵀ (rows × cols) by adaptive cross approximation with partial pivoting, from M's rows and
+/// columns (`row(i, r)`, `col(j, c)`), stopped when the last cross is below `tolerance` times the
+/// approximation's Frobenius norm, or when the rank reaches `most`.
+template <class Row, class Col>
+void cross_approximation(Eigen::Index rows, Eigen::Index cols, const Row& row, const Col& col, double tolerance,
+                         Eigen::Index most, Eigen::MatrixXd& A, Eigen::MatrixXd& B) {
+  most = std::min({most, rows, cols});
+  A.resize(rows, most);
+  B.resize(cols, most);
+  std::vector<char> row_used(std::size_t(rows), 0), col_used(std::size_t(cols), 0);
+  double norm2 = 0;
+  Eigen::Index k = 0, i = 0;
+  Eigen::VectorXd r, c;
+  while (k < most) {
+    row_used[std::size_t(i)] = 1;
+    row(i, r);
+    r -= B.leftCols(k) * A.row(i).head(k).transpose();
+    Eigen::Index j = -1;
+    double best = 0;
+    for (Eigen::Index t = 0; t < cols; ++t)
+      if (!col_used[std::size_t(t)] && std::abs(r(t)) > best) best = std::abs(r(t)), j = t;
+    if (j < 0) {  // this row is done: the next unused one
+      Eigen::Index next = 0;
+      while (next < rows && row_used[std::size_t(next)]) ++next;
+      if (next == rows) break;
+      i = next;
+      continue;
+    }
+    col_used[std::size_t(j)] = 1;
+    col(j, c);
+    c -= A.leftCols(k) * B.row(j).head(k).transpose();
+    const Eigen::VectorXd v = r / r(j);
+    double cross = 0;
+    for (Eigen::Index l = 0; l < k; ++l) cross += A.col(l).dot(c) * B.col(l).dot(v);
+    A.col(k) = c;
+    B.col(k) = v;
+    ++k;
+    const double step2 = c.squaredNorm() * v.squaredNorm();
+    norm2 += 2 * cross + step2;
+    if (step2 <= tolerance * tolerance * norm2) break;
+    Eigen::Index next = -1;  // the next row: the largest of this column's residual among the unused rows
+    best = -1;
+    for (Eigen::Index t = 0; t < rows; ++t)
+      if (!row_used[std::size_t(t)] && std::abs(c(t)) > best) best = std::abs(c(t)), next = t;
+    if (next < 0) break;
+    i = next;
+  }
+  A.conservativeResize(rows, k);
+  B.conservativeResize(cols, k);
+}
+
 /// The assembly of green_blocks step by step: the cluster trees, the block partition, each cluster's
 /// interpolation or distinct nodes, then the blocks themselves.
 template <int dim>
@@ -269,7 +320,8 @@ struct BlockAssembly {
   std::vector<std::vector<Eigen::MatrixXd>> U;  // per row cluster with far blocks: R L, one per row set
   std::vector<Eigen::MatrixXd> V;               // per column cluster with far blocks: Q L
   std::vector<std::unique_ptr<DistinctNodes<dim>>> distinct;
-  std::exception_ptr failure;  // an exception (out of memory) inside a parallel loop, thrown after it
+  std::exception_ptr failure;              // an exception (out of memory) inside a parallel loop, thrown after it
+  CompressedBlocks* compressed = nullptr;  // set: the blocks are kept there, not written into `out`
 
   void keep() {
 #pragma omp critical(fictus_green_blocks_failure)
@@ -324,8 +376,9 @@ void BlockAssembly<dim>::partition() {
     const double exact = cx.work * cy.work;
     if (compress) {
       const double interpolated = interpolation_size(cx.box) * interpolation_size(cy.box);
+      // Kept compressed, a far pair is worth it whenever it is admissible (its storage, not its cost, decides).
       if (std::max(cx.box.radius(), cy.box.radius()) <= far_field.eta * image_distance(cx.box, cy.box, green.grid()) &&
-          interpolated < exact) {
+          (compressed || interpolated < exact)) {
         blocks.push_back({x, y, true, interpolated});
         return;
       }
@@ -404,9 +457,34 @@ void BlockAssembly<dim>::far_block(const Block& b, Eigen::MatrixXd& core, Eigen:
   const Interpolation<dim>&Lx = *x_interp[std::size_t(b.x)], &Ly = *y_interp[std::size_t(b.y)];
   core.resize(Lx.size(), Ly.size());
   green.G(Lx.nodes, Ly.nodes, core.data(), std::size_t(Lx.size()));
+  CompressedBlocks::Block* kept = compressed ? &compressed->blocks[std::size_t(&b - blocks.data())] : nullptr;
+  if (kept) {  // low rank where that is smaller than the dense block, from the block's rows and columns
+    const Eigen::MatrixXd& Vy = V[std::size_t(b.y)];
+    const Eigen::Index p = cx.end - cx.begin, q = cy.end - cy.begin, most = p * q / (p + q);
+    const Eigen::MatrixXd core_V = core * Vy.transpose();  // |L_x| × q
+    std::vector<Eigen::MatrixXd> left(row_sets.size()), right(row_sets.size());
+    bool small = true;
+    for (std::size_t s = 0; s < row_sets.size() && small; ++s) {
+      const Eigen::MatrixXd& Ux = U[std::size_t(b.x)][s];
+      cross_approximation(
+          p, q, [&](Eigen::Index i, Eigen::VectorXd& r) { r = core_V.transpose() * Ux.row(i).transpose(); },
+          [&](Eigen::Index j, Eigen::VectorXd& c) { c = Ux * core_V.col(j); }, far_field_recompression, most, left[s],
+          right[s]);
+      small = left[s].cols() < most;
+    }
+    if (small) {
+      kept->left = std::move(left);
+      kept->right = std::move(right);
+      return;
+    }
+  }
   half.noalias() = core * V[std::size_t(b.y)].transpose();
   for (std::size_t s = 0; s < row_sets.size(); ++s) {
     block.noalias() = U[std::size_t(b.x)][s] * half;
+    if (kept) {
+      kept->dense.push_back(block);
+      continue;
+    }
     for (int j = cy.begin; j < cy.end; ++j)
       for (int i = cx.begin; i < cx.end; ++i)
         out[s](X->item[std::size_t(i)], Y->item[std::size_t(j)]) = block(i - cx.begin, j - cy.begin);
@@ -422,6 +500,8 @@ void BlockAssembly<dim>::near_block(const Block& b, const std::vector<Index<dim>
   const auto &cx = X->clusters[std::size_t(b.x)], &cy = Y->clusters[std::size_t(b.y)];
   const DistinctNodes<dim>& nodes = *distinct[std::size_t(b.x)];
   column.resize(nodes.nodes.size());
+  CompressedBlocks::Block* kept = compressed ? &compressed->blocks[std::size_t(&b - blocks.data())] : nullptr;
+  if (kept) kept->dense.assign(row_sets.size(), Eigen::MatrixXd(cx.end - cx.begin, cy.end - cy.begin));
   for (int j = cy.begin; j < cy.end; ++j) {
     const int col = Y->item[std::size_t(j)];
     const std::size_t first = Q.row_begin[std::size_t(col)];
@@ -435,7 +515,10 @@ void BlockAssembly<dim>::near_block(const Block& b, const std::vector<Index<dim>
         double sum = 0.0;
         for (std::size_t a = R.row_begin[std::size_t(row)]; a < R.row_begin[std::size_t(row) + 1]; ++a, ++entry)
           sum += R.entries[a].value * column[nodes.slot[entry]];
-        out[s](row, col) = sum;
+        if (kept)
+          kept->dense[s](i - cx.begin, j - cy.begin) = sum;
+        else
+          out[s](row, col) = sum;
       }
     }
   }
@@ -505,6 +588,136 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
   if (report) assembly.report(*report);
   return out;
 }
+
+template <int dim>
+CompressedBlocks compressed_green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
+                                         const SparseRows& Q, const Execution& execution, const FarField& far_field,
+                                         FarFieldReport* report) {
+  for (const SparseRows* R : row_sets)
+    if (R->n_rows() != row_sets.front()->n_rows())
+      throw std::invalid_argument("compressed_green_blocks: the row sets differ in their number of rows");
+  if (far_field.order <= 0 || !(far_field.eta > 0 && far_field.leaf >= 1))
+    throw std::invalid_argument("compressed_green_blocks: needs a far field (order > 0, eta > 0, leaves of >= 1 row)");
+  CompressedBlocks c;
+  c.n_rows = row_sets.front()->n_rows();
+  c.n_cols = Q.n_rows();
+  c.n_sets = int(row_sets.size());
+  if (c.n_rows == 0 || c.n_cols == 0) return c;
+  BlockAssembly<dim> assembly(green, row_sets, Q, execution, far_field);
+  assembly.compressed = &c;
+  assembly.trees();
+  assembly.partition();
+  assembly.cluster_data();
+  c.blocks.resize(assembly.blocks.size());
+  for (std::size_t k = 0; k < assembly.blocks.size(); ++k)
+    c.blocks[k].x = assembly.blocks[k].x, c.blocks[k].y = assembly.blocks[k].y;
+  std::vector<Eigen::MatrixXd> unused;
+  assembly.fill(unused);
+  if (report) assembly.report(*report);
+  c.row_item = assembly.X->item;
+  c.col_item = assembly.Y->item;
+  for (const auto& cl : assembly.X->clusters) c.row_clusters.push_back({cl.begin, cl.end});
+  for (const auto& cl : assembly.Y->clusters) c.col_clusters.push_back({cl.begin, cl.end});
+  c.row_parent.assign(assembly.X->clusters.size(), -1);
+  for (std::size_t k = 0; k < assembly.X->clusters.size(); ++k)
+    if (!assembly.X->leaf(int(k)))
+      c.row_parent[std::size_t(assembly.X->clusters[k].left)] =
+          c.row_parent[std::size_t(assembly.X->clusters[k].right)] = int(k);
+  return c;
+}
+
+double CompressedBlocks::bytes() const {
+  double n = 0;
+  for (const Block& b : blocks) {
+    for (const Eigen::MatrixXd& d : b.dense) n += double(d.size());
+    for (const Eigen::MatrixXd& d : b.left) n += double(d.size());
+    for (const Eigen::MatrixXd& d : b.right) n += double(d.size());
+  }
+  return 8.0 * n;
+}
+
+void CompressedBlocks::multiply(const Eigen::VectorXd& x, std::vector<Eigen::VectorXd>& y, int threads) const {
+  Eigen::VectorXd xt(n_cols);  // x in the columns' tree order
+  for (int j = 0; j < n_cols; ++j) xt(j) = x(col_item[std::size_t(j)]);
+  // Each thread adds into its own copy (tree order), summed after.
+  std::vector<Eigen::MatrixXd> partial(std::size_t(std::max(1, threads)));
+  const int n_b = int(blocks.size());
+#pragma omp parallel num_threads(threads)
+  {
+    Eigen::MatrixXd& mine = partial[std::size_t(omp_get_thread_num())];
+    mine = Eigen::MatrixXd::Zero(n_rows, n_sets);
+    Eigen::VectorXd w;
+#pragma omp for schedule(dynamic, 64)
+    for (int k = 0; k < n_b; ++k) {
+      const Block& b = blocks[std::size_t(k)];
+      const Cluster &cx = row_clusters[std::size_t(b.x)], &cy = col_clusters[std::size_t(b.y)];
+      const auto xy = xt.segment(cy.begin, cy.end - cy.begin);
+      if (!b.dense.empty()) {
+        for (int s = 0; s < n_sets; ++s)
+          mine.col(s).segment(cx.begin, cx.end - cx.begin).noalias() += b.dense[std::size_t(s)] * xy;
+      } else {
+        for (int s = 0; s < n_sets; ++s) {
+          w.noalias() = b.right[std::size_t(s)].transpose() * xy;
+          mine.col(s).segment(cx.begin, cx.end - cx.begin).noalias() += b.left[std::size_t(s)] * w;
+        }
+      }
+    }
+  }
+  for (std::size_t p = 1; p < partial.size(); ++p)
+    if (partial[p].size() > 0) partial[0] += partial[p];
+  y.assign(std::size_t(n_sets), Eigen::VectorXd(n_rows));
+  for (int s = 0; s < n_sets; ++s)
+    for (int i = 0; i < n_rows; ++i) y[std::size_t(s)](row_item[std::size_t(i)]) = partial[0](i, s);
+}
+
+std::vector<int> CompressedBlocks::groups(int size) const {
+  std::vector<int> out;
+  for (std::size_t k = 0; k < row_clusters.size(); ++k) {
+    const int parent = row_parent[k];
+    const auto items = [&](int c) { return row_clusters[std::size_t(c)].end - row_clusters[std::size_t(c)].begin; };
+    if (items(int(k)) <= size && (parent < 0 || items(parent) > size)) out.push_back(int(k));
+  }
+  return out;
+}
+
+Eigen::MatrixXd CompressedBlocks::diagonal_block(int k, int g) const {
+  const Cluster& cg = row_clusters[std::size_t(g)];
+  const int n = cg.end - cg.begin;
+  // The group's points and their places among the columns.
+  std::vector<int> place(std::size_t(n_cols), -1);
+  for (int i = cg.begin; i < cg.end; ++i) place[std::size_t(row_item[std::size_t(i)])] = i - cg.begin;
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n, n);
+  std::vector<int> cols, at;  // a block's columns in the group: local column, place
+  for (const Block& b : blocks) {
+    const Cluster &cx = row_clusters[std::size_t(b.x)], &cy = col_clusters[std::size_t(b.y)];
+    const int r0 = std::max(cx.begin, cg.begin), r1 = std::min(cx.end, cg.end);
+    if (r0 >= r1) continue;
+    cols.clear(), at.clear();
+    for (int j = cy.begin; j < cy.end; ++j)
+      if (const int p = place[std::size_t(col_item[std::size_t(j)])]; p >= 0)
+        cols.push_back(j - cy.begin), at.push_back(p);
+    if (cols.empty()) continue;
+    if (!b.dense.empty()) {
+      const Eigen::MatrixXd& D = b.dense[std::size_t(k)];
+      for (std::size_t c = 0; c < cols.size(); ++c)
+        for (int i = r0; i < r1; ++i) M(i - cg.begin, at[c]) = D(i - cx.begin, cols[c]);
+    } else {
+      const Eigen::MatrixXd& L = b.left[std::size_t(k)];
+      for (std::size_t c = 0; c < cols.size(); ++c)
+        M.block(r0 - cg.begin, at[c], r1 - r0, 1).noalias() =
+            L.middleRows(r0 - cx.begin, r1 - r0) * b.right[std::size_t(k)].row(cols[c]).transpose();
+    }
+  }
+  // M's rows are in tree order of the group, its columns at `place`, the same order.
+  return M;
+}
+
+template CompressedBlocks compressed_green_blocks(const GreenTable<2>&, const std::vector<const SparseRows*>&,
+                                                  const SparseRows&, const Execution&, const FarField&,
+                                                  FarFieldReport*);
+template CompressedBlocks compressed_green_blocks(const GreenTable<3>&, const std::vector<const SparseRows*>&,
+                                                  const SparseRows&, const Execution&, const FarField&,
+                                                  FarFieldReport*);
 
 template Eigen::MatrixXd green_block(const GreenTable<2>&, const SparseRows&, const SparseRows&, const Execution&,
                                      const FarField&);

@@ -223,3 +223,29 @@ TEST(Estimates, GrowWithTheGridAndFollowTheInnerSolverAndThreads) {
   if (std::thread::hardware_concurrency() >= 2)
     EXPECT_LT(estimate(4096, fictus::InnerSolver::green, 2).second, seconds_4k);
 }
+
+namespace {
+
+TEST(SchurStorage, HierarchicalGivesTheDenseAnswerIn2d) {
+  // The same code as in 3-D (one pipeline): the compressed S̃, GMRES with block LUs, refined on the
+  // exact S, against the dense LU path, both variants of the paper's problem.
+  const fictus::Problem problem = fictus::paper_problem(512);
+  for (const fictus::Variant v : {fictus::Variant::smooth, fictus::Variant::nonsmooth}) {
+    fictus::SolverOptions o = options_for(v, fictus::InnerSolver::green, 512);
+    o.error_estimate = false;
+    o.schur_storage = fictus::SchurStorageKind::dense;
+    const fictus::Solution dense = fictus::solve(problem, o);
+    o.schur_storage = fictus::SchurStorageKind::hierarchical;
+    const fictus::Solution h = fictus::solve(problem, o);
+    ASSERT_TRUE(dense.newton.converged && h.newton.converged) << fictus::to_string(v);
+    ASSERT_TRUE(h.schur_storage.has_value());
+    EXPECT_EQ(h.schur_storage->kind, "hierarchical");
+    EXPECT_EQ(dense.schur_storage->kind, "dense");
+    EXPECT_EQ(h.newton.active, dense.newton.active) << fictus::to_string(v);
+    double largest = 0;
+    for (double l : dense.lambda) largest = std::max(largest, std::abs(l));
+    EXPECT_LE(max_abs_diff(h.lambda, dense.lambda), 1e-9 * largest) << fictus::to_string(v);
+  }
+}
+
+}  // namespace

@@ -11,6 +11,7 @@
 #include "fictus/boundary/trace_operators.hpp"
 #include "fictus/grid/fast_solver.hpp"
 #include "fictus/solve/fictitious_domain_solver.hpp"
+#include "fictus/solve/hierarchical_schur.hpp"
 #include "fictus/solve/schur_complement.hpp"
 #include "fictus/solve/surface_discretization.hpp"
 
@@ -98,6 +99,86 @@ TEST_P(GreenBlocksTest, InterpolatedFarFieldConvergesWithTheOrder) {
   const std::vector<Eigen::MatrixXd> S =
       fictus::green_blocks(green, {&rows.B, &rows.C}, rows.Q, fictus::Execution{2}, fictus::default_far_field_3d);
   EXPECT_LT(std::max(relative_max_difference(S[0], exact[0]), relative_max_difference(S[1], exact[1])), 2e-2);
+}
+
+TEST_P(GreenBlocksTest, CompressedBlocksAndTheirSolves) {
+  // Patches of 3h at N = 40, Γ at 1.5h: a few hundred rows. The compressed blocks (the hierarchical
+  // solver's partition, far pairs interpolated and recompressed) against the exact dense assembly.
+  const SphereRows rows(GetParam(), 40, 3.0, 1.5);
+  const fictus::GreenTable<3> green(rows.grid, GetParam().c);
+  const std::vector<Eigen::MatrixXd> exact = fictus::green_blocks(green, {&rows.B, &rows.C}, rows.Q);
+  const int m = rows.B.n_rows();
+  fictus::FarField far = fictus::hierarchical_far_field;
+  far.order = fictus::default_far_field_3d.order;
+  far.leaf = 8;  // small leaves: far pairs at this m
+  fictus::FarFieldReport report;
+  const fictus::CompressedBlocks c =
+      fictus::compressed_green_blocks(green, {&rows.B, &rows.C}, rows.Q, fictus::Execution{2}, far, &report);
+  EXPECT_GT(report.far_pairs, 0.2 * (report.far_pairs + report.near_pairs));
+  EXPECT_LE(c.bytes(), 2 * 8.0 * m * m);  // never more than dense
+  const Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(m, -1.0, 2.0).array().sin();
+  std::vector<Eigen::VectorXd> y;
+  c.multiply(x, y, 2);
+  for (int s = 0; s < 2; ++s) {
+    const Eigen::VectorXd want = exact[std::size_t(s)] * x;
+    EXPECT_LT((y[std::size_t(s)] - want).norm(), 1e-5 * want.norm()) << "set " << s;
+  }
+  // Diagonal blocks of the groups: every point in one group, entries as in the product.
+  int covered = 0;
+  for (const int g : c.groups(64)) {
+    const auto& cl = c.row_clusters[std::size_t(g)];
+    ASSERT_LE(cl.end - cl.begin, 64);
+    covered += cl.end - cl.begin;
+    for (int s = 0; s < 2; ++s) {
+      const Eigen::MatrixXd M = c.diagonal_block(s, g);
+      for (int a = cl.begin; a < cl.end; ++a)
+        for (int b = cl.begin; b < cl.end; ++b)
+          ASSERT_NEAR(M(a - cl.begin, b - cl.begin),
+                      exact[std::size_t(s)](c.row_item[std::size_t(a)], c.row_item[std::size_t(b)]),
+                      1e-4 * exact[std::size_t(s)].cwiseAbs().maxCoeff());  // the interpolation's error
+    }
+  }
+  EXPECT_EQ(covered, m);
+  if (GetParam().boundary == fictus::Boundary::periodic && GetParam().c == 0) return;  // bordered: dense only
+
+  // Newton matrices: GMRES with the block LUs, then refined on the exact S, against the exact dense LU.
+  fictus::GmresOptions gmres;
+  gmres.relative_tolerance = 1e-12;
+  fictus::HierarchicalOptions options;
+  options.far_field = far;
+  options.group = 64;
+  const fictus::HierarchicalSchur H(green, rows.B, rows.C, rows.Q, fictus::Execution{2}, {}, options, gmres);
+  EXPECT_EQ(H.storage().kind, "hierarchical");
+  EXPECT_NEAR(H.storage().bytes, c.bytes(), 1e-9 * c.bytes());
+  fictus::ActiveSet active(static_cast<std::size_t>(m));
+  for (int i = 0; i < m; ++i) active[std::size_t(i)] = char(i % 3 != 0);
+  Eigen::MatrixXd S(m, m);
+  for (int i = 0; i < m; ++i) S.row(i) = active[std::size_t(i)] ? exact[0].row(i) : exact[1].row(i);
+  const Eigen::VectorXd d = Eigen::VectorXd::LinSpaced(m, 0.0, 3.0).array().cos();
+  const Eigen::VectorXd want = S.partialPivLu().solve(d);
+  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(m);
+  double alpha = 0;
+  const fictus::LinearSolveReport report_h = H.solve(active, d, nullptr, lambda, alpha);
+  EXPECT_TRUE(report_h.converged);
+  EXPECT_LT(report_h.relative_residual, 1e-11);
+  EXPECT_LT((lambda - want).norm(), 1e-3 * want.norm());  // S̃'s answer
+  EXPECT_LT(report_h.inner_iterations, 150);
+  const auto fast = fictus::make_fast_solver(rows.grid, GetParam().c);
+  const fictus::ImplicitSchur implicit(*fast, rows.B, rows.C, rows.Q, gmres);
+  const fictus::RefinedSchur refined(H, implicit, 1e-13);
+  lambda.setZero();
+  const fictus::LinearSolveReport r = refined.solve(active, d, nullptr, lambda, alpha);
+  EXPECT_TRUE(r.converged) << r.relative_residual;
+  EXPECT_LE(r.inner_iterations, 8);  // fast solves
+  EXPECT_LT((lambda - want).norm(), 1e-10 * want.norm());
+  // A second solve with the same set makes no new block LU; one changed row makes one.
+  const int made = H.factorizations();
+  EXPECT_GE(made, int(c.groups(64).size()));
+  H.solve(active, d, nullptr, lambda, alpha);
+  EXPECT_EQ(H.factorizations(), made);
+  active[0] = 1;
+  H.solve(active, d, nullptr, lambda, alpha);
+  EXPECT_EQ(H.factorizations(), made + 1);
 }
 
 INSTANTIATE_TEST_SUITE_P(Boxes, GreenBlocksTest,

@@ -306,3 +306,58 @@ TEST(ImplicitSurface, NamesWhatIsWrongWithTheLevelFunction) {
 }
 
 }  // namespace
+
+namespace {
+
+/// max |a − b| / max |b| over the multipliers.
+double lambda_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  double largest = 0, difference = 0;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    largest = std::max(largest, std::abs(b[i]));
+    difference = std::max(difference, std::abs(a[i] - b[i]));
+  }
+  return difference / largest;
+}
+
+TEST(SurfaceSolver, HierarchicalSchurGivesTheDenseAnswer) {
+  // Both variants on a sphere with partial contact: Newton on the compressed S̃ (GMRES, block LUs), then
+  // refined on the exact S, against the dense path (LU on S̃, then GMRES on the exact S).
+  const fictus::SurfaceProblem p = small_problem(0.3, 48);
+  for (const fictus::Variant v : {fictus::Variant::smooth, fictus::Variant::nonsmooth}) {
+    fictus::SolverOptions o;
+    o.variant = v;
+    o.threads = 2;
+    o.error_estimate = false;
+    o.schur_storage = fictus::SchurStorageKind::dense;
+    const fictus::SurfaceSolution dense = fictus::solve(p, o);
+    o.schur_storage = fictus::SchurStorageKind::hierarchical;
+    const fictus::SurfaceSolution h = fictus::solve(p, o);
+    const char* variant = fictus::to_string(v);
+    ASSERT_TRUE(dense.newton.converged && h.newton.converged) << variant;
+    ASSERT_TRUE(dense.schur_storage && h.schur_storage) << variant;
+    EXPECT_EQ(dense.schur_storage->kind, "dense");
+    EXPECT_EQ(h.schur_storage->kind, "hierarchical");
+    EXPECT_LE(h.schur_storage->bytes, h.schur_storage->dense_bytes * 1.1) << variant;  // no gain at m ≈ 500
+    EXPECT_EQ(h.newton.active, dense.newton.active) << variant;
+    EXPECT_LT(lambda_difference(h.lambda, dense.lambda), 1e-9) << variant;
+    EXPECT_LT(h.signorini.max_complementarity, 1e-12) << variant;
+    EXPECT_GT(h.inner_iterations, 0) << variant;
+  }
+}
+
+TEST(SurfaceSolver, HierarchicalSchurKeepsASingularBoxDense) {
+  // The bordering (constants in A's null space) is dense only: a warning, and the dense answer.
+  const fictus::SurfaceProblem p = periodic_without_reaction(0.2, 32);
+  fictus::SolverOptions o;
+  o.variant = fictus::Variant::nonsmooth;
+  o.schur_storage = fictus::SchurStorageKind::hierarchical;
+  const fictus::SurfaceSolution s = fictus::solve(p, o);
+  ASSERT_TRUE(s.newton.converged);
+  ASSERT_TRUE(s.schur_storage.has_value());
+  EXPECT_EQ(s.schur_storage->kind, "dense");
+  bool warned = false;
+  for (const std::string& w : s.warnings) warned = warned || w.find("solver.schur_storage") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+}  // namespace

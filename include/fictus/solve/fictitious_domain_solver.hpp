@@ -37,6 +37,8 @@ namespace fictus {
 inline constexpr double far_field_hand_on = 0.05;
 /// GMRES's relative residual for the Newton steps on the exact S behind an interpolated far field.
 inline constexpr double far_field_gmres_tolerance = 1e-13;
+/// Hierarchical storage: the relative residual of GMRES on S̃_𝒜 (Newton's steps before the exact S).
+inline constexpr double hierarchical_gmres_tolerance = 1e-12;
 /// The nested start's coarse grid has at least this many cells along x (solver.nested_start).
 inline constexpr int minimum_nested_grid = 8;
 /// Gauss points per direction of the integrals over ω of a solution (DomainQuantities): 2 integrate

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -65,6 +66,18 @@ std::vector<int> interpolation_nodes(int lo, int hi, int order);
 struct FarFieldReport {
   double near_pairs = 0, far_pairs = 0;
   int near_blocks = 0, far_blocks = 0;
+};
+
+/// What the storage of S_B and S_C took (results.json `schur_storage`; dense: the m × m blocks).
+struct SchurStorage {
+  std::string kind = "dense";  // "dense" or "hierarchical"
+  double bytes = 0;            // both blocks
+  double dense_bytes = 0;      // both blocks dense: 2·m²·8
+  double low_rank_blocks = 0, full_blocks = 0;
+  int largest_rank = 0;  // of the compressed block that takes the most memory
+  double preconditioner_bytes = 0;
+  double far_fraction = 0;  // of the pairs, interpolated
+  double seconds_assembly = 0;
 };
 
 struct LinearSolveReport {
@@ -234,5 +247,43 @@ template <int dim>
 std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
                                           const SparseRows& Q, const Execution& execution = Execution{},
                                           const FarField& far_field = {}, FarFieldReport* report = nullptr);
+
+/// The blocks R_k G Qᵀ kept as the assembly partitions them: near pairs of clusters dense; far pairs
+/// (interpolated: U_x G(P_x, P_y) V_yᵀ) of low rank, A Bᵀ by adaptive cross approximation on that
+/// product's rows and columns to far_field_recompression, or dense where the rank is not low enough to
+/// save memory. No m × m array is made.
+struct CompressedBlocks {
+  struct Cluster {
+    int begin, end;  // items [begin, end) in tree order
+  };
+  struct Block {
+    int x, y;                            // row and column clusters
+    std::vector<Eigen::MatrixXd> dense;  // per row set (p × q), or empty: low rank
+    std::vector<Eigen::MatrixXd> left;   // low rank, per row set: p × k
+    std::vector<Eigen::MatrixXd> right;  // low rank, per row set: q × k
+  };
+  int n_rows = 0, n_cols = 0, n_sets = 0;
+  std::vector<int> row_item, col_item;  // tree order → row (column) index
+  std::vector<Cluster> row_clusters, col_clusters;
+  std::vector<Block> blocks;
+  std::vector<int> row_parent;  // the row tree's parents (−1: root)
+  double bytes() const;
+  /// y[k] = (R_k G Qᵀ) x for every row set k.
+  void multiply(const Eigen::VectorXd& x, std::vector<Eigen::VectorXd>& y, int threads) const;
+  /// Groups of rows: the row clusters of at most `size` items nearest the root (items in tree order).
+  std::vector<int> groups(int size) const;
+  /// The block of set k over the rows × the columns of row cluster g, both in the cluster's tree order
+  /// (the row sets and Q must number the same points, as S_B, S_C).
+  Eigen::MatrixXd diagonal_block(int k, int g) const;
+};
+
+/// The relative accuracy of the far blocks' recompression (below the interpolation's own error).
+inline constexpr double far_field_recompression = 1e-8;
+
+/// green_blocks, kept compressed (`far_field.order` > 0).
+template <int dim>
+CompressedBlocks compressed_green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
+                                         const SparseRows& Q, const Execution& execution, const FarField& far_field,
+                                         FarFieldReport* report = nullptr);
 
 }  // namespace fictus

@@ -160,13 +160,15 @@ struct BasicSolution : SolutionBoundary<dim> {
   NewtonResult newton;
   std::size_t fast_solves = 0;  // applications of A⁻¹ in this solve (the paper's it₁)
   int inner_iterations = 0;     // Krylov iterations over all Newton steps
-  int factorizations = 0;       // dense LUs of Newton matrices (green; the others by updates)
+  int factorizations = 0;       // LUs of Newton matrices (green dense: the others by updates; hierarchical:
+                                // LUs of the preconditioner's blocks)
   bool reused_curve = false;    // γ's trace rows and Schur blocks came from the previous solve
   std::optional<double> condition_number;
   using FarFieldUse = fictus::FarFieldUse;
   using NestedStart = fictus::NestedStart;
   using FluxBalanceUse = fictus::FluxBalanceUse;
   std::optional<FarFieldUse> far_field;
+  std::optional<SchurStorage> schur_storage;  // green only
   std::optional<NestedStart> nested_start;
   std::optional<FluxBalanceUse> flux_balance;
   SignoriniCheck signorini;

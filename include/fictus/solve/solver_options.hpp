@@ -6,6 +6,12 @@ namespace fictus {
 /// automatic: smooth where γ has a continuous normal, nonsmooth where it has corners (a polygon).
 enum class Variant { nonsmooth, smooth, automatic };
 enum class InnerSolver { green, krylov };
+/// How the green solver stores S_B and S_C: dense, hierarchical (hierarchical_schur.hpp), or automatic
+/// (hierarchical from hierarchical_from_points points on, where A is regular).
+enum class SchurStorageKind { automatic, dense, hierarchical };
+/// solver.schur_storage = auto: hierarchical from this many points on, where the dense blocks pass 6 GB
+/// (below it the dense path was the faster in every measured case: bench/results, "compressed Schur").
+inline constexpr int hierarchical_from_points = 20000;
 /// How the traces B_γ u and C_γ u are taken (docs/math.md, "Trace matrices"):
 ///   reconstructed  consistent at x_i: smooth variant, the gradient of the biquadratic interpolant
 ///                  (O(h²)); non-smooth variant, the traces of the kink-corrected field;
@@ -19,6 +25,7 @@ inline Variant resolved_variant(Variant v, bool smooth_boundary) {
 }
 const char* to_string(InnerSolver s);
 const char* to_string(NormalDerivative d);
+const char* to_string(SchurStorageKind k);
 
 struct SolverOptions {
   Variant variant = Variant::automatic;
@@ -30,6 +37,7 @@ struct SolverOptions {
   bool start_all_active = true;  // Newton start: all points active, else λ = 0
   InnerSolver inner = InnerSolver::green;
   double krylov_tolerance = 1e-10;  // relative GMRES residual
+  SchurStorageKind schur_storage = SchurStorageKind::automatic;
   int krylov_max_iterations = 5000;
   double newton_tolerance = 1e-9;  // relative ‖F‖∞
   int max_newton = 50;

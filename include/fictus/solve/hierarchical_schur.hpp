@@ -1,0 +1,88 @@
+#pragma once
+// The Schur blocks kept compressed, for large m (docs/math.md, "The compressed Schur complement"): m grows
+// like N^(dim−1), so the dense blocks (m² entries, an m³ LU per Newton step) end the method at 3-D
+// N ≈ 512, while the blocks couple well-separated points through the box's smooth Green's function.
+//   storage   the cluster trees and the interpolated far field of the dense assembly, with a partition
+//             for memory: every admissible pair of clusters (radius ≤ eta·distance) is far, kept of low
+//             rank by adaptive cross approximation of its interpolated block (far_field_recompression),
+//             or dense where its rank is too high to save memory; near pairs exact and dense
+//             (CompressedBlocks, schur_complement.hpp);
+//   solves    GMRES on S̃_𝒜 = rows of S̃_B (𝒜) and S̃_C (the rest), right-preconditioned by the LUs of
+//             S̃_𝒜's diagonal blocks over groups of at most `group` nearby points (block Jacobi; a group's
+//             LU is made again only where 𝒜 changed in it).
+// The solver runs Newton on it and finishes on the exact S (one fast solve per refinement step,
+// RefinedSchur), as with the dense interpolated far field: the answer is that of the exact S.
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "fictus/grid/green_table.hpp"
+#include "fictus/solve/gmres.hpp"
+#include "fictus/solve/schur_complement.hpp"
+
+namespace fictus {
+
+/// The partition of the compressed blocks: admissible pairs with radius ≤ eta·distance, leaves of 16
+/// (measured on the sphere at m = 804 and 3217: bench/results/2026-11-27-compressed-schur.md).
+inline constexpr FarField hierarchical_far_field{0, 1.0, 16};
+
+struct HierarchicalOptions {
+  FarField far_field;  // the partition and the interpolation of the far pairs (order > 0)
+  int group = 256;     // points per preconditioner block at most
+};
+
+class HierarchicalSchur final : public SchurComplement {
+ public:
+  /// Assembles S_B = B_γ G loadsᵀ + D_B and S_C = C_γ G loadsᵀ + D_C from the Green's table (G is not
+  /// kept) and the diagonal blocks of the preconditioner. Any dimension.
+  template <int dim>
+  HierarchicalSchur(const GreenTable<dim>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
+                    const SparseRows& loads, const Execution& execution, const DirectTerms& direct,
+                    const HierarchicalOptions& options, const GmresOptions& gmres);
+  ~HierarchicalSchur() override;
+  HierarchicalSchur(const HierarchicalSchur&) = delete;
+  HierarchicalSchur& operator=(const HierarchicalSchur&) = delete;
+
+  int size() const override;
+  void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override;
+  /// GMRES to the options' tolerance relative to ‖d‖; no bordering (a singular A takes the dense blocks).
+  LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
+                          Eigen::VectorXd& lambda, double& alpha) const override;
+  std::size_t fast_solves() const override { return 0; }
+  std::optional<double> condition_number(const ActiveSet&) const override { return std::nullopt; }
+  const SchurStorage& storage() const;
+  /// Block LUs of the preconditioner made so far.
+  int factorizations() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The exact S with an approximate one for the solves: `apply` is the exact S (one fast solve), `solve`
+/// refines x ← x + S̃_𝒜⁻¹(rhs − S_𝒜 x) until ‖rhs − S_𝒜 x‖ ≤ tolerance·‖rhs‖ (S̃_𝒜⁻¹ by the approximate one's
+/// solve). Each step costs one fast solve and gains the factor ‖I − S_𝒜 S̃_𝒜⁻¹‖.
+class RefinedSchur final : public SchurComplement {
+ public:
+  RefinedSchur(const SchurComplement& approximate, const ImplicitSchur& exact, double tolerance, int max_steps = 30)
+      : approximate_(approximate), exact_(exact), tolerance_(tolerance), max_steps_(max_steps) {}
+  int size() const override { return exact_.size(); }
+  void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override {
+    exact_.apply(lambda, sb, sc);
+  }
+  LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
+                          Eigen::VectorXd& lambda, double& alpha) const override;
+  std::size_t fast_solves() const override { return exact_.fast_solves(); }
+  std::optional<double> condition_number(const ActiveSet& active) const override {
+    return approximate_.condition_number(active);
+  }
+
+ private:
+  const SchurComplement& approximate_;
+  const ImplicitSchur& exact_;
+  double tolerance_;
+  int max_steps_;
+};
+
+}  // namespace fictus

@@ -1,0 +1,232 @@
+// S̃_B and S̃_C kept compressed, GMRES with a block-Jacobi preconditioner on them, and the refinement on
+// the exact S (hierarchical_schur.hpp).
+#include "fictus/solve/hierarchical_schur.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <exception>
+#include <stdexcept>
+#include <unordered_map>
+#include <vector>
+
+namespace fictus {
+
+LinearSolveReport RefinedSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
+                                      Eigen::VectorXd& lambda, double& alpha) const {
+  if (mode) throw std::logic_error("RefinedSchur: no bordering (a singular A takes the dense blocks)");
+  LinearSolveReport report;
+  const double rn = d.norm();
+  Eigen::VectorXd y, r, correction;
+  double previous = INFINITY, unused = 0.0;
+  for (int step = 0;; ++step) {
+    exact_.apply_newton(active, nullptr, lambda, y);
+    ++report.inner_iterations;
+    r = d - y;
+    report.relative_residual = rn > 0 ? r.norm() / rn : r.norm();
+    report.converged = report.relative_residual <= tolerance_;
+    // Stop when converged, out of steps, or no longer gaining (round-off of the exact S reached).
+    if (report.converged || step == max_steps_ || !(report.relative_residual < 0.5 * previous)) break;
+    previous = report.relative_residual;
+    correction = Eigen::VectorXd::Zero(lambda.size());
+    approximate_.solve(active, r, nullptr, correction, unused);
+    lambda += correction;
+  }
+  alpha = 0.0;
+  return report;
+}
+
+namespace {
+
+using RowMajorSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+/// M(a, b) += D(items[a], items[b]).
+void add_direct(const RowMajorSparse& D, const std::vector<int>& items, Eigen::MatrixXd& M) {
+  if (D.nonZeros() == 0) return;
+  std::unordered_map<int, int> place;
+  for (std::size_t a = 0; a < items.size(); ++a) place[items[a]] = int(a);
+  for (std::size_t a = 0; a < items.size(); ++a)
+    for (RowMajorSparse::InnerIterator it(D, items[a]); it; ++it)
+      if (const auto p = place.find(int(it.col())); p != place.end()) M(Eigen::Index(a), p->second) += it.value();
+}
+
+}  // namespace
+
+struct HierarchicalSchur::Impl {
+  int m = 0;
+  int threads = 1;
+  CompressedBlocks blocks;  // S̃_B (set 0) and S̃_C (set 1) without the direct terms
+  RowMajorSparse D_B, D_C;
+  SchurStorage storage;
+  GmresOptions gmres;
+  std::vector<std::vector<int>> groups;         // the points of each preconditioner block
+  std::vector<Eigen::MatrixXd> diag_B, diag_C;  // S̃_B and S̃_C on each group × group
+  mutable std::vector<Eigen::PartialPivLU<Eigen::MatrixXd>> lu;
+  mutable std::vector<ActiveSet> lu_active;
+  mutable int factorizations = 0;
+
+  void apply(const Eigen::VectorXd& x, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const {
+    std::vector<Eigen::VectorXd> y;
+    blocks.multiply(x, y, threads);
+    sb = std::move(y[0]);
+    sc = std::move(y[1]);
+    if (D_B.nonZeros() > 0) sb += D_B * x;
+    if (D_C.nonZeros() > 0) sc += D_C * x;
+  }
+
+  void apply_newton(const ActiveSet& active, const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+    Eigen::VectorXd sb, sc;
+    apply(x, sb, sc);
+    y.resize(m);
+    for (int i = 0; i < m; ++i) y(i) = active[std::size_t(i)] ? sb(i) : sc(i);
+  }
+
+  /// The preconditioner's LUs for 𝒜 (again only in groups where 𝒜 changed).
+  void prepare(const ActiveSet& active) const {
+    const int n = int(groups.size());
+    std::exception_ptr failure;
+    int made = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : made)
+    for (int g = 0; g < n; ++g) try {
+        const std::vector<int>& items = groups[std::size_t(g)];
+        ActiveSet flags(items.size());
+        for (std::size_t a = 0; a < items.size(); ++a) flags[a] = active[std::size_t(items[a])];
+        if (flags == lu_active[std::size_t(g)]) continue;
+        Eigen::MatrixXd M(Eigen::Index(items.size()), Eigen::Index(items.size()));
+        for (Eigen::Index a = 0; a < M.rows(); ++a)
+          M.row(a) = flags[std::size_t(a)] ? diag_B[std::size_t(g)].row(a) : diag_C[std::size_t(g)].row(a);
+        lu[std::size_t(g)].compute(M);
+        lu_active[std::size_t(g)] = std::move(flags);
+        ++made;
+      } catch (...) {
+#pragma omp critical(fictus_hierarchical_failure)
+        if (!failure) failure = std::current_exception();
+      }
+    if (failure) std::rethrow_exception(failure);
+    factorizations += made;
+  }
+
+  void precondition(const Eigen::VectorXd& r, Eigen::VectorXd& y) const {
+    y.resize(r.size());
+    const int n = int(groups.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int g = 0; g < n; ++g) {
+      const std::vector<int>& items = groups[std::size_t(g)];
+      Eigen::VectorXd v(Eigen::Index(items.size()));
+      for (std::size_t a = 0; a < items.size(); ++a) v(Eigen::Index(a)) = r(items[a]);
+      v = lu[std::size_t(g)].solve(v);
+      for (std::size_t a = 0; a < items.size(); ++a) y(items[a]) = v(Eigen::Index(a));
+    }
+  }
+};
+
+template <int dim>
+HierarchicalSchur::HierarchicalSchur(const GreenTable<dim>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
+                                     const SparseRows& loads, const Execution& execution, const DirectTerms& direct,
+                                     const HierarchicalOptions& options, const GmresOptions& gmres)
+    : impl_(std::make_unique<Impl>()) {
+  const auto start = std::chrono::steady_clock::now();
+  Impl& s = *impl_;
+  s.m = B_gamma.n_rows();
+  s.threads = execution.threads();
+  s.gmres = gmres;
+  if (C_gamma.n_rows() != s.m || loads.n_rows() != s.m)
+    throw std::invalid_argument("hierarchical Schur complement: B_γ, C_γ and the loads differ in their rows");
+  if (!(options.far_field.order > 0 && options.group >= 1))
+    throw std::invalid_argument("hierarchical Schur complement: needs a far field (order > 0) and groups of >= 1");
+  FarFieldReport report;
+  s.blocks = compressed_green_blocks(green, {&B_gamma, &C_gamma}, loads, execution, options.far_field, &report);
+  execution.throw_if_interrupted();
+  s.D_B = direct.trace;
+  s.D_C = direct.normal_derivative;
+  // The preconditioner: S̃_B and S̃_C on each group of nearby points.
+  const std::vector<int> groups = s.blocks.groups(options.group);
+  const int n_groups = int(groups.size());
+  s.groups.resize(std::size_t(n_groups));
+  s.diag_B.resize(std::size_t(n_groups));
+  s.diag_C.resize(std::size_t(n_groups));
+  s.lu.resize(std::size_t(n_groups));
+  s.lu_active.resize(std::size_t(n_groups));
+  std::exception_ptr failure;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(s.threads)
+  for (int g = 0; g < n_groups; ++g) try {
+      const CompressedBlocks::Cluster& cl = s.blocks.row_clusters[std::size_t(groups[std::size_t(g)])];
+      std::vector<int>& items = s.groups[std::size_t(g)];
+      items.assign(s.blocks.row_item.begin() + cl.begin, s.blocks.row_item.begin() + cl.end);
+      s.diag_B[std::size_t(g)] = s.blocks.diagonal_block(0, groups[std::size_t(g)]);
+      s.diag_C[std::size_t(g)] = s.blocks.diagonal_block(1, groups[std::size_t(g)]);
+      add_direct(s.D_B, items, s.diag_B[std::size_t(g)]);
+      add_direct(s.D_C, items, s.diag_C[std::size_t(g)]);
+    } catch (...) {
+#pragma omp critical(fictus_hierarchical_failure)
+      if (!failure) failure = std::current_exception();
+    }
+  if (failure) std::rethrow_exception(failure);
+  SchurStorage& t = s.storage;
+  t.kind = "hierarchical";
+  t.bytes = s.blocks.bytes() + 12.0 * double(s.D_B.nonZeros() + s.D_C.nonZeros());
+  t.dense_bytes = 2.0 * 8.0 * double(s.m) * double(s.m);
+  for (const CompressedBlocks::Block& b : s.blocks.blocks) {
+    if (b.dense.empty()) {
+      t.low_rank_blocks += 1;
+      for (const Eigen::MatrixXd& r : b.right) t.largest_rank = std::max(t.largest_rank, int(r.cols()));
+    } else {
+      t.full_blocks += 1;
+    }
+  }
+  for (const Eigen::MatrixXd& M : s.diag_B) t.preconditioner_bytes += 3.0 * 8.0 * double(M.size());
+  t.far_fraction = report.far_pairs / (report.far_pairs + report.near_pairs);
+  t.seconds_assembly = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+template HierarchicalSchur::HierarchicalSchur(const GreenTable<2>&, const SparseRows&, const SparseRows&,
+                                              const SparseRows&, const Execution&, const DirectTerms&,
+                                              const HierarchicalOptions&, const GmresOptions&);
+template HierarchicalSchur::HierarchicalSchur(const GreenTable<3>&, const SparseRows&, const SparseRows&,
+                                              const SparseRows&, const Execution&, const DirectTerms&,
+                                              const HierarchicalOptions&, const GmresOptions&);
+
+HierarchicalSchur::~HierarchicalSchur() = default;
+
+int HierarchicalSchur::size() const { return impl_->m; }
+
+const SchurStorage& HierarchicalSchur::storage() const { return impl_->storage; }
+
+int HierarchicalSchur::factorizations() const { return impl_->factorizations; }
+
+void HierarchicalSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const {
+  impl_->apply(lambda, sb, sc);
+}
+
+LinearSolveReport HierarchicalSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
+                                           Eigen::VectorXd& lambda, double& alpha) const {
+  if (mode) throw std::logic_error("HierarchicalSchur: no bordering (a singular A takes the dense blocks)");
+  const Impl& s = *impl_;
+  s.prepare(active);
+  Eigen::VectorXd y, v;
+  s.apply_newton(active, lambda, y);
+  const Eigen::VectorXd r0 = d - y;
+  const double dn = d.norm(), rn = r0.norm();
+  LinearSolveReport report;
+  report.relative_residual = dn > 0 ? rn / dn : rn;
+  report.converged = report.relative_residual <= s.gmres.relative_tolerance;
+  if (report.converged) return report;
+  GmresOptions options = s.gmres;
+  options.relative_tolerance = std::min(0.5, s.gmres.relative_tolerance * dn / rn);
+  const LinearOperator op = [&](const Eigen::VectorXd& w, Eigen::VectorXd& out) {
+    s.precondition(w, v);
+    s.apply_newton(active, v, out);
+  };
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(s.m);
+  const GmresReport g = gmres(op, r0, z, options);
+  s.precondition(z, v);
+  lambda += v;
+  alpha = 0.0;
+  report.inner_iterations = g.iterations;
+  report.relative_residual = g.relative_residual * rn / (dn > 0 ? dn : 1.0);
+  report.converged = g.converged;
+  return report;
+}
+
+}  // namespace fictus
