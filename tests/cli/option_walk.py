@@ -57,6 +57,7 @@ WALK = {
     "load_quadrature": 3,
     "error_quadrature": 4,
     "far_field": False,
+    "schur_storage": "dense",
     "flux_balance": False,
     "nested_start": 28,
     "error_estimate": False,
