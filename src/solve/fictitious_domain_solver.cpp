@@ -274,23 +274,18 @@ void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
                                                  b.direct(), h_options, inner);
     setup.storage = h->storage();
     setup.schur = std::move(h);
-    if (!keep) st.green.reset();
-    setup.exact = std::make_unique<ImplicitSchur>(*st.fast, b.B_gamma(), b.C_gamma(), b.loads(), gmres, b.direct());
-    clock.mark("schur");
-    st.execution.throw_if_interrupted();
-    return;
+  } else {
+    FarFieldReport report;
+    setup.schur = std::make_unique<ExplicitSchur>(*st.green, b.B_gamma(), b.C_gamma(), b.loads(), st.execution,
+                                                  b.direct(), b.far_field(options), &report);
+    SchurStorage dense;
+    dense.bytes = dense.dense_bytes = 2.0 * 8.0 * double(m) * double(m);
+    setup.storage = dense;
+    if (report.far_pairs > 0) setup.far_field = report;
   }
-  FarFieldReport report;
-  setup.schur = std::make_unique<ExplicitSchur>(*st.green, b.B_gamma(), b.C_gamma(), b.loads(), st.execution,
-                                                b.direct(), b.far_field(options), &report);
   if (!keep) st.green.reset();
-  SchurStorage dense;
-  dense.bytes = dense.dense_bytes = 2.0 * 8.0 * double(m) * double(m);
-  setup.storage = dense;
-  if (report.far_pairs > 0) {
-    setup.far_field = report;
+  if (hierarchical || setup.far_field)  // Newton finishes on the exact S
     setup.exact = std::make_unique<ImplicitSchur>(*st.fast, b.B_gamma(), b.C_gamma(), b.loads(), gmres, b.direct());
-  }
   clock.mark("schur");
   st.execution.throw_if_interrupted();
 }
