@@ -237,7 +237,13 @@ json solution_to_json(const BasicProblem<dim>& problem, const BasicSolution<dim>
   };
   j["conditions"] = {{"signorini", part_json(contact.signorini)},
                      {"dirichlet", part_json(contact.dirichlet)},
-                     {"neumann", part_json(contact.neumann)}};
+                     {"neumann", part_json(contact.neumann)},
+                     {"junctions", json::array()}};  // where the parts meet, located between the points
+  for (const PartJunction<dim>& junction : s.junctions) {
+    json p = json::array();
+    for (int d = 0; d < dim; ++d) p.push_back(junction.at[d]);
+    j["conditions"]["junctions"].push_back(p);
+  }
   j["contact"]["boundary_lines"] = json::array();  // 3-D: consecutive points of contact.boundary
   for (const auto& line : s.contact_boundary_lines) j["contact"]["boundary_lines"].push_back({line[0], line[1]});
   j["domain"] = s.domain ? domain_json(*s.domain) : json(nullptr);

@@ -149,6 +149,10 @@ py::dict contact(const BasicSolution<dim>& s) {
                                    {"neumann", &c.neumann}})
     parts[name] =
         py::dict(py::arg("points") = part->points, py::arg("measure") = part->measure, py::arg("flux") = part->flux);
+  py::array_t<double> junctions({py::ssize_t(s.junctions.size()), py::ssize_t(dim)});
+  for (std::size_t k = 0; k < s.junctions.size(); ++k)
+    for (int a = 0; a < dim; ++a) junctions.mutable_at(py::ssize_t(k), py::ssize_t(a)) = s.junctions[k].at[a];
+  parts["junctions"] = junctions;  // where the parts meet, located between the points
   d["conditions"] = parts;
   return d;
 }

@@ -530,6 +530,9 @@ def test_mixed_conditions_match_the_cli(tmp_path, name, replace):
         assert results["conditions"][part]["points"] > 0, part
         for key, value in results["conditions"][part].items():
             assert s.contact_summary["conditions"][part][key] == pytest.approx(value, rel=1e-12, abs=1e-12), (part, key)
+    junctions = np.array(results["conditions"]["junctions"])
+    assert len(junctions) > 0
+    np.testing.assert_allclose(s.contact_summary["conditions"]["junctions"], junctions, rtol=1e-12, atol=1e-12)
     condition = np.array([int(p["condition"]) for p in points])
     np.testing.assert_array_equal(s.condition, condition)
     assert s.contact_summary["points"] == int(s.contact.sum()) == results["contact"]["points"]

@@ -2,14 +2,76 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <queue>
 #include <stdexcept>
 #include <string>
 
 namespace fictus {
 
+namespace {
+
+/// The arcs in the placement measure: m equal ones from (phase − ½)·W/m on; or, with breaks, each piece
+/// between consecutive breaks cut into equal arcs, the pieces given their counts one at a time to the
+/// piece whose arcs are longest (at least one each). Each arc as [begin, end) in the measure, and the
+/// parameter at a break exactly where an arc starts or ends there (NaN elsewhere).
+struct PlacedArc {
+  double centre, begin, end, t_begin, t_end;
+};
+
+std::vector<PlacedArc> placed_arcs(const ArcLengthTable& measure, int m, double phase,
+                                   const std::vector<double>& breaks) {
+  const double total = measure.length(), none = std::numeric_limits<double>::quiet_NaN();
+  std::vector<PlacedArc> arcs;
+  if (breaks.empty()) {
+    const double step = total / m;
+    for (int i = 0; i < m; ++i) {
+      const double w = (i + phase) * step;
+      arcs.push_back({w, w - 0.5 * step, w + 0.5 * step, none, none});
+    }
+    return arcs;
+  }
+  std::vector<std::pair<double, double>> at;  // (measure, parameter) of each break
+  for (double t : breaks) at.emplace_back(t <= 0 ? 0.0 : measure.s_of_t(t), t);
+  std::sort(at.begin(), at.end());
+  at.erase(std::unique(at.begin(), at.end(),  // a junction at a corner breaks γ once
+                       [total](const auto& a, const auto& b) { return b.first - a.first < 1e-12 * total; }),
+           at.end());
+  if (at.size() > 1 && at[0].first + total - at.back().first < 1e-12 * total) at.pop_back();
+  const int pieces = int(at.size());
+  if (m < pieces)
+    throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) + " is fewer than the " +
+                                std::to_string(pieces) +
+                                " pieces of gamma between the junctions of the conditions' parts (and its corners)");
+  std::vector<double> length(static_cast<std::size_t>(pieces));
+  for (int k = 0; k < pieces; ++k)
+    length[std::size_t(k)] =
+        (k + 1 < pieces ? at[std::size_t(k) + 1].first : at[0].first + total) - at[std::size_t(k)].first;
+  std::vector<int> count(static_cast<std::size_t>(pieces), 1);
+  std::priority_queue<std::pair<double, int>> longest;  // (arc length in the piece, piece)
+  for (int k = 0; k < pieces; ++k) longest.emplace(length[std::size_t(k)], k);
+  for (int given = pieces; given < m; ++given) {
+    const int k = longest.top().second;
+    longest.pop();
+    ++count[std::size_t(k)];
+    longest.emplace(length[std::size_t(k)] / count[std::size_t(k)], k);
+  }
+  for (int k = 0; k < pieces; ++k) {
+    const double from = at[std::size_t(k)].first, step = length[std::size_t(k)] / count[std::size_t(k)];
+    const int n = count[std::size_t(k)];
+    for (int i = 0; i < n; ++i)
+      arcs.push_back({from + (i + 0.5) * step, from + i * step, from + (i + 1) * step,
+                      i == 0 ? at[std::size_t(k)].second : none,
+                      i + 1 == n ? at[std::size_t(k + 1) % std::size_t(pieces)].second : none});
+  }
+  return arcs;
+}
+
+}  // namespace
+
 Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase,
-                             const ArcLengthTable* placement) {
+                             const ArcLengthTable* placement, const std::vector<double>& breaks) {
   if (m < 1) throw std::invalid_argument("make_collocation: need m >= 1, got " + std::to_string(m));
   Collocation c;
   c.m = m;
@@ -25,26 +87,35 @@ Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_lengt
   c.normal.resize(m);
   const double two_pi = 2.0 * std::numbers::pi;
   const ArcLengthTable& measure = placement ? *placement : arc_length;
-  const double total = measure.length(), step = total / m;
-  auto t_at = [&](double w) {  // parameter at measure w (mod the total); exact ends at 0 and the total
+  const double total = measure.length();
+  auto wrap = [total](double w) {
     w = std::fmod(w, total);
-    w = w < 0 ? w + total : w;
+    return w < 0 ? w + total : w;
+  };
+  auto t_at = [&](double w) {  // parameter at measure w (mod the total); exact ends at 0 and the total
+    w = wrap(w);
     return w <= 0 ? 0.0 : measure.t_of_s(w);
   };
+  std::vector<PlacedArc> arcs = placed_arcs(measure, m, phase, breaks);
+  // Point 0 is the first from t = 0 on (an arc may wrap past 0).
+  std::stable_sort(arcs.begin(), arcs.end(),
+                   [&wrap](const PlacedArc& a, const PlacedArc& b) { return wrap(a.centre) < wrap(b.centre); });
+  const bool equal = !placement && breaks.empty();
   for (int i = 0; i < m; ++i) {
-    const double w = (i + phase) * step, begin = w - 0.5 * step, end = w + 0.5 * step;
+    const PlacedArc& a = arcs[std::size_t(i)];
+    const double w = a.centre;
     c.t[i] = t_at(w);
-    c.arc_begin[i] = std::abs(begin) < 1e-14 * total ? 0.0 : t_at(begin);
-    c.arc_end[i] = std::abs(end - total) < 1e-14 * total ? two_pi : t_at(end);
+    c.arc_begin[i] = !std::isnan(a.t_begin) ? a.t_begin : std::abs(a.begin) < 1e-14 * total ? 0.0 : t_at(a.begin);
+    c.arc_end[i] = !std::isnan(a.t_end) ? a.t_end : std::abs(a.end - total) < 1e-14 * total ? two_pi : t_at(a.end);
     c.point[i] = curve.position(c.t[i]);
     c.normal[i] = curve.outward_normal(c.t[i]);
-    if (placement) {
+    if (equal) {
+      c.s[i] = w;
+      c.arc[i] = c.spacing;
+    } else {
       c.s[i] = arc_length.s_of_t(c.t[i]);
       const double from = arc_length.s_of_t(c.arc_begin[i]), to = arc_length.s_of_t(c.arc_end[i]);
       c.arc[i] = to >= from ? to - from : to + c.length - from;
-    } else {
-      c.s[i] = w;
-      c.arc[i] = c.spacing;
     }
   }
   return c;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <queue>
 #include <stdexcept>
 #include <tuple>
 
@@ -170,7 +171,8 @@ void icosahedron(std::vector<Point3>& vertices, std::vector<std::array<int, 3>>&
 
 }  // namespace
 
-std::vector<Point3> split_into_patches(PatchedSurface& s, int m) {
+std::vector<Point3> split_into_patches(PatchedSurface& s, int m, const std::vector<int>& labels,
+                                       std::vector<int>* patch_labels) {
   const std::size_t count = s.triangles.size();
   if (m < 1 || std::size_t(m) > count / 4)
     throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) + " needs 1 <= m <= " +
@@ -181,9 +183,36 @@ std::vector<Point3> split_into_patches(PatchedSurface& s, int m) {
     centroid[t] = (1.0 / 3) * (s.triangles[t].a + s.triangles[t].b + s.triangles[t].c);
     weight[t] = area(s.triangles[t]);
   }
-  // Lloyd's iteration from m triangles spread over the list.
+  // Lloyd's iteration from m triangles spread over the list (with labels: over each label's triangles,
+  // the counts given one at a time to the label whose patches are largest).
   std::vector<Point3> seeds(m);
-  for (int p = 0; p < m; ++p) seeds[p] = centroid[std::size_t(p) * count / std::size_t(m)];
+  std::vector<int> seed_label(std::size_t(m), 0);
+  if (labels.empty()) {
+    for (int p = 0; p < m; ++p) seeds[p] = centroid[std::size_t(p) * count / std::size_t(m)];
+  } else {
+    if (labels.size() != count) throw std::invalid_argument("split_into_patches: one label per triangle");
+    std::map<int, std::vector<std::size_t>> members;
+    std::map<int, double> label_area;
+    for (std::size_t t = 0; t < count; ++t) members[labels[t]].push_back(t), label_area[labels[t]] += weight[t];
+    if (int(members.size()) > m)
+      throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) + " is fewer than the " +
+                                  std::to_string(members.size()) + " parts of the surface");
+    std::map<int, int> given;
+    std::priority_queue<std::pair<double, int>> largest;  // (patch area in the label, label)
+    for (const auto& [label, a] : label_area) given[label] = 1, largest.emplace(a, label);
+    for (int n = int(members.size()); n < m; ++n) {
+      const int label = largest.top().second;
+      largest.pop();
+      largest.emplace(label_area[label] / ++given[label], label);
+    }
+    int p = 0;
+    for (const auto& [label, list] : members)
+      for (int k = 0; k < given[label]; ++k, ++p) {
+        seeds[p] = centroid[list[std::size_t(k) * list.size() / std::size_t(given[label])]];
+        seed_label[std::size_t(p)] = label;
+      }
+  }
+  const auto may_take = [&](std::size_t t, int p) { return labels.empty() || labels[t] == seed_label[std::size_t(p)]; };
   s.patch_of.assign(count, 0);
   // The nearest seed by buckets of side 2·(patch spacing): when the nearest one in the 27 buckets
   // around a centroid is within one bucket side, no seed outside them is nearer; else all are searched.
@@ -213,6 +242,7 @@ std::vector<Point3> split_into_patches(PatchedSurface& s, int m) {
     for (std::size_t t = 0; t < count; ++t) {
       double best = 1e300;
       const auto nearest = [&](int p) {
+        if (!may_take(t, p)) return;
         const Point3 d = centroid[t] - seeds[p];
         const double distance = dot(d, d);
         if (distance < best || (distance == best && p < s.patch_of[t])) best = distance, s.patch_of[t] = p;
@@ -243,6 +273,7 @@ std::vector<Point3> split_into_patches(PatchedSurface& s, int m) {
   for (std::size_t t = 0; t < count; ++t) s.area[s.patch_of[t]] += weight[t];
   for (int p = 0; p < m; ++p)
     if (s.area[p] == 0.0) throw std::runtime_error("surface patches: an empty patch (use a smaller edge)");
+  if (patch_labels) *patch_labels = seed_label;
   return seeds;
 }
 

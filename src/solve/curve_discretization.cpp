@@ -15,12 +15,13 @@
 namespace fictus {
 
 CurveDiscretization::CurveDiscretization(std::shared_ptr<const Curve> gamma, const Grid2& grid,
-                                         const SolverOptions& options, double c, const Execution& execution)
+                                         const SolverOptions& options, double c, const Execution& execution,
+                                         const PartConditions<2>& parts)
     : execution_(execution), gamma_(std::move(gamma)) {
   if (!gamma_) throw std::invalid_argument("geometry: no curve given");
   SolverOptions resolved = options;
   resolved.variant = resolved_variant(options.variant, gamma_->smooth());
-  make_geometry(grid, resolved);
+  make_geometry(grid, resolved, parts);
   make_trace_rows(grid, resolved, c);
 }
 
@@ -77,7 +78,35 @@ OffsetRoom curve_offset_room(std::shared_ptr<const Curve> gamma, const Box2& box
 
 }  // namespace
 
-void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options) {
+std::vector<PointCondition> CurveDiscretization::part_layout(const PartConditions<2>& parts) const {
+  if (!parts.mixed()) return {};
+  const int samples = std::max(4096, 16 * collocation_.m);
+  std::vector<PointCondition> layout(static_cast<std::size_t>(samples));
+  for (int k = 0; k < samples; ++k)
+    layout[std::size_t(k)] = parts.at(gamma_->position(2 * std::numbers::pi * (k + 0.5) / samples));
+  return layout;
+}
+
+std::vector<std::pair<double, PointCondition>> CurveDiscretization::junctions(
+    const PartConditions<2>& parts, const std::vector<PointCondition>& layout) const {
+  std::vector<std::pair<double, PointCondition>> out;
+  const int samples = int(layout.size());
+  const double step = 2 * std::numbers::pi / samples;
+  for (int k = 0; k < samples; ++k) {
+    const PointCondition before = layout[std::size_t(k)], after = layout[std::size_t(k + 1) % std::size_t(samples)];
+    if (before == after) continue;
+    double lo = (k + 0.5) * step, hi = lo + step;
+    for (int i = 0; i < 60; ++i) {
+      const double t = 0.5 * (lo + hi);
+      (parts.at(gamma_->position(std::fmod(t, 2 * std::numbers::pi))) == before ? lo : hi) = t;
+    }
+    out.emplace_back(std::fmod(0.5 * (lo + hi), 2 * std::numbers::pi), after);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options, const PartConditions<2>& parts) {
   const Curve& gamma = *gamma_;
   const double h = grid.h(), width = grid.box().width(0);
   check_simple(gamma, "geometry");
@@ -115,8 +144,28 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
                      options.variant == Variant::smooth ? curve_offset_room(gamma_, grid.box()) : OffsetRoom()};
   spacing_ = plan_spacing(input, options);
   const int m = spacing_.m;
+  // Mixed conditions: the arcs end where the parts meet (and at the corners, which the phase would
+  // otherwise keep the points away from), so that each point's arc lies in one part.
+  collocation_.m = m;
+  part_layout_ = part_layout(parts);
+  const std::vector<std::pair<double, PointCondition>> joins = junctions(parts, part_layout_);
+  std::vector<double> breaks;
+  for (const auto& [t, part] : joins) breaks.push_back(t);
+  if (!breaks.empty() && options.variant == Variant::nonsmooth)
+    for (double t : gamma.corners()) breaks.push_back(t);
+  const auto set_point_parts = [&]() {
+    if (part_layout_.empty()) return;
+    point_parts_.assign(std::size_t(m), part_layout_[0]);
+    if (joins.empty()) return;
+    for (int i = 0; i < m; ++i) {  // the part after the last junction before t_i (cyclically)
+      const double t = collocation_.t[std::size_t(i)];
+      auto it = std::upper_bound(joins.begin(), joins.end(), t, [](double v, const auto& j) { return v < j.first; });
+      point_parts_[std::size_t(i)] = (it == joins.begin() ? joins.back() : *std::prev(it)).second;
+    }
+  };
   if (options.variant == Variant::nonsmooth) {
-    collocation_ = make_collocation(gamma, arc_length, m, phase_off_corners(gamma, arc_length, m));
+    collocation_ = make_collocation(gamma, arc_length, m, phase_off_corners(gamma, arc_length, m), nullptr, breaks);
+    set_point_parts();
     Gamma_ = gamma_;
     return;
   }
@@ -125,7 +174,8 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
   // stretched by 1 + δκ): the longest arc of Γ, which sets the ripple of the controls, is as short as m
   // allows (docs/math.md, "Placement of the points").
   const ArcLengthTable placement = offset_placement(gamma, delta_);
-  collocation_ = make_collocation(gamma, arc_length, m, 0.5, &placement);
+  collocation_ = make_collocation(gamma, arc_length, m, 0.5, &placement, breaks);
+  set_point_parts();
   Gamma_ = std::make_shared<OffsetCurve>(gamma_, delta_);
   check_simple(*Gamma_, "formulation.offset");  // the plan's room says so; checked again on Γ itself
   check_inside_box(*Gamma_, grid.box(), 2 * h, "formulation.offset");

@@ -190,8 +190,8 @@ SolverOptions solve_options(const State<dim>& st, const BasicContactData<dim>& d
 template <int dim>
 BoundarySetup<dim>& boundary_setup(State<dim>& st, const BasicContactData<dim>& data, const SolverOptions& options,
                                    PhaseClock& clock, bool& reused) {
-  reused =
-      st.setup && st.setup->schur && st.setup->gamma == data.gamma && same_boundary_options(st.setup->options, options);
+  reused = st.setup && st.setup->schur && st.setup->gamma == data.gamma &&
+           same_boundary_options(st.setup->options, options) && st.setup->boundary->same_parts(data.conditions);
   if (reused) return *st.setup;
   st.setup.reset();
   auto setup = std::make_unique<BoundarySetup<dim>>();
@@ -199,10 +199,12 @@ BoundarySetup<dim>& boundary_setup(State<dim>& st, const BasicContactData<dim>& 
   setup->options = options;
   const MarkPhase mark = [&clock](const std::string& phase) { clock.mark(phase); };
   if constexpr (dim == 2) {
-    setup->boundary = std::make_unique<CurveDiscretization>(data.gamma, st.grid, options, st.c, st.execution);
+    setup->boundary =
+        std::make_unique<CurveDiscretization>(data.gamma, st.grid, options, st.c, st.execution, data.conditions);
     clock.mark("geometry");
   } else {
-    setup->boundary = std::make_unique<SurfaceDiscretization>(data.gamma, st.grid, options, st.c, st.execution, mark);
+    setup->boundary = std::make_unique<SurfaceDiscretization>(data.gamma, st.grid, options, st.c, st.execution, mark,
+                                                              data.conditions);
   }
   st.setup = std::move(setup);
   return *st.setup;
@@ -444,13 +446,17 @@ void obstacle_and_conditions(const BoundaryDiscretization<dim>& boundary, const 
   pc.kind.assign(std::size_t(m), PointCondition::signorini);
   pc.flux = Eigen::VectorXd::Zero(m);
   int dirichlet = 0, neumann = 0;
+  const std::vector<PointCondition>& placed = boundary.point_parts();  // the part each point was placed in
   for (int i = 0; i < m; ++i) {
     const Point<dim>& p = x[std::size_t(i)];
-    const bool in_d = parts.dirichlet && condition_value(parts.dirichlet(p), "conditions.dirichlet", p) != 0;
-    const bool in_n = parts.neumann && condition_value(parts.neumann(p), "conditions.neumann", p) != 0;
+    bool in_d = parts.dirichlet && condition_value(parts.dirichlet(p), "conditions.dirichlet", p) != 0;
+    bool in_n = parts.neumann && condition_value(parts.neumann(p), "conditions.neumann", p) != 0;
     if (in_d && in_n)
       throw std::invalid_argument("conditions.neumann: overlaps conditions.dirichlet at the point " +
                                   detail::format_point(p) + " of gamma (a point takes one condition)");
+    if (!placed.empty())
+      in_d = placed[std::size_t(i)] == PointCondition::dirichlet,
+      in_n = placed[std::size_t(i)] == PointCondition::neumann;
     if (in_d) {
       sol.g[std::size_t(i)] = condition_value(parts.u(p), "conditions.u", p);
       pc.kind[std::size_t(i)] = PointCondition::dirichlet;
@@ -471,11 +477,43 @@ void obstacle_and_conditions(const BoundaryDiscretization<dim>& boundary, const 
   sol.conditions = std::move(pc);
 }
 
+/// With mixed conditions: each pair of neighbouring points under different conditions, with the junction
+/// between them located by bisection along the chord from x_i to x_j on the parts' expressions (docs/math.md,
+/// "Mixed conditions"). The chord is within O(d²) of γ, which places the junction to second order.
+template <int dim>
+void locate_junctions(const BasicContactData<dim>& data, BasicSolution<dim>& sol) {
+  sol.junctions.clear();
+  if (sol.conditions.kind.empty()) return;
+  const PartConditions<dim>& parts = data.conditions;
+  const auto holds = [](const auto& part, const Point<dim>& x) {
+    if (!part) return false;
+    const double value = part(x);
+    return std::isfinite(value) && value != 0;
+  };
+  const auto kind = [&](const Point<dim>& x) {
+    return holds(parts.dirichlet, x) ? PointCondition::dirichlet
+           : holds(parts.neumann, x) ? PointCondition::neumann
+                                     : PointCondition::signorini;
+  };
+  for (NeighbourPair& pair : neighbour_pairs<dim>(sol)) {
+    const PointCondition own = sol.condition(pair.i);
+    if (own == sol.condition(pair.j)) continue;
+    const Point<dim>&xi = sol.points()[std::size_t(pair.i)], &xj = sol.points()[std::size_t(pair.j)];
+    double lo = 0, hi = 1;
+    for (int k = 0; k < 40; ++k) {
+      const double t = 0.5 * (lo + hi);
+      (kind(xi + t * (xj - xi)) == own ? lo : hi) = t;
+    }
+    const double theta = 0.5 * (lo + hi);
+    sol.junctions.push_back({std::move(pair), theta, xi + theta * (xj - xi)});
+  }
+}
+
 /// With mixed conditions: where the Dirichlet part meets the Signorini part with the obstacle above
 /// u_D (u ≥ g on one side, u = u_D on the other), u jumps: its energy is infinite and the quantities do
-/// not converge with N. Judged at each Dirichlet–Signorini pair of neighbours from g − u_D at both points:
-/// their mean (the mismatch at the junction) beyond their difference (what one spacing explains). A
-/// warning names the first such junction.
+/// not converge with N. Judged at each Dirichlet–Signorini junction from g − u_D at both points: their
+/// mean (the mismatch at the junction) beyond their difference (what one spacing explains). A warning
+/// names the first such junction.
 template <int dim>
 void junction_warning(const BoundaryDiscretization<dim>& boundary, const BasicContactData<dim>& data,
                       BasicSolution<dim>& sol) {
@@ -483,7 +521,8 @@ void junction_warning(const BoundaryDiscretization<dim>& boundary, const BasicCo
   const std::vector<double> g = boundary.obstacle(data);  // the obstacle at the Dirichlet points too
   double scale = 0;
   for (double v : sol.g) scale = std::max(scale, std::abs(v));
-  for (const NeighbourPair& pair : neighbour_pairs<dim>(sol)) {
+  for (const PartJunction<dim>& junction : sol.junctions) {
+    const NeighbourPair& pair = junction.pair;
     const PointCondition a = sol.condition(pair.i), b = sol.condition(pair.j);
     if (!((a == PointCondition::dirichlet && b == PointCondition::signorini) ||
           (a == PointCondition::signorini && b == PointCondition::dirichlet)))
@@ -494,8 +533,7 @@ void junction_warning(const BoundaryDiscretization<dim>& boundary, const BasicCo
     const double mismatch = 0.5 * (di + dj);
     if (!(mismatch > std::abs(di - dj) + 1e-9 * scale)) continue;
     sol.warnings.push_back("conditions.u: where the Dirichlet part meets the Signorini part near " +
-                           detail::format_point<dim>(0.5 * (xi + xj)) + ", the obstacle g lies " +
-                           format_number(mismatch) +
+                           detail::format_point<dim>(junction.at) + ", the obstacle g lies " + format_number(mismatch) +
                            " above u there: u jumps (its energy is infinite) and the quantities do not converge "
                            "with N");
     return;
@@ -772,6 +810,7 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
   load_terms<dim>(st, setup);
   const BoundaryDiscretization<dim>& boundary = *setup.boundary;
   boundary.describe(sol);
+  locate_junctions<dim>(data, sol);
   junction_warning<dim>(boundary, data, sol);
   sol.delta = boundary.delta();
   sol.flux_balance = boundary.flux_balance(setup.shift);

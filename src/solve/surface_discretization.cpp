@@ -70,16 +70,24 @@ struct SurfaceDiscretization::Kink {
 
 SurfaceDiscretization::SurfaceDiscretization(std::shared_ptr<const Surface> gamma, const Grid3& grid,
                                              const SolverOptions& options, double c, const Execution& execution,
-                                             const MarkPhase& mark)
+                                             const MarkPhase& mark, const PartConditions<3>& parts)
     : grid_(grid), gamma_(std::move(gamma)), execution_(execution), c_(c), balance_wanted_(options.flux_balance) {
   if (!gamma_) throw std::invalid_argument("geometry: no surface given");
-  make_geometry(options);
+  make_geometry(options, parts);
   make_trace_rows(options, mark);
 }
 
 SurfaceDiscretization::~SurfaceDiscretization() = default;
 
-void SurfaceDiscretization::make_geometry(const SolverOptions& options) {
+std::vector<PointCondition> SurfaceDiscretization::part_layout(const PartConditions<3>& parts) const {
+  if (!parts.mixed()) return {};
+  std::vector<PointCondition> layout;
+  layout.reserve(gamma_patches_.triangles.size());
+  for (const Triangle3& t : gamma_patches_.triangles) layout.push_back(parts.at((1.0 / 3) * (t.a + t.b + t.c)));
+  return layout;
+}
+
+void SurfaceDiscretization::make_geometry(const SolverOptions& options, const PartConditions<3>& parts) {
   const Surface& gamma = *gamma_;
   const double h = grid_.h();
   check_inside_box(gamma, grid_, 0, "geometry");  // before any work
@@ -98,6 +106,23 @@ void SurfaceDiscretization::make_geometry(const SolverOptions& options) {
   execution_.throw_if_interrupted();
   gamma_patches_ = gamma.patches(plan_.m, h);
   execution_.throw_if_interrupted();
+  part_layout_ = part_layout(parts);
+  if (!part_layout_.empty()) {  // the patches again, each in one part; a patch's point: its centroid's foot on γ
+    std::vector<int> labels;
+    for (PointCondition part : part_layout_) labels.push_back(int(part));
+    std::vector<int> patch_labels;
+    const std::vector<Point3> seeds = split_into_patches(gamma_patches_, plan_.m, labels, &patch_labels);
+    const Box3 bounds = gamma.bounds();
+    const double tolerance = 1e-13 * std::max({bounds.width(0), bounds.width(1), bounds.width(2)});
+    for (int p = 0; p < plan_.m; ++p) {
+      const SurfaceFoot foot = nearest_point(gamma, seeds[std::size_t(p)], seeds[std::size_t(p)], tolerance);
+      gamma_patches_.point[std::size_t(p)] = foot.foot;
+      gamma_patches_.normal[std::size_t(p)] = foot.normal;
+    }
+    point_parts_.assign(patch_labels.size(), PointCondition::signorini);
+    for (std::size_t p = 0; p < patch_labels.size(); ++p) point_parts_[p] = PointCondition(patch_labels[p]);
+    execution_.throw_if_interrupted();
+  }
   Gamma_patches_ = gamma_patches_;
   if (options.variant == Variant::smooth) {
     delta_ = plan_.delta;

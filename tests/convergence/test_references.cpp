@@ -75,6 +75,63 @@ INSTANTIATE_TEST_SUITE_P(Problems, References,
                            return info.param.name + "_" + fictus::to_string(info.param.variant);
                          });
 
+// Mixed conditions in 2-D: the peanut with a Dirichlet part (the right lobe), a Neumann part (the bottom)
+// and two Signorini arcs, one with a contact piece whose ends are free-boundary points in general position
+// (tests/references/peanut_mixed.toml; peanut_mixed.json: FreeFEM, P2 on meshes fitted to γ with the four
+// junctions as vertices and graded towards them and the contact ends; 1.2e6 dofs on the last level, u
+// changing by 1.6e-8 and the fluxes by 7e-11 from the level before). Both variants, N = 256 … 2048.
+TEST(ReferencesMixed, PeanutConvergesToTheFittedMeshSolution) {
+  const std::string dir = std::string(FICTUS_SOURCE_DIR) + "/tests/references/";
+  const reference::Reference reference = reference::load(dir, "peanut_mixed");
+  std::ifstream json_file(dir + "peanut_mixed.json");
+  const nlohmann::json parts = nlohmann::json::parse(json_file)["conditions"];
+  const double ref_dirichlet = parts["dirichlet_part"]["flux"], ref_force = parts["signorini_part"]["flux"],
+               ref_contact = parts["signorini_part"]["contact_measure"];
+  for (const auto variant : {fictus::Variant::smooth, fictus::Variant::nonsmooth}) {
+    std::vector<fictus::LevelResult> rows;
+    std::vector<std::array<double, 3>> part_errors;
+    std::vector<double> end_errors;
+    for (int N = 256; N <= 2048; N *= 2) {
+      fictus::ProblemSpec spec = fictus::read_problem_file(dir + "peanut_mixed.toml");
+      spec.problem.N = N;
+      spec.options.variant = variant;
+      spec.options.condition_number = false;
+      spec.options.error_estimate = false;
+      spec.options.threads = 2;
+      const fictus::Solution s = fictus::solve(spec.problem, spec.options);
+      ASSERT_TRUE(s.newton.converged) << "N = " << N << ": " << s.newton.failure;
+      EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+      const reference::Comparison cmp = reference::compare(reference, s);
+      rows.push_back(cmp.level);
+      end_errors.push_back(cmp.resolved_end_error_spacings);
+      const fictus::ContactSummary c = fictus::contact_summary(s);
+      // the parts' lengths: the arcs end at the junctions (to the arc-length table)
+      EXPECT_NEAR(c.dirichlet.measure, double(parts["dirichlet_part"]["measure"]), 1e-8);
+      EXPECT_NEAR(c.neumann.measure, double(parts["neumann_part"]["measure"]), 1e-8);
+      part_errors.push_back({std::abs(c.dirichlet.flux / ref_dirichlet - 1), std::abs(c.force / ref_force - 1),
+                             std::abs(c.measure / ref_contact - 1)});
+      std::cout << "N = " << N << ", " << fictus::to_string(variant) << ": Dirichlet flux "
+                << c.dirichlet.flux / ref_dirichlet - 1 << ", contact force " << c.force / ref_force - 1
+                << ", contact length " << c.measure / ref_contact - 1 << " (relative), contact ends within "
+                << cmp.resolved_end_error_spacings << " s\n";
+    }
+    std::cout << fictus::format_convergence_table(
+        std::string("peanut_mixed against its fitted-mesh reference, ") + fictus::to_string(variant), rows,
+        std::nullopt);
+    // Measured (docs/math.md, "Mixed conditions"): first order in L²(ω), the junctions' r^{1/2} singularities
+    // setting it; the fluxes through the parts and the contact length within a few 1e-3 at N = 2048, the
+    // force's error falling at each N.
+    const bool smooth = variant == fictus::Variant::smooth;
+    EXPECT_GE(fictus::fitted_rates(rows)[0], 0.9);
+    EXPECT_LT(rows.back().l2_omega, smooth ? 5e-5 : 1e-4);
+    EXPECT_LT(part_errors.back()[0], 2e-3);
+    EXPECT_LT(part_errors.back()[1], smooth ? 2.5e-3 : 5e-3);
+    EXPECT_LT(part_errors.back()[2], 5e-3);
+    for (std::size_t k = 1; k < part_errors.size(); ++k) EXPECT_LT(part_errors[k][1], part_errors[k - 1][1]);
+    for (double e : end_errors) EXPECT_LE(e, 0.25);
+  }
+}
+
 // 3-D: the ellipsoid of tests/references/ellipsoid3d.toml against its fitted reference
 // (ellipsoid3d.json: FreeFEM, P2 on curved tetrahedra fitted exactly to γ, primal-dual active set;
 // ∫u, ∫u² to about 3e-6 relative, ∫|∇u|² to about 7e-5, pointwise u to a few 1e-4). The smooth
@@ -207,20 +264,24 @@ TEST(References3d, MixedEllipsoidConvergesToTheFittedMeshSolution) {
               << c.dirichlet.flux / ref_dirichlet - 1 << ", contact force " << c.force / ref_force - 1
               << ", contact area " << c.measure / ref_contact - 1 << " (relative), contact flags agree " << agree << "/"
               << samples << "\n";
-    // Measured (docs/math.md, "Mixed conditions"): the parts are resolved to whole patches (s = 8h), so
-    // the caps' areas, the fluxes through them and the contact area are first-order and still far off at
-    // these N; they fall with N, and so does the largest pointwise error (beside the junction curves).
+    // Measured (docs/math.md, "Mixed conditions"): the patches follow the junction curves to within a
+    // triangle, so the caps' areas are right to 1e-3; the fluxes through them and the contact area are
+    // still first-order (the junctions are singular points of u) and far off at these N; they fall with
+    // N, and so does the largest pointwise error (beside the junction curves).
+    const nlohmann::json& parts = reference["conditions"];
+    EXPECT_NEAR(c.dirichlet.measure / double(parts["dirichlet_part"]["measure"]), 1, 2e-3);
+    EXPECT_NEAR(c.neumann.measure / double(parts["neumann_part"]["measure"]), 1, 2e-3);
     const std::array<double, 3> part_errors = {std::abs(c.dirichlet.flux / ref_dirichlet - 1),
                                                std::abs(c.force / ref_force - 1),
                                                std::abs(c.measure / ref_contact - 1)};
     EXPECT_LT(std::abs(rel_u), 6e-3);
-    EXPECT_LT(std::abs(rel_grad2), 0.05);
+    EXPECT_LT(std::abs(rel_grad2), 0.04);
     EXPECT_LT(pointwise, 0.9 * previous_pointwise);
-    EXPECT_LT(part_errors[0], 0.12);
+    EXPECT_LT(part_errors[0], 0.08);
     EXPECT_LT(part_errors[1], 0.3);
     EXPECT_LT(part_errors[2], 0.5);
     for (int k = 0; k < 3 && N > 96; ++k) EXPECT_LT(part_errors[std::size_t(k)], previous_part_errors[std::size_t(k)]);
-    EXPECT_GE(agree, 185);
+    EXPECT_GE(agree, 180);
     previous_pointwise = pointwise;
     previous_part_errors = part_errors;
   }

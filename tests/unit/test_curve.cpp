@@ -90,6 +90,46 @@ TEST(Collocation, OffsetPlacementMakesTheArcsOfGammaEqualWhereGammaIsConvex) {
   EXPECT_GT(star_placement.length(), star_table.length());
 }
 
+TEST(Collocation, ArcsEndAtTheBreaks) {
+  // Three breaks (one past t = 0 on the wrap): every break is an arc's end and the next arc's start, the
+  // arcs are equal within each piece, the m arcs cover γ once, and the longest is as short as m allows.
+  const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2, 0.3);
+  const fictus::ArcLengthTable table(e);
+  const std::vector<double> breaks = {0.4, 2.5, 6.1};
+  const int m = 37;
+  const fictus::Collocation c = fictus::make_collocation(e, table, m, 0.5, nullptr, breaks);
+  ASSERT_EQ(c.m, m);
+  double total = 0, longest = 0;
+  for (int i = 0; i < m; ++i) {
+    total += c.arc[i];
+    longest = std::max(longest, c.arc[i]);
+    EXPECT_NEAR(c.arc_end[i], c.arc_begin[(i + 1) % m], 1e-12) << i;  // consecutive, in order from t = 0
+    if (i > 0) EXPECT_GT(c.s[i], c.s[i - 1]);
+  }
+  EXPECT_NEAR(total, table.length(), 1e-12);
+  for (double t : breaks) {
+    int ends = 0;
+    for (int i = 0; i < m; ++i) ends += std::abs(c.arc_end[i] - t) < 1e-14;
+    EXPECT_EQ(ends, 1) << "break " << t;
+  }
+  // Optimal counts: taking an arc from any piece would make its arcs longer than the longest now.
+  const double L = table.length();
+  std::vector<double> at;
+  for (double t : breaks) at.push_back(table.s_of_t(t));
+  for (int k = 0; k < 3; ++k) {
+    const double from = at[std::size_t(k)], length = k < 2 ? at[std::size_t(k) + 1] - from : at[0] + L - from;
+    std::vector<int> in_piece;
+    for (int i = 0; i < m; ++i)
+      if (std::fmod(c.s[i] - from + L, L) < length) in_piece.push_back(i);
+    const int count = int(in_piece.size());
+    ASSERT_GE(count, 1);
+    for (int i : in_piece) EXPECT_NEAR(c.arc[i], length / count, 1e-12) << "piece " << k;  // equal within it
+    if (count > 1) EXPECT_GE(length / (count - 1), longest * (1 - 1e-12)) << "piece " << k;
+  }
+  EXPECT_LT(longest, 1.1 * L / m);
+  EXPECT_THROW(fictus::make_collocation(e, table, 2, 0.5, nullptr, breaks), std::invalid_argument);
+}
+
 TEST(Collocation, DefaultRuleKeepsTheSpacingInCells) {
   const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2);
   const double L = fictus::ArcLengthTable(e).length();

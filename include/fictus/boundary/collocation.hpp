@@ -19,16 +19,19 @@ struct Collocation {
   std::vector<double> s;                   // arc length of point i
   std::vector<double> arc;                 // length of the arc of γ point i owns (L/m without placement)
   std::vector<double> t;                   // parameter of point i
-  std::vector<double> arc_begin, arc_end;  // parameters bounding arc i, arc_begin[0] = 0
+  std::vector<double> arc_begin, arc_end;  // parameters bounding arc i (arc_begin[0] = 0 with phase ½, no breaks)
   std::vector<Point2> point, normal;       // x_i and the outward unit normal n_i
 
   int n_points() const { return m; }
 };
 
 /// The points of arcs equal in `placement` (nullptr: in arc length), point i at the placement
-/// measure's (i + phase)·W/m.
+/// measure's (i + phase)·W/m. With `breaks` (parameters of γ, e.g. where the conditions' parts meet), an
+/// arc ends at each break: the pieces between consecutive breaks get arcs equal within each piece, as
+/// many as keep the longest arc shortest (at least one a piece; `phase` is then unused). Throws
+/// std::invalid_argument naming formulation.multipliers when m is below the number of pieces.
 Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase = 0.5,
-                             const ArcLengthTable* placement = nullptr);
+                             const ArcLengthTable* placement = nullptr, const std::vector<double>& breaks = {});
 
 /// The smooth variant's placement measure for Γ at distance δ: speed |p′(t)|·max(1, 1 + δκ(t)), the
 /// speed of the offset curve where γ is convex and of γ itself where it is concave.

@@ -59,8 +59,11 @@ PatchedSurface ellipsoid_patches(Point3 center, Point3 semi_axes, int m, double 
 
 /// Splits the triangles of `s` into m patches of nearly equal area (Lloyd's iteration on the area-weighted
 /// triangle centroids): sets patch_of, m and area, sizes point and normal, and returns each patch's
-/// centroid for the caller to move onto the surface.
-std::vector<Point3> split_into_patches(PatchedSurface& s, int m);
+/// centroid for the caller to move onto the surface. With `labels` (one per triangle), a patch takes
+/// triangles of one label only: each label gets patches as many as keep the largest patch area smallest
+/// (at least one), and `patch_labels` (if given) receives each patch's label.
+std::vector<Point3> split_into_patches(PatchedSurface& s, int m, const std::vector<int>& labels = {},
+                                       std::vector<int>* patch_labels = nullptr);
 
 /// A torus about the z-axis through `center`: core radius R, tube radius r (0 < r < R), triangulated
 /// by its angle chart with edges about `edge`, split into m patches (the nearest points of the torus to

@@ -83,6 +83,19 @@ class BoundaryDiscretization {
                                    const Data& data) const = 0;
   /// The solution's description of the points (collocation and Γ, or patches).
   virtual void describe(SolutionBoundary<dim>& out) const = 0;
+
+  /// With mixed conditions, the points are placed part by part, so that no point's part of γ straddles
+  /// a junction of two parts (docs/math.md, "Mixed conditions"): each point's part as placed; empty
+  /// without mixed conditions.
+  const std::vector<PointCondition>& point_parts() const { return point_parts_; }
+  /// Whether `parts` divide γ as the parts the points were placed for (then the setup can be kept).
+  bool same_parts(const PartConditions<dim>& parts) const { return part_layout(parts) == part_layout_; }
+
+ protected:
+  /// The part of each of γ's fine pieces (2-D: samples of the curve; 3-D: the triangles) under `parts`;
+  /// empty without mixed conditions.
+  virtual std::vector<PointCondition> part_layout(const PartConditions<dim>& parts) const = 0;
+  std::vector<PointCondition> point_parts_, part_layout_;
 };
 
 /// The boundary of dimension dim for γ on `grid`: a CurveDiscretization or a SurfaceDiscretization

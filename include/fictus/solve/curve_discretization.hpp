@@ -19,9 +19,11 @@ class CurveDiscretization final : public BoundaryDiscretization<2> {
   ///   1. geometry: γ checked (counter-clockwise, simple, 2h inside the box), m and δ by the rules of
   ///      spacing_rule.hpp, the collocation points and Γ (smooth variant: simple, 2h inside the box);
   ///   2. trace rows: B_γ, C_γ, B_Γ, and the kink correction's rows and direct terms.
-  /// Throws std::invalid_argument naming the option or "geometry" on bad input.
+  /// With mixed conditions (`parts`), the arcs of the points end at the junctions of the parts (and, in
+  /// the non-smooth variant, at γ's corners). Throws std::invalid_argument naming the option or
+  /// "geometry" on bad input.
   CurveDiscretization(std::shared_ptr<const Curve> gamma, const Grid2& grid, const SolverOptions& options, double c,
-                      const Execution& execution);
+                      const Execution& execution, const PartConditions<2>& parts = {});
 
   const std::vector<Point2>& points() const override { return collocation_.point; }
   const std::vector<Point2>& normals() const override { return collocation_.normal; }
@@ -53,7 +55,13 @@ class CurveDiscretization final : public BoundaryDiscretization<2> {
   const std::shared_ptr<const Curve>& Gamma() const { return Gamma_; }
 
  private:
-  void make_geometry(const Grid2& grid, SolverOptions options);
+  void make_geometry(const Grid2& grid, SolverOptions options, const PartConditions<2>& parts);
+  /// The parts at K = max(4096, 16m) samples of γ, at t = 2π(k + ½)/K.
+  std::vector<PointCondition> part_layout(const PartConditions<2>& parts) const override;
+  /// The parameters where the parts meet, each with the part that follows it, from the samples' parts
+  /// (each change bisected to round-off).
+  std::vector<std::pair<double, PointCondition>> junctions(const PartConditions<2>& parts,
+                                                           const std::vector<PointCondition>& layout) const;
   void make_trace_rows(const Grid2& grid, const SolverOptions& options, double c);
 
   const Execution& execution_;

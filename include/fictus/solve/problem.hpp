@@ -4,6 +4,7 @@
 // γ a closed curve (dim = 2, curve.hpp) or a closed surface (dim = 3, surface.hpp); or, with mixed
 // conditions (PartConditions), u = u_D on a Dirichlet part and ∂u/∂n = q on a Neumann part of γ and
 // the Signorini conditions on the rest.
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <string>
@@ -14,6 +15,10 @@
 #include "fictus/solve/solver_options.hpp"
 
 namespace fictus {
+
+/// The condition at a point of γ (mixed conditions, docs/math.md): Signorini (its row chosen by the active
+/// set), or an equation always in force: Dirichlet (the B row) or Neumann (the C row).
+enum class PointCondition : char { signorini = 0, dirichlet = 1, neumann = 2 };
 
 /// What γ is in a dimension: a Curve in 2-D, a Surface in 3-D.
 template <int dim>
@@ -46,6 +51,18 @@ struct PartConditions {
   std::function<double(const Point<dim>& x)> u;                          // u_D on the Dirichlet part
   std::function<double(const Point<dim>& x, const Point<dim>& n)> flux;  // q on the Neumann part (unset: 0)
   bool mixed() const { return bool(dirichlet) || bool(neumann); }
+  /// The part x lies in: Dirichlet where that expression is finite and non-zero, else Neumann where that
+  /// one is, else Signorini (the overlap of the two parts is refused at the points, not here).
+  PointCondition at(const Point<dim>& x) const {
+    const auto holds = [&x](const std::function<double(const Point<dim>&)>& part) {
+      if (!part) return false;
+      const double value = part(x);
+      return std::isfinite(value) && value != 0;
+    };
+    return holds(dirichlet) ? PointCondition::dirichlet
+           : holds(neumann) ? PointCondition::neumann
+                            : PointCondition::signorini;
+  }
 };
 
 /// What may change from one solve to the next on the same grid: γ, the obstacle, the conditions on

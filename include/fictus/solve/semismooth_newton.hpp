@@ -23,16 +23,13 @@
 
 #include <Eigen/Dense>
 
+#include "fictus/solve/problem.hpp"
 #include "fictus/solve/schur_complement.hpp"
 #include "fictus/solve/solver_options.hpp"
 
 namespace fictus {
 
 struct NewtonResult;
-
-/// The condition at a point of γ (mixed conditions, docs/math.md): Signorini (its row chosen by the active
-/// set), or an equation always in force: Dirichlet (the B row) or Neumann (the C row).
-enum class PointCondition : char { signorini = 0, dirichlet = 1, neumann = 2 };
 
 /// The conditions at the points: each point's kind and q at the Neumann points (0 elsewhere).
 struct PointConditions {

@@ -107,6 +107,23 @@ struct ErrorEstimate {
   std::string skipped;      // non-empty: no estimate, and why
 };
 
+/// Neighbouring points of γ: consecutive points of a curve, patches sharing a triangle edge of a surface.
+struct NeighbourPair {
+  int i = 0, j = 0;
+  double distance = 0;       // between x_i and x_j (along the curve in 2-D, the chord in 3-D)
+  double border = 0;         // the measure of the parts' common border: 1 in 2-D, the shared edges' length in 3-D
+  std::vector<int> corners;  // 3-D: the triangulation's vertices (by index) at the ends of the border's edges
+};
+
+/// Mixed conditions: two neighbouring points under different conditions, and where between them the
+/// condition changes (docs/math.md, "Mixed conditions"): at the fraction θ of the way from x_i to x_j.
+template <int dim>
+struct PartJunction {
+  NeighbourPair pair;
+  double theta = 0.5;
+  Point<dim> at;
+};
+
 /// The points of γ a solution's values belong to, and the boundary carrying λ.
 template <int dim>
 struct SolutionBoundary;
@@ -148,6 +165,7 @@ struct BasicSolution : SolutionBoundary<dim> {
   std::vector<double> lambda, g, trace, normal_derivative;  // per point: λ, g (u_D at Dirichlet points), B_γû, C_γû
   /// Mixed conditions: each point's condition and q at the Neumann points; kind empty: all Signorini.
   PointConditions conditions;
+  std::vector<PartJunction<dim>> junctions;  // mixed conditions: where the parts meet, located between points
   PointCondition condition(int i) const {
     return conditions.kind.empty() ? PointCondition::signorini : conditions.kind[std::size_t(i)];
   }
@@ -189,13 +207,6 @@ struct BasicSolution : SolutionBoundary<dim> {
 using Solution = BasicSolution<2>;
 using SurfaceSolution = BasicSolution<3>;
 
-/// Neighbouring points of γ: consecutive points of a curve, patches sharing a triangle edge of a surface.
-struct NeighbourPair {
-  int i = 0, j = 0;
-  double distance = 0;       // between x_i and x_j (along the curve in 2-D, the chord in 3-D)
-  double border = 0;         // the measure of the parts' common border: 1 in 2-D, the shared edges' length in 3-D
-  std::vector<int> corners;  // 3-D: the triangulation's vertices (by index) at the ends of the border's edges
-};
 template <int dim>
 std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<dim>& boundary);
 

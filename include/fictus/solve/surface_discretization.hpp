@@ -35,9 +35,11 @@ class SurfaceDiscretization final : public BoundaryDiscretization<3> {
   ///   2. trace rows: B_γ, C_γ, B_Γ; in the non-smooth variant with reconstructed traces, the kink
   ///      correction (its rows join B_Γ as the loads; D_B, D_C act on λ directly).
   /// `mark` is told "geometry" and "kink_correction" as they end. Throws std::invalid_argument naming
-  /// the option or "geometry" on bad input. `execution` must outlive the object.
+  /// the option or "geometry" on bad input. `execution` must outlive the object. With mixed conditions
+  /// (`parts`), each patch takes triangles of one part only, so the patch borders follow the junctions
+  /// of the parts to within a triangle.
   SurfaceDiscretization(std::shared_ptr<const Surface> gamma, const Grid3& grid, const SolverOptions& options, double c,
-                        const Execution& execution, const MarkPhase& mark);
+                        const Execution& execution, const MarkPhase& mark, const PartConditions<3>& parts = {});
   ~SurfaceDiscretization() override;
 
   const std::vector<Point3>& points() const override { return gamma_patches_.point; }
@@ -74,7 +76,9 @@ class SurfaceDiscretization final : public BoundaryDiscretization<3> {
   void describe(SolutionBoundary<3>& out) const override;
 
  private:
-  void make_geometry(const SolverOptions& options);
+  void make_geometry(const SolverOptions& options, const PartConditions<3>& parts);
+  /// The parts at the centroids of γ's triangles.
+  std::vector<PointCondition> part_layout(const PartConditions<3>& parts) const override;
   void make_trace_rows(const SolverOptions& options, const MarkPhase& mark);
 
   Grid3 grid_;
