@@ -41,9 +41,9 @@ std::vector<PlacedArc> placed_arcs(const ArcLengthTable& measure, int m, double 
   if (at.size() > 1 && at[0].first + total - at.back().first < 1e-12 * total) at.pop_back();
   const int pieces = int(at.size());
   if (m < pieces)
-    throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) + " is fewer than the " +
-                                std::to_string(pieces) +
-                                " pieces of gamma between the junctions of the conditions' parts (and its corners)");
+    throw std::invalid_argument(
+        "formulation.multipliers: m = " + std::to_string(m) + " is fewer than the " + std::to_string(pieces) +
+        " pieces of gamma between the junctions of the conditions' parts (and its corners): raise m or N");
   std::vector<double> length(static_cast<std::size_t>(pieces));
   for (int k = 0; k < pieces; ++k)
     length[std::size_t(k)] =
@@ -57,13 +57,14 @@ std::vector<PlacedArc> placed_arcs(const ArcLengthTable& measure, int m, double 
     ++count[std::size_t(k)];
     longest.emplace(length[std::size_t(k)] / count[std::size_t(k)], k);
   }
+  const auto end_at = [](double t) { return t <= 0 ? 2 * std::numbers::pi : t; };  // an arc ending at t = 0
   for (int k = 0; k < pieces; ++k) {
     const double from = at[std::size_t(k)].first, step = length[std::size_t(k)] / count[std::size_t(k)];
     const int n = count[std::size_t(k)];
     for (int i = 0; i < n; ++i)
       arcs.push_back({from + (i + 0.5) * step, from + i * step, from + (i + 1) * step,
                       i == 0 ? at[std::size_t(k)].second : none,
-                      i + 1 == n ? at[std::size_t(k + 1) % std::size_t(pieces)].second : none});
+                      i + 1 == n ? end_at(at[std::size_t(k + 1) % std::size_t(pieces)].second) : none});
   }
   return arcs;
 }

@@ -196,14 +196,20 @@ std::vector<Point3> split_into_patches(PatchedSurface& s, int m, const std::vect
     for (std::size_t t = 0; t < count; ++t) members[labels[t]].push_back(t), label_area[labels[t]] += weight[t];
     if (int(members.size()) > m)
       throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) + " is fewer than the " +
-                                  std::to_string(members.size()) + " parts of the surface");
+                                  std::to_string(members.size()) + " parts of the surface: raise m or N");
     std::map<int, int> given;
     std::priority_queue<std::pair<double, int>> largest;  // (patch area in the label, label)
-    for (const auto& [label, a] : label_area) given[label] = 1, largest.emplace(a, label);
-    for (int n = int(members.size()); n < m; ++n) {
+    for (const auto& [label, a] : label_area) {
+      given[label] = 1;
+      if (members[label].size() > 1) largest.emplace(a, label);
+    }
+    for (int n = int(members.size()); n < m; ++n) {  // a label takes at most as many patches as triangles
+      if (largest.empty())
+        throw std::invalid_argument("formulation.multipliers: m = " + std::to_string(m) +
+                                    " is more than the parts' triangles allow (a smaller edge allows more)");
       const int label = largest.top().second;
       largest.pop();
-      largest.emplace(label_area[label] / ++given[label], label);
+      if (++given[label] < int(members[label].size())) largest.emplace(label_area[label] / given[label], label);
     }
     int p = 0;
     for (const auto& [label, list] : members)

@@ -87,10 +87,21 @@ std::vector<PointCondition> CurveDiscretization::part_layout(const PartCondition
   return layout;
 }
 
+bool CurveDiscretization::same_parts(const PartConditions<2>& parts) const {
+  const std::vector<PointCondition> layout = part_layout(parts);
+  if (layout != part_layout_) return false;
+  const std::vector<std::pair<double, PointCondition>> now = junctions(parts, layout);
+  if (now.size() != junctions_.size()) return false;
+  for (std::size_t k = 0; k < now.size(); ++k)
+    if (now[k].second != junctions_[k].second || std::abs(now[k].first - junctions_[k].first) > 1e-12) return false;
+  return true;
+}
+
 std::vector<std::pair<double, PointCondition>> CurveDiscretization::junctions(
     const PartConditions<2>& parts, const std::vector<PointCondition>& layout) const {
   std::vector<std::pair<double, PointCondition>> out;
   const int samples = int(layout.size());
+  if (samples == 0) return out;
   const double step = 2 * std::numbers::pi / samples;
   for (int k = 0; k < samples; ++k) {
     const PointCondition before = layout[std::size_t(k)], after = layout[std::size_t(k + 1) % std::size_t(samples)];
@@ -148,11 +159,22 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
   // otherwise keep the points away from), so that each point's arc lies in one part.
   collocation_.m = m;
   part_layout_ = part_layout(parts);
-  const std::vector<std::pair<double, PointCondition>> joins = junctions(parts, part_layout_);
+  junctions_ = junctions(parts, part_layout_);
+  const std::vector<std::pair<double, PointCondition>>& joins = junctions_;
   std::vector<double> breaks;
   for (const auto& [t, part] : joins) breaks.push_back(t);
-  if (!breaks.empty() && options.variant == Variant::nonsmooth)
-    for (double t : gamma.corners()) breaks.push_back(t);
+  // The corners too (non-smooth), where they are few: one within a quarter spacing of a junction is
+  // left to the junction (no sliver of an arc between them).
+  if (const std::vector<double> corners = gamma.corners();
+      !breaks.empty() && options.variant == Variant::nonsmooth && int(corners.size()) <= m / 4)
+    for (double t : corners) {
+      bool near = false;
+      for (const auto& [junction, part] : joins) {
+        const double d = std::abs(arc_length.s_of_t(t) - arc_length.s_of_t(junction));
+        near = near || std::min(d, L - d) < 0.25 * L / m;
+      }
+      if (!near) breaks.push_back(t);
+    }
   const auto set_point_parts = [&]() {
     if (part_layout_.empty()) return;
     point_parts_.assign(std::size_t(m), part_layout_[0]);

@@ -485,16 +485,6 @@ void locate_junctions(const BasicContactData<dim>& data, BasicSolution<dim>& sol
   sol.junctions.clear();
   if (sol.conditions.kind.empty()) return;
   const PartConditions<dim>& parts = data.conditions;
-  const auto holds = [](const auto& part, const Point<dim>& x) {
-    if (!part) return false;
-    const double value = part(x);
-    return std::isfinite(value) && value != 0;
-  };
-  const auto kind = [&](const Point<dim>& x) {
-    return holds(parts.dirichlet, x) ? PointCondition::dirichlet
-           : holds(parts.neumann, x) ? PointCondition::neumann
-                                     : PointCondition::signorini;
-  };
   for (NeighbourPair& pair : neighbour_pairs<dim>(sol)) {
     const PointCondition own = sol.condition(pair.i);
     if (own == sol.condition(pair.j)) continue;
@@ -502,7 +492,7 @@ void locate_junctions(const BasicContactData<dim>& data, BasicSolution<dim>& sol
     double lo = 0, hi = 1;
     for (int k = 0; k < 40; ++k) {
       const double t = 0.5 * (lo + hi);
-      (kind(xi + t * (xj - xi)) == own ? lo : hi) = t;
+      (parts.at(xi + t * (xj - xi)) == own ? lo : hi) = t;
     }
     const double theta = 0.5 * (lo + hi);
     sol.junctions.push_back({std::move(pair), theta, xi + theta * (xj - xi)});

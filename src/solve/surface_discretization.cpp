@@ -107,21 +107,35 @@ void SurfaceDiscretization::make_geometry(const SolverOptions& options, const Pa
   gamma_patches_ = gamma.patches(plan_.m, h);
   execution_.throw_if_interrupted();
   part_layout_ = part_layout(parts);
-  if (!part_layout_.empty()) {  // the patches again, each in one part; a patch's point: its centroid's foot on γ
+  if (!part_layout_.empty() &&
+      std::any_of(part_layout_.begin(), part_layout_.end(), [&](PointCondition c) { return c != part_layout_[0]; })) {
+    // The patches again, each in one part. A patch's point: the foot on γ of the centroid of its triangle
+    // nearest to the patch's centroid (inside the patch, whatever its shape).
     std::vector<int> labels;
     for (PointCondition part : part_layout_) labels.push_back(int(part));
     std::vector<int> patch_labels;
     const std::vector<Point3> seeds = split_into_patches(gamma_patches_, plan_.m, labels, &patch_labels);
+    const std::vector<Triangle3>& triangles = gamma_patches_.triangles;
+    std::vector<Point3> start(std::size_t(plan_.m));
+    std::vector<double> best(std::size_t(plan_.m), 1e300);
+    for (std::size_t t = 0; t < triangles.size(); ++t) {
+      const int p = gamma_patches_.patch_of[t];
+      const Point3 c = (1.0 / 3) * (triangles[t].a + triangles[t].b + triangles[t].c);
+      if (const double d = norm(c - seeds[std::size_t(p)]); d < best[std::size_t(p)])
+        best[std::size_t(p)] = d, start[std::size_t(p)] = c;
+    }
     const Box3 bounds = gamma.bounds();
     const double tolerance = 1e-13 * std::max({bounds.width(0), bounds.width(1), bounds.width(2)});
     for (int p = 0; p < plan_.m; ++p) {
-      const SurfaceFoot foot = nearest_point(gamma, seeds[std::size_t(p)], seeds[std::size_t(p)], tolerance);
+      const SurfaceFoot foot = nearest_point(gamma, start[std::size_t(p)], start[std::size_t(p)], tolerance);
       gamma_patches_.point[std::size_t(p)] = foot.foot;
       gamma_patches_.normal[std::size_t(p)] = foot.normal;
     }
     point_parts_.assign(patch_labels.size(), PointCondition::signorini);
     for (std::size_t p = 0; p < patch_labels.size(); ++p) point_parts_[p] = PointCondition(patch_labels[p]);
     execution_.throw_if_interrupted();
+  } else if (!part_layout_.empty()) {
+    point_parts_.assign(std::size_t(plan_.m), part_layout_[0]);
   }
   Gamma_patches_ = gamma_patches_;
   if (options.variant == Variant::smooth) {

@@ -89,7 +89,7 @@ class BoundaryDiscretization {
   /// without mixed conditions.
   const std::vector<PointCondition>& point_parts() const { return point_parts_; }
   /// Whether `parts` divide γ as the parts the points were placed for (then the setup can be kept).
-  bool same_parts(const PartConditions<dim>& parts) const { return part_layout(parts) == part_layout_; }
+  virtual bool same_parts(const PartConditions<dim>& parts) const { return part_layout(parts) == part_layout_; }
 
  protected:
   /// The part of each of γ's fine pieces (2-D: samples of the curve; 3-D: the triangles) under `parts`;

@@ -62,6 +62,9 @@ class CurveDiscretization final : public BoundaryDiscretization<2> {
   /// (each change bisected to round-off).
   std::vector<std::pair<double, PointCondition>> junctions(const PartConditions<2>& parts,
                                                            const std::vector<PointCondition>& layout) const;
+  /// The samples' parts and the junctions (to 1e-12 in the parameter) as when the points were placed.
+  bool same_parts(const PartConditions<2>& parts) const override;
+  std::vector<std::pair<double, PointCondition>> junctions_;
   void make_trace_rows(const Grid2& grid, const SolverOptions& options, double c);
 
   const Execution& execution_;
