@@ -80,7 +80,7 @@ OffsetRoom curve_offset_room(std::shared_ptr<const Curve> gamma, const Box2& box
 
 std::vector<PointCondition> CurveDiscretization::part_layout(const PartConditions<2>& parts) const {
   if (!parts.mixed()) return {};
-  const int samples = std::max(4096, 16 * collocation_.m);
+  const int samples = std::max(4096, 16 * spacing_.m);
   std::vector<PointCondition> layout(static_cast<std::size_t>(samples));
   for (int k = 0; k < samples; ++k)
     layout[std::size_t(k)] = parts.at(gamma_->position(2 * std::numbers::pi * (k + 0.5) / samples));
@@ -157,7 +157,6 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
   const int m = spacing_.m;
   // Mixed conditions: the arcs end where the parts meet (and at the corners, which the phase would
   // otherwise keep the points away from), so that each point's arc lies in one part.
-  collocation_.m = m;
   part_layout_ = part_layout(parts);
   junctions_ = junctions(parts, part_layout_);
   const std::vector<std::pair<double, PointCondition>>& joins = junctions_;
