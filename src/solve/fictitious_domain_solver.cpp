@@ -270,8 +270,6 @@ void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
     HierarchicalOptions h_options;
     h_options.far_field = b.far_field(interpolated);
     if (h_options.far_field.order == 0) h_options.far_field = default_far_field_3d;  // 2-D: the same rule
-    h_options.far_field.eta = hierarchical_far_field.eta;  // a partition for memory (hierarchical_schur.hpp)
-    h_options.far_field.leaf = hierarchical_far_field.leaf;
     auto h = std::make_unique<HierarchicalSchur>(*st.green, b.B_gamma(), b.C_gamma(), b.loads(), st.execution,
                                                  b.direct(), h_options, inner);
     setup.storage = h->storage();
@@ -553,7 +551,8 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
     if (dense)
       exact = std::make_unique<PreconditionedSchur>(*dense, *setup.exact, polish);
     else
-      exact = std::make_unique<RefinedSchur>(*setup.schur, *setup.exact, far_field_gmres_tolerance);
+      exact = std::make_unique<RefinedSchur>(dynamic_cast<const HierarchicalSchur&>(*setup.schur), *setup.exact,
+                                             far_field_gmres_tolerance);
     NewtonOptions from_there = newton_options;  // solver.max_newton caps both runs together
     from_there.conditions = first.conditions;
     from_there.start = &sol.newton;

@@ -217,10 +217,19 @@ struct DistinctNodes {
   }
 };
 
+/// A piece of the assembly's work: a pair of clusters, interpolated (far) or exact.
 struct Block {
   int x, y;  // row and column clusters
   bool far;
   double cost;
+  int store = -1;         // kept compressed: the kept block whose entries it makes (else written into `out`)
+  bool low_rank = false;  // kept compressed: the whole kept block, recompressed to low rank where that is smaller
+};
+
+/// A block of the compressed storage: a pair of clusters, far (low rank) or near (dense).
+struct Store {
+  int x, y;
+  bool far;
 };
 
 }  // namespace
@@ -305,17 +314,19 @@ void cross_approximation(Eigen::Index rows, Eigen::Index cols, const Row& row, c
 template <int dim>
 struct BlockAssembly {
   BlockAssembly(const GreenTable<dim>& g, const std::vector<const SparseRows*>& r, const SparseRows& q,
-                const Execution& e, const FarField& f)
-      : green(g), row_sets(r), Q(q), execution(e), far_field(f) {}
+                const Execution& e, const FarField& f, const FarField& kept = {})
+      : green(g), row_sets(r), Q(q), execution(e), far_field(f), storage(kept) {}
   const GreenTable<dim>& green;
   const std::vector<const SparseRows*>& row_sets;
   const SparseRows& Q;
   const Execution& execution;
   const FarField& far_field;
+  const FarField storage;  // kept compressed: the storage's partition (eta, leaf)
   RowSide rows{row_sets}, cols{{&Q}};
   bool compress = far_field.order > 0;
   std::unique_ptr<ClusterTree<dim>> X, Y;
   std::vector<Block> blocks;
+  std::vector<Store> stores;  // kept compressed: the storage's blocks
   std::vector<std::unique_ptr<Interpolation<dim>>> x_interp, y_interp;
   std::vector<std::vector<Eigen::MatrixXd>> U;  // per row cluster with far blocks: R L, one per row set
   std::vector<Eigen::MatrixXd> V;               // per column cluster with far blocks: Q L
@@ -336,6 +347,13 @@ struct BlockAssembly {
   void near_block(const Block& b, const std::vector<Index<dim>>& q_nodes, const std::vector<double>& q_values,
                   std::vector<double>& column, std::vector<Eigen::MatrixXd>& out) const;
   void report(FarFieldReport& r) const;
+  /// Where the entry of row set s at tree positions (i, j) of block b goes.
+  double& entry(const Block& b, std::size_t s, int i, int j, std::vector<Eigen::MatrixXd>& out) const {
+    if (b.store < 0) return out[s](X->item[std::size_t(i)], Y->item[std::size_t(j)]);
+    const Store& kept = stores[std::size_t(b.store)];
+    return compressed->blocks[std::size_t(b.store)].dense[s](i - X->clusters[std::size_t(kept.x)].begin,
+                                                             j - Y->clusters[std::size_t(kept.y)].begin);
+  }
   std::vector<int> cluster_items(const ClusterTree<dim>& T, int c) const {
     const auto& cl = T.clusters[std::size_t(c)];
     return std::vector<int>(T.item.begin() + cl.begin, T.item.begin() + cl.end);
@@ -363,7 +381,10 @@ void BlockAssembly<dim>::trees() {
 }
 
 /// The block partition: a pair far apart (max radius ≤ eta·distance) is interpolated when that is
-/// cheaper than exact; otherwise split, down to pairs of leaves computed exactly. Dearest first.
+/// cheaper than exact; otherwise split, down to pairs of leaves computed exactly. Kept compressed, the
+/// storage has its own coarser partition (storage.eta, leaves of storage.leaf rows): each of its
+/// admissible pairs is one far block, kept of low rank; each of its near pairs one dense block whose
+/// entries the same rule makes (so most of them are interpolated, as in the dense assembly). Dearest first.
 template <int dim>
 void BlockAssembly<dim>::partition() {
   const auto interpolation_size = [&](const NodeBox<dim>& b) {
@@ -371,21 +392,46 @@ void BlockAssembly<dim>::partition() {
     for (int d = 0; d < dim && !b.empty(); ++d) s *= std::min(double(far_field.order), double(b.hi[d]) - b.lo[d] + 1);
     return s;
   };
-  const auto split = [&](auto&& self, int x, int y) -> void {
+  const auto admissible = [&](int x, int y, double eta) {
+    const auto &cx = X->clusters[std::size_t(x)], &cy = Y->clusters[std::size_t(y)];
+    return std::max(cx.box.radius(), cy.box.radius()) <= eta * image_distance(cx.box, cy.box, green.grid());
+  };
+  const auto split = [&](auto&& self, int x, int y, int store) -> void {
     const auto &cx = X->clusters[std::size_t(x)], &cy = Y->clusters[std::size_t(y)];
     const double exact = cx.work * cy.work;
     if (compress) {
       const double interpolated = interpolation_size(cx.box) * interpolation_size(cy.box);
-      // Kept compressed, a far pair is worth it whenever it is admissible (its storage, not its cost, decides).
-      if (std::max(cx.box.radius(), cy.box.radius()) <= far_field.eta * image_distance(cx.box, cy.box, green.grid()) &&
-          (compressed || interpolated < exact)) {
-        blocks.push_back({x, y, true, interpolated});
+      if (interpolated < exact && admissible(x, y, far_field.eta)) {
+        blocks.push_back({x, y, true, interpolated, store});
         return;
       }
     }
     if (X->leaf(x) && Y->leaf(y)) {
-      blocks.push_back({x, y, false, exact});
+      blocks.push_back({x, y, false, exact, store});
     } else if (X->leaf(x) || (!Y->leaf(y) && cy.end - cy.begin > cx.end - cx.begin)) {
+      self(self, x, cy.left, store);
+      self(self, x, cy.right, store);
+    } else {
+      self(self, cx.left, y, store);
+      self(self, cx.right, y, store);
+    }
+  };
+  const auto size = [](const auto& c) { return c.end - c.begin; };
+  const auto kept_leaf = [&](const ClusterTree<dim>& T, int c) {
+    return T.leaf(c) || size(T.clusters[std::size_t(c)]) <= storage.leaf;
+  };
+  const auto keep = [&](auto&& self, int x, int y) -> void {
+    const auto &cx = X->clusters[std::size_t(x)], &cy = Y->clusters[std::size_t(y)];
+    // Kept compressed, a far pair is worth it whenever it is admissible (its storage, not its cost, decides).
+    if (admissible(x, y, storage.eta)) {
+      stores.push_back({x, y, true});
+      Block b{x, y, true, interpolation_size(cx.box) * interpolation_size(cy.box), int(stores.size()) - 1};
+      b.low_rank = true;
+      blocks.push_back(b);
+    } else if (kept_leaf(*X, x) && kept_leaf(*Y, y)) {
+      stores.push_back({x, y, false});
+      split(split, x, y, int(stores.size()) - 1);
+    } else if (kept_leaf(*X, x) || (!kept_leaf(*Y, y) && size(cy) > size(cx))) {
       self(self, x, cy.left);
       self(self, x, cy.right);
     } else {
@@ -393,7 +439,10 @@ void BlockAssembly<dim>::partition() {
       self(self, cx.right, y);
     }
   };
-  split(split, 0, 0);
+  if (compressed)
+    keep(keep, 0, 0);
+  else
+    split(split, 0, 0, -1);
   std::sort(blocks.begin(), blocks.end(), [](const Block& a, const Block& b) { return a.cost > b.cost; });
 }
 
@@ -457,7 +506,7 @@ void BlockAssembly<dim>::far_block(const Block& b, Eigen::MatrixXd& core, Eigen:
   const Interpolation<dim>&Lx = *x_interp[std::size_t(b.x)], &Ly = *y_interp[std::size_t(b.y)];
   core.resize(Lx.size(), Ly.size());
   green.G(Lx.nodes, Ly.nodes, core.data(), std::size_t(Lx.size()));
-  CompressedBlocks::Block* kept = compressed ? &compressed->blocks[std::size_t(&b - blocks.data())] : nullptr;
+  CompressedBlocks::Block* kept = b.low_rank ? &compressed->blocks[std::size_t(b.store)] : nullptr;
   if (kept) {  // low rank where that is smaller than the dense block, from the block's rows and columns
     const Eigen::MatrixXd& Vy = V[std::size_t(b.y)];
     const Eigen::Index p = cx.end - cx.begin, q = cy.end - cy.begin, most = p * q / (p + q);
@@ -486,8 +535,7 @@ void BlockAssembly<dim>::far_block(const Block& b, Eigen::MatrixXd& core, Eigen:
       continue;
     }
     for (int j = cy.begin; j < cy.end; ++j)
-      for (int i = cx.begin; i < cx.end; ++i)
-        out[s](X->item[std::size_t(i)], Y->item[std::size_t(j)]) = block(i - cx.begin, j - cy.begin);
+      for (int i = cx.begin; i < cx.end; ++i) entry(b, s, i, j, out) = block(i - cx.begin, j - cy.begin);
   }
 }
 
@@ -500,25 +548,20 @@ void BlockAssembly<dim>::near_block(const Block& b, const std::vector<Index<dim>
   const auto &cx = X->clusters[std::size_t(b.x)], &cy = Y->clusters[std::size_t(b.y)];
   const DistinctNodes<dim>& nodes = *distinct[std::size_t(b.x)];
   column.resize(nodes.nodes.size());
-  CompressedBlocks::Block* kept = compressed ? &compressed->blocks[std::size_t(&b - blocks.data())] : nullptr;
-  if (kept) kept->dense.assign(row_sets.size(), Eigen::MatrixXd(cx.end - cx.begin, cy.end - cy.begin));
   for (int j = cy.begin; j < cy.end; ++j) {
     const int col = Y->item[std::size_t(j)];
     const std::size_t first = Q.row_begin[std::size_t(col)];
     green.G(nodes.nodes.data(), nodes.nodes.size(), q_nodes.data() + first, q_values.data() + first,
             Q.row_begin[std::size_t(col) + 1] - first, column.data());
-    std::size_t entry = 0;
+    std::size_t slot = 0;
     for (std::size_t s = 0; s < row_sets.size(); ++s) {
       const SparseRows& R = *row_sets[s];
       for (int i = cx.begin; i < cx.end; ++i) {
         const int row = X->item[std::size_t(i)];
         double sum = 0.0;
-        for (std::size_t a = R.row_begin[std::size_t(row)]; a < R.row_begin[std::size_t(row) + 1]; ++a, ++entry)
-          sum += R.entries[a].value * column[nodes.slot[entry]];
-        if (kept)
-          kept->dense[s](i - cx.begin, j - cy.begin) = sum;
-        else
-          out[s](row, col) = sum;
+        for (std::size_t a = R.row_begin[std::size_t(row)]; a < R.row_begin[std::size_t(row) + 1]; ++a, ++slot)
+          sum += R.entries[a].value * column[nodes.slot[slot]];
+        entry(b, s, i, j, out) = sum;
       }
     }
   }
@@ -592,25 +635,34 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
 template <int dim>
 CompressedBlocks compressed_green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
                                          const SparseRows& Q, const Execution& execution, const FarField& far_field,
-                                         FarFieldReport* report) {
+                                         const FarField& storage, FarFieldReport* report) {
   for (const SparseRows* R : row_sets)
     if (R->n_rows() != row_sets.front()->n_rows())
       throw std::invalid_argument("compressed_green_blocks: the row sets differ in their number of rows");
-  if (far_field.order <= 0 || !(far_field.eta > 0 && far_field.leaf >= 1))
-    throw std::invalid_argument("compressed_green_blocks: needs a far field (order > 0, eta > 0, leaves of >= 1 row)");
+  if (far_field.order <= 0 || !(far_field.eta > 0 && far_field.leaf >= 1) || !(storage.eta > 0 && storage.leaf >= 1))
+    throw std::invalid_argument(
+        "compressed_green_blocks: needs a far field (order > 0, eta > 0, leaves of >= 1 row) and a storage partition "
+        "(eta > 0, leaves of >= 1 row)");
   CompressedBlocks c;
   c.n_rows = row_sets.front()->n_rows();
   c.n_cols = Q.n_rows();
   c.n_sets = int(row_sets.size());
   if (c.n_rows == 0 || c.n_cols == 0) return c;
-  BlockAssembly<dim> assembly(green, row_sets, Q, execution, far_field);
+  BlockAssembly<dim> assembly(green, row_sets, Q, execution, far_field, storage);
   assembly.compressed = &c;
   assembly.trees();
   assembly.partition();
   assembly.cluster_data();
-  c.blocks.resize(assembly.blocks.size());
-  for (std::size_t k = 0; k < assembly.blocks.size(); ++k)
-    c.blocks[k].x = assembly.blocks[k].x, c.blocks[k].y = assembly.blocks[k].y;
+  c.blocks.resize(assembly.stores.size());
+  for (std::size_t k = 0; k < assembly.stores.size(); ++k) {
+    const Store& kept = assembly.stores[k];
+    c.blocks[k].x = kept.x, c.blocks[k].y = kept.y;
+    if (!kept.far)  // filled in place by the pieces of the block
+      c.blocks[k].dense.assign(row_sets.size(), Eigen::MatrixXd(assembly.X->clusters[std::size_t(kept.x)].end -
+                                                                    assembly.X->clusters[std::size_t(kept.x)].begin,
+                                                                assembly.Y->clusters[std::size_t(kept.y)].end -
+                                                                    assembly.Y->clusters[std::size_t(kept.y)].begin));
+  }
   std::vector<Eigen::MatrixXd> unused;
   assembly.fill(unused);
   if (report) assembly.report(*report);
@@ -713,10 +765,10 @@ Eigen::MatrixXd CompressedBlocks::diagonal_block(int k, int g) const {
 }
 
 template CompressedBlocks compressed_green_blocks(const GreenTable<2>&, const std::vector<const SparseRows*>&,
-                                                  const SparseRows&, const Execution&, const FarField&,
+                                                  const SparseRows&, const Execution&, const FarField&, const FarField&,
                                                   FarFieldReport*);
 template CompressedBlocks compressed_green_blocks(const GreenTable<3>&, const std::vector<const SparseRows*>&,
-                                                  const SparseRows&, const Execution&, const FarField&,
+                                                  const SparseRows&, const Execution&, const FarField&, const FarField&,
                                                   FarFieldReport*);
 
 template Eigen::MatrixXd green_block(const GreenTable<2>&, const SparseRows&, const SparseRows&, const Execution&,

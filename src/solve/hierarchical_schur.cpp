@@ -19,7 +19,7 @@ LinearSolveReport RefinedSchur::solve(const ActiveSet& active, const Eigen::Vect
   LinearSolveReport report;
   const double rn = d.norm();
   Eigen::VectorXd y, r, correction;
-  double previous = INFINITY, unused = 0.0;
+  double previous = INFINITY;
   for (int step = 0;; ++step) {
     exact_.apply_newton(active, nullptr, lambda, y);
     ++report.inner_iterations;
@@ -30,7 +30,7 @@ LinearSolveReport RefinedSchur::solve(const ActiveSet& active, const Eigen::Vect
     if (report.converged || step == max_steps_ || !(report.relative_residual < 0.5 * previous)) break;
     previous = report.relative_residual;
     correction = Eigen::VectorXd::Zero(lambda.size());
-    approximate_.solve(active, r, nullptr, correction, unused);
+    approximate_.solve(active, r, correction, correction_tolerance_);
     lambda += correction;
   }
   alpha = 0.0;
@@ -136,7 +136,8 @@ HierarchicalSchur::HierarchicalSchur(const GreenTable<dim>& green, const SparseR
   if (!(options.far_field.order > 0 && options.group >= 1))
     throw std::invalid_argument("hierarchical Schur complement: needs a far field (order > 0) and groups of >= 1");
   FarFieldReport report;
-  s.blocks = compressed_green_blocks(green, {&B_gamma, &C_gamma}, loads, execution, options.far_field, &report);
+  s.blocks = compressed_green_blocks(green, {&B_gamma, &C_gamma}, loads, execution, options.far_field, options.storage,
+                                     &report);
   execution.throw_if_interrupted();
   s.D_B = direct.trace;
   s.D_C = direct.normal_derivative;
@@ -202,6 +203,12 @@ void HierarchicalSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb
 LinearSolveReport HierarchicalSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
                                            Eigen::VectorXd& lambda, double& alpha) const {
   if (mode) throw std::logic_error("HierarchicalSchur: no bordering (a singular A takes the dense blocks)");
+  alpha = 0.0;
+  return solve(active, d, lambda, impl_->gmres.relative_tolerance);
+}
+
+LinearSolveReport HierarchicalSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, Eigen::VectorXd& lambda,
+                                           double relative_tolerance) const {
   const Impl& s = *impl_;
   s.prepare(active);
   Eigen::VectorXd y, v;
@@ -210,10 +217,10 @@ LinearSolveReport HierarchicalSchur::solve(const ActiveSet& active, const Eigen:
   const double dn = d.norm(), rn = r0.norm();
   LinearSolveReport report;
   report.relative_residual = dn > 0 ? rn / dn : rn;
-  report.converged = report.relative_residual <= s.gmres.relative_tolerance;
+  report.converged = report.relative_residual <= relative_tolerance;
   if (report.converged) return report;
   GmresOptions options = s.gmres;
-  options.relative_tolerance = std::min(0.5, s.gmres.relative_tolerance * dn / rn);
+  options.relative_tolerance = std::min(0.5, relative_tolerance * dn / rn);
   const LinearOperator op = [&](const Eigen::VectorXd& w, Eigen::VectorXd& out) {
     s.precondition(w, v);
     s.apply_newton(active, v, out);
@@ -222,7 +229,6 @@ LinearSolveReport HierarchicalSchur::solve(const ActiveSet& active, const Eigen:
   const GmresReport g = gmres(op, r0, z, options);
   s.precondition(z, v);
   lambda += v;
-  alpha = 0.0;
   report.inner_iterations = g.iterations;
   report.relative_residual = g.relative_residual * rn / (dn > 0 ? dn : 1.0);
   report.converged = g.converged;

@@ -27,9 +27,13 @@ namespace fictus {
 /// (measured on the sphere at m = 804 and 3217: bench/results/2026-11-27-compressed-schur.md).
 inline constexpr FarField hierarchical_far_field{0, 1.0, 16};
 
+/// RefinedSchur's GMRES tolerance for each correction (relative to its residual).
+inline constexpr double refinement_correction_tolerance = 1e-4;
+
 struct HierarchicalOptions {
-  FarField far_field;  // the partition and the interpolation of the far pairs (order > 0)
-  int group = 256;     // points per preconditioner block at most
+  FarField far_field;                         // how the entries are made: the dense assembly's far field (order > 0)
+  FarField storage = hierarchical_far_field;  // the storage's partition (eta, leaf)
+  int group = 256;                            // points per preconditioner block at most
 };
 
 class HierarchicalSchur final : public SchurComplement {
@@ -49,6 +53,9 @@ class HierarchicalSchur final : public SchurComplement {
   /// GMRES to the options' tolerance relative to ‖d‖; no bordering (a singular A takes the dense blocks).
   LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
                           Eigen::VectorXd& lambda, double& alpha) const override;
+  /// The same to another relative tolerance (a refinement's correction needs no more than S̃'s accuracy).
+  LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, Eigen::VectorXd& lambda,
+                          double relative_tolerance) const;
   std::size_t fast_solves() const override { return 0; }
   std::optional<double> condition_number(const ActiveSet&) const override { return std::nullopt; }
   const SchurStorage& storage() const;
@@ -60,13 +67,20 @@ class HierarchicalSchur final : public SchurComplement {
   std::unique_ptr<Impl> impl_;
 };
 
-/// The exact S with an approximate one for the solves: `apply` is the exact S (one fast solve), `solve`
-/// refines x ← x + S̃_𝒜⁻¹(rhs − S_𝒜 x) until ‖rhs − S_𝒜 x‖ ≤ tolerance·‖rhs‖ (S̃_𝒜⁻¹ by the approximate one's
-/// solve). Each step costs one fast solve and gains the factor ‖I − S_𝒜 S̃_𝒜⁻¹‖.
+/// The exact S with the compressed one for the solves: `apply` is the exact S (one fast solve), `solve`
+/// refines x ← x + S̃_𝒜⁻¹(rhs − S_𝒜 x) until ‖rhs − S_𝒜 x‖ ≤ tolerance·‖rhs‖, each S̃_𝒜⁻¹ by GMRES to
+/// `correction_tolerance`. Each step costs one fast solve and gains about the factor
+/// ‖I − S_𝒜 S̃_𝒜⁻¹‖ + correction_tolerance: a correction solved further than S̃'s own accuracy (the far
+/// field's interpolation, 1e-4 … 1e-2) gains nothing.
 class RefinedSchur final : public SchurComplement {
  public:
-  RefinedSchur(const SchurComplement& approximate, const ImplicitSchur& exact, double tolerance, int max_steps = 30)
-      : approximate_(approximate), exact_(exact), tolerance_(tolerance), max_steps_(max_steps) {}
+  RefinedSchur(const HierarchicalSchur& approximate, const ImplicitSchur& exact, double tolerance,
+               double correction_tolerance = refinement_correction_tolerance, int max_steps = 30)
+      : approximate_(approximate),
+        exact_(exact),
+        tolerance_(tolerance),
+        correction_tolerance_(correction_tolerance),
+        max_steps_(max_steps) {}
   int size() const override { return exact_.size(); }
   void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override {
     exact_.apply(lambda, sb, sc);
@@ -79,9 +93,9 @@ class RefinedSchur final : public SchurComplement {
   }
 
  private:
-  const SchurComplement& approximate_;
+  const HierarchicalSchur& approximate_;
   const ImplicitSchur& exact_;
-  double tolerance_;
+  double tolerance_, correction_tolerance_;
   int max_steps_;
 };
 

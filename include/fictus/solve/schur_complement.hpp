@@ -280,10 +280,13 @@ struct CompressedBlocks {
 /// The relative accuracy of the far blocks' recompression (below the interpolation's own error).
 inline constexpr double far_field_recompression = 1e-8;
 
-/// green_blocks, kept compressed (`far_field.order` > 0).
+/// green_blocks, kept compressed: the blocks of `storage`'s partition (pairs of clusters of up to
+/// storage.leaf rows at the bottom; admissible where max radius ≤ storage.eta·distance), its far ones of
+/// low rank. The entries come as in green_blocks with `far_field` (order > 0): the near blocks' mostly
+/// interpolated, in pieces of far_field's partition.
 template <int dim>
 CompressedBlocks compressed_green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
                                          const SparseRows& Q, const Execution& execution, const FarField& far_field,
-                                         FarFieldReport* report = nullptr);
+                                         const FarField& storage, FarFieldReport* report = nullptr);
 
 }  // namespace fictus
