@@ -536,7 +536,11 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
   const NewtonOptions newton_options = detail::newton_options(options, st.execution);
   NewtonOptions first = newton_options;
   const int m = setup.boundary->n_points();
-  if (setup.exact) first.hand_on_at_changes = std::max(1, int(far_field_hand_on * m));
+  // Hand on to the exact S: from the dense S̃ when few points still change (each step there is an LU or
+  // an update of one); from the compressed S̃ only once its active set has settled (its steps cost no
+  // fast solve, the exact S's several).
+  const bool compressed = dynamic_cast<const HierarchicalSchur*>(setup.schur.get()) != nullptr;
+  if (setup.exact) first.hand_on_at_changes = compressed ? 0 : std::max(1, int(far_field_hand_on * m));
   if (!start.empty()) first.start_active = &start;
   if (!sol.conditions.kind.empty()) first.conditions = &sol.conditions;
   const ConstantMode* mode = setup.mode ? &*setup.mode : nullptr;

@@ -13,17 +13,27 @@
 
 namespace fictus {
 
+void RefinedSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const {
+  if (last_lambda_.size() != lambda.size() || last_lambda_ != lambda) {
+    exact_.apply(lambda, last_sb_, last_sc_);
+    last_lambda_ = lambda;
+  }
+  sb = last_sb_;
+  sc = last_sc_;
+}
+
 LinearSolveReport RefinedSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
                                       Eigen::VectorXd& lambda, double& alpha) const {
   if (mode) throw std::logic_error("RefinedSchur: no bordering (a singular A takes the dense blocks)");
   LinearSolveReport report;
   const double rn = d.norm();
-  Eigen::VectorXd y, r, correction;
+  Eigen::VectorXd sb, sc, r(d.size()), correction;
   double previous = INFINITY;
   for (int step = 0;; ++step) {
-    exact_.apply_newton(active, nullptr, lambda, y);
-    ++report.inner_iterations;
-    r = d - y;
+    const std::size_t before = exact_.fast_solves();
+    apply(lambda, sb, sc);
+    report.inner_iterations += int(exact_.fast_solves() - before);
+    for (Eigen::Index i = 0; i < r.size(); ++i) r(i) = d(i) - (active[std::size_t(i)] ? sb(i) : sc(i));
     report.relative_residual = rn > 0 ? r.norm() / rn : r.norm();
     report.converged = report.relative_residual <= tolerance_;
     // Stop when converged, out of steps, or no longer gaining (round-off of the exact S reached).

@@ -5,13 +5,15 @@
 //   storage   the cluster trees and the interpolated far field of the dense assembly, with a partition
 //             for memory: every admissible pair of clusters (radius ≤ eta·distance) is far, kept of low
 //             rank by adaptive cross approximation of its interpolated block (far_field_recompression),
-//             or dense where its rank is too high to save memory; near pairs exact and dense
+//             or dense where its rank is too high to save memory; near pairs dense, their entries made
+//             as the dense assembly makes them (most interpolated, the nearest exact)
 //             (CompressedBlocks, schur_complement.hpp);
 //   solves    GMRES on S̃_𝒜 = rows of S̃_B (𝒜) and S̃_C (the rest), right-preconditioned by the LUs of
 //             S̃_𝒜's diagonal blocks over groups of at most `group` nearby points (block Jacobi; a group's
 //             LU is made again only where 𝒜 changed in it).
 // The solver runs Newton on it and finishes on the exact S (one fast solve per refinement step,
-// RefinedSchur), as with the dense interpolated far field: the answer is that of the exact S.
+// RefinedSchur, its corrections by GMRES to refinement_correction_tolerance), as with the dense
+// interpolated far field: the answer is that of the exact S.
 #include <cstddef>
 #include <memory>
 #include <optional>
@@ -71,7 +73,8 @@ class HierarchicalSchur final : public SchurComplement {
 /// refines x ← x + S̃_𝒜⁻¹(rhs − S_𝒜 x) until ‖rhs − S_𝒜 x‖ ≤ tolerance·‖rhs‖, each S̃_𝒜⁻¹ by GMRES to
 /// `correction_tolerance`. Each step costs one fast solve and gains about the factor
 /// ‖I − S_𝒜 S̃_𝒜⁻¹‖ + correction_tolerance: a correction solved further than S̃'s own accuracy (the far
-/// field's interpolation, 1e-4 … 1e-2) gains nothing.
+/// field's interpolation, 1e-4 … 1e-2) gains nothing. The exact product of the last λ is kept, so
+/// Newton's residual at a solve's answer and the next solve's first residual cost no fast solve.
 class RefinedSchur final : public SchurComplement {
  public:
   RefinedSchur(const HierarchicalSchur& approximate, const ImplicitSchur& exact, double tolerance,
@@ -82,9 +85,7 @@ class RefinedSchur final : public SchurComplement {
         correction_tolerance_(correction_tolerance),
         max_steps_(max_steps) {}
   int size() const override { return exact_.size(); }
-  void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override {
-    exact_.apply(lambda, sb, sc);
-  }
+  void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override;
   LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
                           Eigen::VectorXd& lambda, double& alpha) const override;
   std::size_t fast_solves() const override { return exact_.fast_solves(); }
@@ -97,6 +98,7 @@ class RefinedSchur final : public SchurComplement {
   const ImplicitSchur& exact_;
   double tolerance_, correction_tolerance_;
   int max_steps_;
+  mutable Eigen::VectorXd last_lambda_, last_sb_, last_sc_;  // the last exact product
 };
 
 }  // namespace fictus
