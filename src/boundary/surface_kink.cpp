@@ -633,33 +633,28 @@ std::pair<std::vector<int>, int> connected_parts(const Eigen::SparseMatrix<doubl
 namespace {
 
 /// β_j: how far the readings' area-weighted column sums Σ_i a_i S_ij miss c∫_ω of the field of a unit
-/// layer on patch j (one adjoint solve, and one more for Φ when c ≠ 0).
+/// layer on patch j (one fast solve).
 Eigen::VectorXd missed_fluxes(const SurfaceKink& kink, const SparseRows& C_gamma, const SparseRows& loads,
                               const Eigen::SparseMatrix<double>& D_C, GridVector load_of_omega,
                               const FastSolver<3>& fast, const Eigen::VectorXd& a, int& fast_solves) {
   const int m = int(a.size());
-  // Σ_i a_i S_ij = (B_Γ + R)_j·y + (D_Cᵀa)_j with y = A⁻¹C_γᵀa (one adjoint solve).
-  std::vector<double> share;
-  {
-    GridVector y(fast.grid().n_unknowns(), 0.0);
-    C_gamma.add_transposed(std::vector<double>(a.begin(), a.end()), y);
-    fast.solve_in_place(y);
-    loads.multiply(y, share);
-    ++fast_solves;
-  }
-  const Eigen::VectorXd from_direct = D_C.transpose() * a;
-  // c∫_ω of the field of a unit layer on patch j, I_h w_j = A⁻¹(B_Γ + R)ᵀe_j + I_hψ_j: with
-  // Φ = A⁻¹ℓ (ℓ_k = ∫_ω φ_k), c((B_Γ + R)_j·Φ + Σ_k ψ_j(x_k)ℓ_k).
-  std::vector<double> flux(std::size_t(m), 0.0);
+  // Σ_i a_i S_ij = (B_Γ + R)_j·A⁻¹C_γᵀa + (D_Cᵀa)_j (an adjoint solve), less c∫_ω of the field of a
+  // unit layer on patch j, I_h w_j = A⁻¹(B_Γ + R)ᵀe_j + I_hψ_j: c((B_Γ + R)_j·A⁻¹ℓ + Σ_k ψ_j(x_k)ℓ_k)
+  // with ℓ_k = ∫_ω φ_k. A is symmetric: both solves are one, A⁻¹(C_γᵀa − cℓ).
+  GridVector y(fast.grid().n_unknowns(), 0.0);
+  C_gamma.add_transposed(std::vector<double>(a.begin(), a.end()), y);
+  std::vector<double> band(std::size_t(m), 0.0);
   if (fast.c() != 0.0) {
-    const std::vector<double> band = kink.band_sums(load_of_omega);
-    fast.solve_in_place(load_of_omega);  // now Φ
-    ++fast_solves;
-    loads.multiply(load_of_omega, flux);
-    for (int j = 0; j < m; ++j) flux[std::size_t(j)] = fast.c() * (flux[std::size_t(j)] + band[std::size_t(j)]);
+    band = kink.band_sums(load_of_omega);
+    for (std::size_t k = 0; k < y.size(); ++k) y[k] -= fast.c() * load_of_omega[k];
   }
+  fast.solve_in_place(y);
+  ++fast_solves;
+  std::vector<double> share;
+  loads.multiply(y, share);
+  const Eigen::VectorXd from_direct = D_C.transpose() * a;
   Eigen::VectorXd beta(m);
-  for (int j = 0; j < m; ++j) beta[j] = share[std::size_t(j)] + from_direct[j] - flux[std::size_t(j)];
+  for (int j = 0; j < m; ++j) beta[j] = share[std::size_t(j)] + from_direct[j] - fast.c() * band[std::size_t(j)];
   return beta;
 }
 

@@ -345,6 +345,30 @@ TEST(SurfaceSolver, HierarchicalSchurGivesTheDenseAnswer) {
   }
 }
 
+TEST(SurfaceSolver, EstimatesFollowTheSchurStorage) {
+  // bench/sphere_contact.toml at N = 512, non-smooth (m = 12 868), measured on 2 threads
+  // (bench/results/2026-11-28-compressed-schur-assembly.md): peak 8.16 GiB dense, 5.07 GiB compressed.
+  fictus::SurfaceProblem p = small_problem(0.25, 512);
+  fictus::SolverOptions o;
+  o.variant = fictus::Variant::nonsmooth;
+  o.threads = 2;
+  const double GiB = double(1 << 30);
+  o.schur_storage = fictus::SchurStorageKind::dense;
+  const double dense = double(fictus::estimated_peak_bytes(p, o)) / GiB;
+  const double dense_seconds = fictus::estimated_seconds(p, o);
+  o.schur_storage = fictus::SchurStorageKind::automatic;  // compressed from m = 5000 on in 3-D
+  const double automatic = double(fictus::estimated_peak_bytes(p, o)) / GiB;
+  EXPECT_NEAR(dense, 8.16, 0.15 * 8.16);
+  EXPECT_NEAR(automatic, 5.07, 0.15 * 5.07);
+  EXPECT_LT(fictus::estimated_seconds(p, o), dense_seconds);
+  // A singular A keeps the dense blocks, and so does the estimate.
+  p.boundary = fictus::Boundary::periodic;
+  p.c = 0;
+  const double singular = double(fictus::estimated_peak_bytes(p, o)) / GiB;
+  p.c = 1;
+  EXPECT_GT(singular, double(fictus::estimated_peak_bytes(p, o)) / GiB + 2.0);
+}
+
 TEST(SurfaceSolver, HierarchicalSchurKeepsASingularBoxDense) {
   // The bordering (constants in A's null space) is dense only: a warning, and the dense answer.
   const fictus::SurfaceProblem p = periodic_without_reaction(0.2, 32);

@@ -89,7 +89,7 @@ class SurfaceKink {
 /// neighbouring patches (W_ij = Σ_k (B_Γ)_ik (B_Γ)_jk > 0, their rows' overlap) adds the same
 /// W_ij(φ_i − φ_j)(λ_j − λ_i) to both of their area-weighted readings (nothing when λ_i = λ_j), with
 /// Lφ = (β − μa)/2 for the weighted graph Laplacian L of W on each connected part of γ and μ = Σβ/Σa
-/// there. load_of_omega: ℓ_k = ∫_ω φ_k (unused when c = 0). Two fast solves (one when c = 0);
+/// there. load_of_omega: ℓ_k = ∫_ω φ_k (unused when c = 0). One fast solve;
 /// throws std::invalid_argument for a singular A.
 struct FluxBalance {
   Eigen::SparseMatrix<double> correction;  // X, m × m

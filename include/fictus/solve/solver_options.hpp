@@ -7,11 +7,23 @@ namespace fictus {
 enum class Variant { nonsmooth, smooth, automatic };
 enum class InnerSolver { green, krylov };
 /// How the green solver stores S_B and S_C: dense, hierarchical (hierarchical_schur.hpp), or automatic
-/// (hierarchical from hierarchical_from_points points on, where A is regular).
+/// (hierarchical from hierarchical_from_points(dim) points on, where A is regular).
 enum class SchurStorageKind { automatic, dense, hierarchical };
-/// solver.schur_storage = auto: hierarchical from this many points on, where the dense blocks pass 6 GB
-/// (below it the dense path was the faster in every measured case: bench/results, "compressed Schur").
-inline constexpr int hierarchical_from_points = 20000;
+/// solver.schur_storage = auto: hierarchical from this many points on. 3-D: where the compressed blocks
+/// were the faster on the sphere (bench/results, "compressed Schur"); both paths refine on the exact S
+/// there. 2-D: where the dense blocks pass 6 GB; its dense blocks are exact, so Newton makes no fast
+/// solve and the dense path stays the faster while it fits.
+inline constexpr int hierarchical_from_points_3d = 5000;
+inline constexpr int hierarchical_from_points_2d = 20000;
+inline constexpr int hierarchical_from_points(int dim) {
+  return dim == 2 ? hierarchical_from_points_2d : hierarchical_from_points_3d;
+}
+/// Whether a green solve keeps S_B and S_C compressed: `kind`, auto by m; never with a singular A (a
+/// periodic box with c = 0: the bordering is dense only).
+inline constexpr bool compressed_schur(SchurStorageKind kind, int dim, double m, bool singular) {
+  return !singular && (kind == SchurStorageKind::hierarchical ||
+                       (kind == SchurStorageKind::automatic && m >= hierarchical_from_points(dim)));
+}
 /// How the traces B_γ u and C_γ u are taken (docs/math.md, "Trace matrices"):
 ///   reconstructed  consistent at x_i: smooth variant, the gradient of the biquadratic interpolant
 ///                  (O(h²)); non-smooth variant, the traces of the kink-corrected field;
