@@ -525,7 +525,8 @@ void junction_warning(const BoundaryDiscretization<dim>& boundary, const BasicCo
 }
 
 /// Step 5: semismooth Newton on λ with the Schur blocks; where the far field was interpolated, on S̃
-/// until the active set has nearly settled, then on the exact S preconditioned by S̃ from there.
+/// until the active set has nearly settled (dense S̃) or settled (compressed S̃), then on the exact S,
+/// solved through S̃ (GMRES preconditioned by its LU, or refinement) from there.
 template <int dim>
 void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions& options, const ActiveSet& start,
             BasicSolution<dim>& sol) {
@@ -537,6 +538,8 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
   // fast solve, the exact S's several).
   const bool compressed = dynamic_cast<const HierarchicalSchur*>(setup.schur.get()) != nullptr;
   if (setup.exact) first.hand_on_at_changes = compressed ? 0 : std::max(1, int(far_field_hand_on * m));
+  if (setup.exact && compressed)  // a set that never settles on S̃ leaves the exact S two steps at least
+    first.max_iterations = std::max(1, newton_options.max_iterations - 2);
   if (!start.empty()) first.start_active = &start;
   if (!sol.conditions.kind.empty()) first.conditions = &sol.conditions;
   const ConstantMode* mode = setup.mode ? &*setup.mode : nullptr;
@@ -880,14 +883,14 @@ std::pair<double, double> nodes_and_multipliers(const BasicProblem<dim>& problem
   return {nodes, m};
 }
 
-}  // namespace
-
 /// Whether a green solve of `problem` would keep its Schur blocks compressed.
 template <int dim>
 bool compressed(const BasicProblem<dim>& problem, const SolverOptions& options, double m) {
   return options.inner == InnerSolver::green &&
          compressed_schur(options.schur_storage, dim, m, problem.boundary == Boundary::periodic && problem.c == 0);
 }
+
+}  // namespace
 
 template <int dim>
 std::size_t estimated_peak_bytes(const BasicProblem<dim>& problem, const SolverOptions& options) {
@@ -914,8 +917,8 @@ double estimated_seconds(const BasicProblem<dim>& problem, const SolverOptions& 
   // and the assembly 4e-6 s per pair, three LUs. Threads divide it, up to the cores there are.
   const double threads = std::clamp(double(Execution(options.threads).threads()), 1.0,
                                     double(std::max(1u, std::thread::hardware_concurrency())));
-  // Compressed blocks: the same assembly, and about 12 fast solves of Newton's refinement (5e-8 s per
-  // node·log2(nodes) on 2 threads at 3-D N = 256 … 512) instead of the LUs.
+  // Compressed blocks: the same assembly, and instead of the LUs Newton's refinement (about 12 fast
+  // solves) and GMRES on S̃, in all 5e-8 s per node·log2(nodes) on 2 threads (3-D, N = 256 … 512).
   const double grid = (dim == 2 ? 4.5e-9 : 3e-8) * n_log_n, pairs = (dim == 2 ? 1.15e-6 : 2e-6) * m * m,
                dense = compressed(problem, options, m) ? 5e-8 * n_log_n : (dim == 2 ? 8 : 3) * 0.5e-10 * m * m * m;
   const double seconds =

@@ -420,7 +420,7 @@ void BlockAssembly<dim>::partition() {
   const auto kept_leaf = [&](const ClusterTree<dim>& T, int c) {
     return T.leaf(c) || size(T.clusters[std::size_t(c)]) <= storage.leaf;
   };
-  const auto keep = [&](auto&& self, int x, int y) -> void {
+  const auto store_partition = [&](auto&& self, int x, int y) -> void {
     const auto &cx = X->clusters[std::size_t(x)], &cy = Y->clusters[std::size_t(y)];
     // Kept compressed, a far pair is worth it whenever it is admissible (its storage, not its cost, decides).
     if (admissible(x, y, storage.eta)) {
@@ -440,7 +440,7 @@ void BlockAssembly<dim>::partition() {
     }
   };
   if (compressed)
-    keep(keep, 0, 0);
+    store_partition(store_partition, 0, 0);
   else
     split(split, 0, 0, -1);
   std::sort(blocks.begin(), blocks.end(), [](const Block& a, const Block& b) { return a.cost > b.cost; });

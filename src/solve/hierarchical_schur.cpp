@@ -222,7 +222,10 @@ LinearSolveReport HierarchicalSchur::solve(const ActiveSet& active, const Eigen:
   const Impl& s = *impl_;
   s.prepare(active);
   Eigen::VectorXd y, v;
-  s.apply_newton(active, lambda, y);
+  if (lambda.isZero(0.0))  // a refinement's correction starts from zero: no product needed
+    y = Eigen::VectorXd::Zero(s.m);
+  else
+    s.apply_newton(active, lambda, y);
   const Eigen::VectorXd r0 = d - y;
   const double dn = d.norm(), rn = r0.norm();
   LinearSolveReport report;

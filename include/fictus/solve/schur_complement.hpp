@@ -248,10 +248,11 @@ std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const st
                                           const SparseRows& Q, const Execution& execution = Execution{},
                                           const FarField& far_field = {}, FarFieldReport* report = nullptr);
 
-/// The blocks R_k G Qᵀ kept as the assembly partitions them: near pairs of clusters dense; far pairs
-/// (interpolated: U_x G(P_x, P_y) V_yᵀ) of low rank, A Bᵀ by adaptive cross approximation on that
-/// product's rows and columns to far_field_recompression, or dense where the rank is not low enough to
-/// save memory. No m × m array is made.
+/// The blocks R_k G Qᵀ kept in a partition for memory (compressed_green_blocks): near pairs of clusters
+/// dense (their entries as green_blocks makes them); far pairs (interpolated: U_x G(P_x, P_y) V_yᵀ) of
+/// low rank, A Bᵀ by adaptive cross approximation on that product's rows and columns to
+/// far_field_recompression, or dense where the rank is not low enough to save memory. No m × m array is
+/// made.
 struct CompressedBlocks {
   struct Cluster {
     int begin, end;  // items [begin, end) in tree order
