@@ -635,7 +635,7 @@ namespace {
 /// β_j: how far the readings' area-weighted column sums Σ_i a_i S_ij miss c∫_ω of the field of a unit
 /// layer on patch j (one fast solve).
 Eigen::VectorXd missed_fluxes(const SurfaceKink& kink, const SparseRows& C_gamma, const SparseRows& loads,
-                              const Eigen::SparseMatrix<double>& D_C, GridVector load_of_omega,
+                              const Eigen::SparseMatrix<double>& D_C, const GridVector& load_of_omega,
                               const FastSolver<3>& fast, const Eigen::VectorXd& a, int& fast_solves) {
   const int m = int(a.size());
   // Σ_i a_i S_ij = (B_Γ + R)_j·A⁻¹C_γᵀa + (D_Cᵀa)_j (an adjoint solve), less c∫_ω of the field of a
@@ -718,8 +718,8 @@ Eigen::SparseMatrix<double> balance_correction(const SparseRows& B_Gamma, const 
 }  // namespace
 
 FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, const SparseRows& C_gamma,
-                         const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C, GridVector load_of_omega,
-                         const FastSolver<3>& fast) {
+                         const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C,
+                         const GridVector& load_of_omega, const FastSolver<3>& fast) {
   const int m = B_Gamma.n_rows();
   if (fast.singular()) throw std::invalid_argument("flux_balance: A is singular (a periodic box with c = 0)");
   if (C_gamma.n_rows() != m || loads.n_rows() != m || D_C.rows() != m || D_C.cols() != m ||
@@ -730,8 +730,7 @@ FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, con
   result.area = Eigen::Map<const Eigen::VectorXd>(areas.data(), Eigen::Index(areas.size()));
   const Eigen::VectorXd& a = result.area;
 
-  const Eigen::VectorXd beta =
-      missed_fluxes(kink, C_gamma, loads, D_C, std::move(load_of_omega), fast, a, result.fast_solves);
+  const Eigen::VectorXd beta = missed_fluxes(kink, C_gamma, loads, D_C, load_of_omega, fast, a, result.fast_solves);
   {
     double mean = 0, square = 0;
     for (int j = 0; j < m; ++j) mean += beta[j] / a[j] / m;

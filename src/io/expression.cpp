@@ -2,10 +2,13 @@
 
 #include <muParser.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <deque>
 #include <limits>
+#include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -18,6 +21,7 @@ struct Expression::Shared {
   std::vector<std::string> variables;
   std::vector<std::pair<std::string, double>> constants;
   std::uint64_t id;
+  std::optional<double> constant;  // the value, where the text names no variable and no local
 };
 
 namespace {
@@ -51,12 +55,32 @@ double* make_local(const char* name, void* data) {
 std::unique_ptr<Compiled> compile(const std::string& text, const std::vector<std::string>& variables,
                                   const std::vector<std::pair<std::string, double>>& constants) {
   auto c = std::make_unique<Compiled>();
+  // muParser's own _pi and _e stop at 13 digits (3.141592653589): the full doubles instead.
+  c->parser.DefineConst("_pi", std::numbers::pi);
+  c->parser.DefineConst("_e", std::numbers::e);
   for (const auto& [name, value] : constants) c->parser.DefineConst(name, value);
   c->values.assign(variables.size(), 0.0);
   for (std::size_t k = 0; k < variables.size(); ++k) c->parser.DefineVar(variables[k], &c->values[k]);
   c->parser.SetVarFactory(make_local, c.get());
   c->parser.SetExpr(text);
   return c;
+}
+
+/// This thread's compiled parser of expression `id` (made on first use).
+Compiled& compiled(std::uint64_t id, const std::string& text, const std::vector<std::string>& variables,
+                   const std::vector<std::pair<std::string, double>>& constants) {
+  thread_local std::unordered_map<std::uint64_t, std::unique_ptr<Compiled>> cache;
+  auto& slot = cache[id];
+  if (!slot) slot = compile(text, variables, constants);
+  return *slot;
+}
+
+/// One evaluation at the values set. Locals start as NaN on every evaluation: one read before it is
+/// assigned (on some branch) gives NaN, which the callers' finiteness checks report, never a value left
+/// from an earlier call.
+double evaluate_once(Compiled& c) {
+  std::fill(c.locals.begin(), c.locals.end(), std::numeric_limits<double>::quiet_NaN());
+  return c.parser.Eval();
 }
 
 bool is_name_char(char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; }
@@ -115,6 +139,10 @@ Expression::Expression(std::string text, std::vector<std::string> variables, std
       throw std::invalid_argument(shared->key + ": cannot parse \"" + shown(shared->text) + "\": unknown variable \"" +
                                   unknown + "\"" + hint);
     }
+    bool constant = c->local_names.empty();
+    for (const std::string& name : shared->variables)
+      constant = constant && find_word(shared->text, name) == std::string::npos;
+    if (constant) shared->constant = c->parser.Eval();
   } catch (const mu::Parser::exception_type& e) {
     for (const auto& [name, value] : shared->constants) {  // "a = …" where a is a parameter
       const std::size_t at = find_word(shared->text, name);
@@ -132,15 +160,29 @@ Expression::Expression(std::string text, std::vector<std::string> variables, std
 }
 
 double Expression::operator()(const double* values) const {
-  thread_local std::unordered_map<std::uint64_t, std::unique_ptr<Compiled>> cache;
-  auto& slot = cache[shared_->id];
-  if (!slot) slot = compile(shared_->text, shared_->variables, shared_->constants);
-  for (std::size_t k = 0; k < slot->values.size(); ++k) slot->values[k] = values[k];
-  // Locals start as NaN on every evaluation: one read before it is assigned (on some branch) gives
-  // NaN, which the callers' finiteness checks report, never a value left from an earlier call.
-  std::fill(slot->locals.begin(), slot->locals.end(), std::numeric_limits<double>::quiet_NaN());
+  Compiled& c = compiled(shared_->id, shared_->text, shared_->variables, shared_->constants);
+  std::copy(values, values + c.values.size(), c.values.begin());
   try {
-    return slot->parser.Eval();
+    return evaluate_once(c);
+  } catch (const mu::Parser::exception_type& e) {
+    throw std::invalid_argument(shared_->key + ": cannot evaluate \"" + shared_->text + "\": " + e.GetMsg());
+  }
+}
+
+void Expression::evaluate(std::size_t n, std::initializer_list<const double*> columns, double* out) const {
+  if (columns.size() != shared_->variables.size())
+    throw std::invalid_argument(shared_->key + ": wrong number of columns");
+  if (shared_->constant) {
+    std::fill(out, out + n, *shared_->constant);
+    return;
+  }
+  Compiled& c = compiled(shared_->id, shared_->text, shared_->variables, shared_->constants);
+  const double* const* column = columns.begin();
+  try {
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t k = 0; k < c.values.size(); ++k) c.values[k] = column[k][i];
+      out[i] = evaluate_once(c);
+    }
   } catch (const mu::Parser::exception_type& e) {
     throw std::invalid_argument(shared_->key + ": cannot evaluate \"" + shared_->text + "\": " + e.GetMsg());
   }

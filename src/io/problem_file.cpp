@@ -363,6 +363,17 @@ std::shared_ptr<const Surface> read_surface(TableReader& geometry, const Express
   return std::make_shared<Ellipsoid>(center, Point3{a[0], a[1], a[2]});
 }
 
+/// The batch form of an expression in (x, y) or (x, y, z): one parser lookup per batch.
+template <int dim>
+typename Fields<dim>::Vectorized vectorized(const Expression& e) {
+  if constexpr (dim == 2)
+    return [e](std::size_t n, const double* x, const double* y, double* out) { e.evaluate(n, {x, y}, out); };
+  else
+    return [e](std::size_t n, const double* x, const double* y, const double* z, double* out) {
+      e.evaluate(n, {x, y, z}, out);
+    };
+}
+
 /// [data]: c (through the schema), f, g and the exact solution as expressions in x, y (, z); in 2-D g
 /// may also name phi (the polar angle about γ's center) and s (the arc length along γ).
 template <int dim>
@@ -373,6 +384,7 @@ void read_data(TableReader& data, const ExpressionMaker& expression, DomainSetti
   if constexpr (dim == 2) {
     const Expression f = expression(data.required_string("f"), {"x", "y"}, "data.f");
     p.f = [f](double x, double y) { return f({x, y}); };
+    p.f_vectorized = vectorized<2>(f);
     const Expression g = expression(data.required_string("g"), {"x", "y", "phi", "s"}, "data.g");
     spec.g_about = [g](Point2 center) -> std::function<double(double, double, double)> {
       return [g, center](double x, double y, double s) { return g({x, y, std::atan2(y - center.y, x - center.x), s}); };
@@ -381,15 +393,19 @@ void read_data(TableReader& data, const ExpressionMaker& expression, DomainSetti
     if (data.has("exact")) {
       const Expression exact = expression(data.string("exact", ""), {"x", "y"}, "data.exact");
       p.exact = [exact](double x, double y) { return exact({x, y}); };
+      p.exact_vectorized = vectorized<2>(exact);
     }
   } else {
     const Expression f = expression(data.required_string("f"), {"x", "y", "z"}, "data.f");
     p.f = [f](double x, double y, double z) { return f({x, y, z}); };
+    p.f_vectorized = vectorized<3>(f);
     const Expression g = expression(data.required_string("g"), {"x", "y", "z"}, "data.g");
     p.g = [g](double x, double y, double z) { return g({x, y, z}); };
+    p.g_vectorized = vectorized<3>(g);
     if (data.has("exact")) {
       const Expression exact = expression(data.string("exact", ""), {"x", "y", "z"}, "data.exact");
       p.exact = [exact](double x, double y, double z) { return exact({x, y, z}); };
+      p.exact_vectorized = vectorized<3>(exact);
     }
   }
   data.finish();

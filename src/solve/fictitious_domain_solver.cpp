@@ -340,7 +340,7 @@ namespace {
 /// this grid takes. Its steps are reported as "N/2 <step>"; an interrupt asked there ends this solve too.
 template <int dim>
 std::optional<BasicSolution<dim>> coarse_solve(const State<dim>& st, const BasicContactData<dim>& data,
-                                               const SolverOptions& options, std::string& skipped) {
+                                               const SolverOptions& options, bool field, std::string& skipped) {
   const int N = st.grid.nx();
   if (N % 2 != 0) {
     skipped = "N is odd";
@@ -370,13 +370,19 @@ std::optional<BasicSolution<dim>> coarse_solve(const State<dim>& st, const Basic
   bool stop_asked = false;  // a data callback may turn an interrupt into invalid_argument (Python's Ctrl-C)
   const auto check = [&execution, &stop_asked] { return stop_asked = stop_asked || execution.interrupt_requested(); };
   try {
+    const auto solve_coarse = [&] {  // the field only where the estimate wants it
+      FictitiousDomainSolver<dim> solver(coarse, coarse_options);
+      solver.set_progress(progress);
+      solver.set_interrupt_check(check);
+      return solver.solve(coarse, coarse_options, field, false);
+    };
     std::optional<BasicSolution<dim>> made;
     try {
-      made.emplace(solve(coarse, coarse_options, progress, check));
+      made.emplace(solve_coarse());
     } catch (const std::invalid_argument& e) {  // an offset given for this grid may not fit on that one:
       if (coarse_options.offset == 0 || std::string(e.what()).rfind("formulation.offset", 0) != 0 || stop_asked) throw;
       coarse_options.offset = 0;  // then δ by that grid's own rule
-      made.emplace(solve(coarse, coarse_options, progress, check));
+      made.emplace(solve_coarse());
     }
     BasicSolution<dim>& s = *made;
     if (s.newton.converged) return std::move(s);
@@ -536,7 +542,7 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
   // Hand on to the exact S: from the dense S̃ when few points still change (each step there is an LU or
   // an update of one); from the compressed S̃ only once its active set has settled (its steps cost no
   // fast solve, the exact S's several).
-  const bool compressed = dynamic_cast<const HierarchicalSchur*>(setup.schur.get()) != nullptr;
+  const auto* compressed = dynamic_cast<const HierarchicalSchur*>(setup.schur.get());
   if (setup.exact) first.hand_on_at_changes = compressed ? 0 : std::max(1, int(far_field_hand_on * m));
   if (setup.exact && compressed)  // a set that never settles on S̃ leaves the exact S two steps at least
     first.max_iterations = std::max(1, newton_options.max_iterations - 2);
@@ -545,7 +551,12 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
   const ConstantMode* mode = setup.mode ? &*setup.mode : nullptr;
   const Eigen::VectorXd g = to_eigen(sol.g);
   const std::size_t before = setup.schur->fast_solves(), exact_before = setup.exact ? setup.exact->fast_solves() : 0;
-  sol.newton = solve_semismooth_newton(*setup.schur, setup.b0, setup.c0, g, first, mode);
+  // On the compressed S̃ the first run seeks the active set only: its solves need not go below S̃'s own
+  // accuracy (the exact run refines λ from there).
+  std::optional<SettlingSchur> settling;
+  if (setup.exact && compressed) settling.emplace(*compressed, settling_tolerance);
+  sol.newton = solve_semismooth_newton(settling ? static_cast<const SchurComplement&>(*settling) : *setup.schur,
+                                       setup.b0, setup.c0, g, first, mode);
   if (setup.exact) {
     GmresOptions polish = detail::gmres_options(options, m, st.execution);
     polish.relative_tolerance = far_field_gmres_tolerance;
@@ -554,8 +565,7 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
     if (dense)
       exact = std::make_unique<PreconditionedSchur>(*dense, *setup.exact, polish);
     else
-      exact = std::make_unique<RefinedSchur>(dynamic_cast<const HierarchicalSchur&>(*setup.schur), *setup.exact,
-                                             far_field_gmres_tolerance);
+      exact = std::make_unique<RefinedSchur>(*compressed, *setup.exact, far_field_gmres_tolerance);
     NewtonOptions from_there = newton_options;  // solver.max_newton caps both runs together
     from_there.conditions = first.conditions;
     from_there.start = &sol.newton;
@@ -730,7 +740,7 @@ std::optional<BasicSolution<dim>> coarse_step(const State<dim>& st, const BasicC
   const bool estimate = options.error_estimate && compute_field;
   if (!nested && !estimate) return std::nullopt;
   std::string skipped;
-  std::optional<BasicSolution<dim>> coarse = coarse_solve<dim>(st, data, options, skipped);
+  std::optional<BasicSolution<dim>> coarse = coarse_solve<dim>(st, data, options, estimate, skipped);
   clock.mark(nested ? "nested_start" : "coarse_solve");
   const double seconds = sol.timings.phases.back().second;
   if (nested) {

@@ -25,26 +25,57 @@ void RefinedSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eig
 LinearSolveReport RefinedSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
                                       Eigen::VectorXd& lambda, double& alpha) const {
   if (mode) throw std::logic_error("RefinedSchur: no bordering (a singular A takes the dense blocks)");
-  LinearSolveReport report;
-  const double rn = d.norm();
-  Eigen::VectorXd sb, sc, r(d.size()), correction;
-  double previous = INFINITY;
-  for (int step = 0;; ++step) {
-    const std::size_t before = exact_.fast_solves();
-    apply(lambda, sb, sc);
-    report.inner_iterations += int(exact_.fast_solves() - before);
-    for (Eigen::Index i = 0; i < r.size(); ++i) r(i) = d(i) - (active[std::size_t(i)] ? sb(i) : sc(i));
-    report.relative_residual = rn > 0 ? r.norm() / rn : r.norm();
-    report.converged = report.relative_residual <= tolerance_;
-    // Stop when converged, out of steps, or no longer gaining (round-off of the exact S reached).
-    if (report.converged || step == max_steps_ || !(report.relative_residual < 0.5 * previous)) break;
-    previous = report.relative_residual;
-    correction = Eigen::VectorXd::Zero(lambda.size());
-    approximate_.solve(active, r, correction, correction_tolerance_);
-    lambda += correction;
-  }
   alpha = 0.0;
+  LinearSolveReport report;
+  const Eigen::Index m = d.size();
+  const auto rows = [&](const Eigen::VectorXd& sb, const Eigen::VectorXd& sc, Eigen::VectorXd& out) {
+    out.resize(m);
+    for (Eigen::Index i = 0; i < m; ++i) out(i) = active[std::size_t(i)] ? sb(i) : sc(i);
+  };
+  const std::size_t before = exact_.fast_solves();
+  Eigen::VectorXd sb0, sc0, r;
+  apply(lambda, sb0, sc0);  // no fast solve where Newton's residual made this product
+  rows(sb0, sc0, r);
+  r = d - r;
+  const double rn = d.norm(), scale = rn > 0 ? rn : 1.0;
+  report.relative_residual = r.norm() / scale;
+  report.converged = report.relative_residual <= tolerance_;
+  if (!report.converged) {
+    // Flexible GMRES on S_𝒜 from λ, each direction S̃_𝒜⁻¹v by GMRES to correction_tolerance; the
+    // directions and their exact products are kept, so λ's product needs no fast solve at the end.
+    std::vector<Eigen::VectorXd> z, z_sb, z_sc;
+    const LinearOperator precondition = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+      out = Eigen::VectorXd::Zero(m);
+      approximate_.solve(active, v, out, correction_tolerance_);
+      z.push_back(out);
+    };
+    const LinearOperator exact = [&](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
+      Eigen::VectorXd sb, sc;
+      exact_.apply(x, sb, sc);
+      rows(sb, sc, out);
+      z_sb.push_back(std::move(sb));
+      z_sc.push_back(std::move(sc));
+    };
+    const FlexibleGmresReport g = flexible_gmres(exact, precondition, r, max_steps_, tolerance_ * rn / r.norm());
+    for (Eigen::Index k = 0; k < g.coefficients.size(); ++k) {
+      const double y = g.coefficients(k);
+      lambda += y * z[std::size_t(k)];
+      sb0 += y * z_sb[std::size_t(k)];
+      sc0 += y * z_sc[std::size_t(k)];
+    }
+    last_lambda_ = lambda, last_sb_ = std::move(sb0), last_sc_ = std::move(sc0);
+    report.relative_residual = g.relative_residual * r.norm() / scale;
+    report.converged = report.relative_residual <= tolerance_;
+  }
+  report.inner_iterations = int(exact_.fast_solves() - before);
   return report;
+}
+
+LinearSolveReport SettlingSchur::solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
+                                       Eigen::VectorXd& lambda, double& alpha) const {
+  if (mode) throw std::logic_error("SettlingSchur: no bordering (a singular A takes the dense blocks)");
+  alpha = 0.0;
+  return approximate_.solve(active, d, lambda, tolerance_);
 }
 
 namespace {

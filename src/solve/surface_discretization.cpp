@@ -192,9 +192,9 @@ std::size_t SurfaceDiscretization::finish_setup(const FastSolver<3>& fast, const
   // The flux balance (flux_balance in surface_kink.hpp): X joins D_C.
   if (!kink_ || !balance_wanted_ || fast.singular()) return 0;
   constexpr int load_points = 3;  // per Gauss line of the cut-voxel rule, as the error integrals'
-  GridVector load_of_omega = c_ != 0.0 ? omega_load(grid_, *gamma_, load_points, execution_) : GridVector();
-  FluxBalance b = fictus::flux_balance(kink_->model, B_Gamma_, C_gamma_, loads_, direct_.normal_derivative,
-                                       std::move(load_of_omega), fast);
+  load_of_omega_ = c_ != 0.0 ? omega_load(grid_, *gamma_, load_points, execution_) : GridVector();
+  FluxBalance b =
+      fictus::flux_balance(kink_->model, B_Gamma_, C_gamma_, loads_, direct_.normal_derivative, load_of_omega_, fast);
   direct_.normal_derivative += b.correction;
   kink_->balance = std::move(b.correction);
   kink_->area = std::move(b.area);
@@ -212,7 +212,9 @@ double SurfaceDiscretization::reading_shift(const GridVector& u0, const Vectoriz
   constexpr int load_points = 3;  // as finish_setup's ℓ
   double u0_integral = 0;         // ∫_ω u₀
   if (c_ != 0.0) {
-    const GridVector load_of_omega = omega_load(grid_, *gamma_, load_points, execution_);
+    const GridVector load_of_omega =
+        load_of_omega_.empty() ? omega_load(grid_, *gamma_, load_points, execution_) : std::move(load_of_omega_);
+    load_of_omega_ = GridVector();
     for (std::size_t k = 0; k < load_of_omega.size(); ++k) u0_integral += load_of_omega[k] * u0[k];
   }
   std::vector<double> c_u0;

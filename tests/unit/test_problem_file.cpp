@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <string>
+#include <vector>
 
 #include "fictus/io/expression.hpp"
 #include "fictus/io/problem_file.hpp"
@@ -15,6 +17,27 @@ TEST(Expression, LocalNamesHoldIntermediateValues) {
   const fictus::Expression e("r2 = (x - 0.5)^2 + y^2, s = sqrt(r2), s * r2 + 1", {"x", "y"}, "data.f");
   EXPECT_NEAR(e({0.5 + 0.3, 0.4}), std::pow(0.25, 1.5) + 1, 1e-15);
   EXPECT_NEAR(e({1.5, 0.0}), 2.0, 1e-15);
+}
+
+TEST(Expression, BatchesEqualPointwiseValues) {
+  const std::vector<double> x{0.1, 0.7, -2.0, 0.5}, y{0.3, 0.0, 1.5, 0.5}, z{1.0, 2.0, 3.0, 4.0};
+  std::vector<double> out(x.size(), -1.0);
+  // With locals, a branch, a parameter; and a local read before its assignment on one branch (NaN, as
+  // pointwise: no value carried over from the point before).
+  const fictus::Expression e("r2 = (x - 0.5)^2 + y^2, r2 < 1 ? exp(-r2) * k : y", {"x", "y"}, "data.f", {{"k", 3.0}});
+  e.evaluate(x.size(), {x.data(), y.data()}, out.data());
+  for (std::size_t i = 0; i < x.size(); ++i) EXPECT_EQ(out[i], e({x[i], y[i]})) << i;
+  const fictus::Expression late("a = x > 0 ? x : a + 1, a", {"x"}, "data.f");
+  late.evaluate(x.size(), {x.data()}, out.data());
+  EXPECT_EQ(out[1], 0.7);
+  EXPECT_TRUE(std::isnan(out[2]));
+  // Naming no variable: one value for every point, k and _pi (to the last digit) included.
+  const fictus::Expression constant("-2 * k + _pi + max(1, 2)", {"x", "y", "z"}, "data.f", {{"k", 0.5}});
+  constant.evaluate(3, {x.data(), y.data(), z.data()}, out.data());
+  for (int i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(out[std::size_t(i)], 1 + std::acos(-1.0));
+  EXPECT_EQ(out[3], 0.5);  // beyond n: untouched
+  EXPECT_THROW(constant.evaluate(1, {x.data()}, out.data()), std::invalid_argument);
+  EXPECT_EQ(fictus::Expression("_e", {"x"}, "data.f")({0.0}), std::numbers::e);
 }
 
 TEST(Expression, UnknownOrUnassignedNamesAreErrors) {

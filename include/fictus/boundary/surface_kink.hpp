@@ -99,7 +99,7 @@ struct FluxBalance {
   int fast_solves = 0;
 };
 FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, const SparseRows& C_gamma,
-                         const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C, GridVector load_of_omega,
-                         const FastSolver<3>& fast);
+                         const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C,
+                         const GridVector& load_of_omega, const FastSolver<3>& fast);
 
 }  // namespace fictus

@@ -24,6 +24,10 @@ class Expression {
   /// Value for the variables in the order given at construction.
   double operator()(std::initializer_list<double> values) const;
   double operator()(const double* values) const;
+  /// Values at n points: columns[k][i] is variable k at point i (one array per variable, in the order
+  /// given at construction). One parser lookup for all of them; an expression that names none of its
+  /// variables is evaluated once.
+  void evaluate(std::size_t n, std::initializer_list<const double*> columns, double* out) const;
 
   const std::string& text() const;
   /// Whether the text names `name` as a whole word (a variable, constant or local of that name).

@@ -30,4 +30,16 @@ using LinearOperator = std::function<void(const Eigen::VectorXd& x, Eigen::Vecto
 GmresReport gmres(const LinearOperator& apply, const Eigen::VectorXd& b, Eigen::VectorXd& x,
                   const GmresOptions& options);
 
+struct FlexibleGmresReport : GmresReport {
+  Eigen::VectorXd coefficients;  // y: x = Σ_k y_k z_k
+};
+
+/// One cycle of flexible GMRES for A x = b from x = 0, at most `steps` steps, while each step gains a
+/// factor 2: the k-th search direction z_k = precondition(v_k) may change from step to step (an inner
+/// iterative solve), and `apply` is called on z_0, z_1, … in order, once each. Returns the
+/// coefficients y of x = Σ_k y_k z_k; a caller that keeps z_k and A z_k has x and A x without another
+/// product. `iterations` counts the products.
+FlexibleGmresReport flexible_gmres(const LinearOperator& apply, const LinearOperator& precondition,
+                                   const Eigen::VectorXd& b, int steps, double relative_tolerance);
+
 }  // namespace fictus

@@ -93,6 +93,9 @@ class SurfaceDiscretization final : public BoundaryDiscretization<3> {
   DirectTerms direct_;
   struct Kink;
   std::unique_ptr<Kink> kink_;  // the kink correction and the flux balance (non-smooth, reconstructed)
+  // ℓ_k = ∫_ω φ_k (c ≠ 0), made by finish_setup and kept for the first reading_shift only (one grid
+  // array; a later load makes it again).
+  mutable GridVector load_of_omega_;
 };
 
 }  // namespace fictus
