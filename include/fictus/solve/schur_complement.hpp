@@ -278,8 +278,10 @@ struct CompressedBlocks {
   Eigen::MatrixXd diagonal_block(int k, int g) const;
 };
 
-/// The relative accuracy of the far blocks' recompression (below the interpolation's own error).
-inline constexpr double far_field_recompression = 1e-8;
+/// The relative accuracy of the far blocks' recompression: two orders below the interpolation's own
+/// error (1e-3 … 1e-4), so S̃ steers Newton as well as with 1e-8 (the same steps and fast solves on the
+/// sphere at N = 384 and 512), in 45 % less memory (bench/results/2026-11-28-newton-and-grid-phases.md).
+inline constexpr double far_field_recompression = 1e-5;
 
 /// green_blocks, kept compressed: the blocks of `storage`'s partition (pairs of clusters of up to
 /// storage.leaf rows at the bottom; admissible where max radius ≤ storage.eta·distance), its far ones of
