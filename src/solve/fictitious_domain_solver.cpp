@@ -906,10 +906,10 @@ template <int dim>
 std::size_t estimated_peak_bytes(const BasicProblem<dim>& problem, const SolverOptions& options) {
   const auto [nodes, m] = nodes_and_multipliers(problem, options);
   // Dense: S_B, S_C and the LU's copy (2-D: and the condition number's). Compressed: S_B and S_C as
-  // measured on the sphere (16m²·0.71 at m = 3217, ·0.29 at m = 12 868: 1900·m^1.37 bytes) and the
-  // preconditioner's blocks of 256 points (three matrices).
+  // measured on the sphere (16m²·0.44 at m = 3217, ·0.25 at m = 7238, ·0.16 at m = 12 868:
+  // 2600·m^1.27 bytes) and the preconditioner's blocks of 256 points (three matrices).
   const double schur = compressed(problem, options, m)
-                           ? std::min(16 * m * m, 1900 * std::pow(m, 1.37)) + 3 * 8 * 256 * m
+                           ? std::min(16 * m * m, 2600 * std::pow(m, 1.27)) + 3 * 8 * 256 * m
                            : (dim == 2 ? 4 : 3) * 8 * m * m;
   const double bytes = (dim == 2 ? 3 : 4) * 8 * nodes + schur + 32.0 * (1 << 20);
   return bytes > 1.8e19 ? std::size_t(1.8e19) : std::size_t(bytes);
@@ -927,10 +927,10 @@ double estimated_seconds(const BasicProblem<dim>& problem, const SolverOptions& 
   // and the assembly 4e-6 s per pair, three LUs. Threads divide it, up to the cores there are.
   const double threads = std::clamp(double(Execution(options.threads).threads()), 1.0,
                                     double(std::max(1u, std::thread::hardware_concurrency())));
-  // Compressed blocks: the same assembly, and instead of the LUs Newton's refinement (about 12 fast
-  // solves) and GMRES on S̃, in all 5e-8 s per node·log2(nodes) on 2 threads (3-D, N = 256 … 512).
+  // Compressed blocks: the same assembly, and instead of the LUs Newton's exact solves (about 9 fast
+  // solves) and GMRES on S̃, in all 3e-8 s per node·log2(nodes) on 2 threads (3-D, N = 256 … 512).
   const double grid = (dim == 2 ? 4.5e-9 : 3e-8) * n_log_n, pairs = (dim == 2 ? 1.15e-6 : 2e-6) * m * m,
-               dense = compressed(problem, options, m) ? 5e-8 * n_log_n : (dim == 2 ? 8 : 3) * 0.5e-10 * m * m * m;
+               dense = compressed(problem, options, m) ? 3e-8 * n_log_n : (dim == 2 ? 8 : 3) * 0.5e-10 * m * m * m;
   const double seconds =
       options.inner == InnerSolver::green ? grid + pairs + dense : grid + 2.5 * m * 2.5 * 2.3e-10 * n_log_n;
   return seconds * 2 / threads;
