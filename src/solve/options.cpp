@@ -251,7 +251,7 @@ void data_and_solver_specs(std::vector<OptionSpec>& specs) {
                           to_string(SchurStorageKind::hierarchical)},
                          {SchurStorageKind::automatic, SchurStorageKind::dense, SchurStorageKind::hierarchical},
                          "green: S_B and S_C dense (LU), or hierarchical (far pairs of low rank, no m × m "
-                         "array; GMRES with block LUs, then refined on the exact S); auto: hierarchical from m = " +
+                         "array; GMRES with block LUs, then flexible GMRES on the exact S); auto: hierarchical from m = " +
                              std::to_string(hierarchical_from_points_3d) + " on in 3-D, " +
                              std::to_string(hierarchical_from_points_2d) + " in 2-D"));
   {
