@@ -119,6 +119,7 @@ BasicProblem<dim> member(const Family& family, const BasicProblemSpec<dim>& base
                          const std::string& text, const OptionFlags& flags, double v) {
   BasicProblem<dim> problem = base.problem;
   if (family.kind == "g_scale") {
+    problem.g_vectorized = nullptr;  // the batch form of the file's g would be used instead of the scaled g
     if constexpr (dim == 2) {
       if (problem.g) problem.g = [g = base.problem.g, v](double x, double y) { return v * g(x, y); };
       if (problem.g_along_curve)
@@ -144,7 +145,8 @@ BasicProblem<dim> member(const Family& family, const BasicProblemSpec<dim>& base
     if (!family.moves_curve) keep = base.problem.gamma;
     problem = problem_from_text<dim>(text, args.problem_path, flags, {{family.name, v}}, keep).problem;
   }
-  if (family.kind != "parameter") problem.exact = nullptr;  // the exact solution is the base problem's
+  if (family.kind != "parameter")  // the exact solution is the base problem's
+    problem.exact = nullptr, problem.exact_vectorized = nullptr;
   return problem;
 }
 

@@ -246,14 +246,15 @@ void data_and_solver_specs(std::vector<OptionSpec>& specs) {
       choice(std::string("solver"), std::string("schur"), &SolverOptions::inner,
              {to_string(InnerSolver::green), to_string(InnerSolver::krylov)}, {InnerSolver::green, InnerSolver::krylov},
              "green: explicit Schur complement, dense LU; krylov: GMRES on the implicit one (the paper's)"));
-  specs.push_back(choice(std::string("solver"), std::string("schur_storage"), &SolverOptions::schur_storage,
-                         {to_string(SchurStorageKind::automatic), to_string(SchurStorageKind::dense),
-                          to_string(SchurStorageKind::hierarchical)},
-                         {SchurStorageKind::automatic, SchurStorageKind::dense, SchurStorageKind::hierarchical},
-                         "green: S_B and S_C dense (LU), or hierarchical (far pairs of low rank, no m × m "
-                         "array; GMRES with block LUs, then flexible GMRES on the exact S); auto: hierarchical from m = " +
-                             std::to_string(hierarchical_from_points_3d) + " on in 3-D, " +
-                             std::to_string(hierarchical_from_points_2d) + " in 2-D"));
+  specs.push_back(
+      choice(std::string("solver"), std::string("schur_storage"), &SolverOptions::schur_storage,
+             {to_string(SchurStorageKind::automatic), to_string(SchurStorageKind::dense),
+              to_string(SchurStorageKind::hierarchical)},
+             {SchurStorageKind::automatic, SchurStorageKind::dense, SchurStorageKind::hierarchical},
+             "green: S_B and S_C dense (LU), or hierarchical (far pairs of low rank, no m × m "
+             "array; GMRES with block LUs, then flexible GMRES on the exact S); auto: hierarchical from m = " +
+                 std::to_string(hierarchical_from_points_3d) + " on in 3-D, " +
+                 std::to_string(hierarchical_from_points_2d) + " in 2-D"));
   {
     OptionSpec s = number("solver", "krylov_tolerance", &SolverOptions::krylov_tolerance, 0.0, true, 1.0, true,
                           "relative GMRES residual");
