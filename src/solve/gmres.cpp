@@ -11,57 +11,62 @@ namespace {
 /// One GMRES cycle from the residual r (β = ‖r‖ > 0): the Arnoldi basis V by modified Gram–Schmidt
 /// (twice, for stability) with Givens rotations, at most `steps` steps, stopping at ‖residual‖ ≤ target.
 /// `step(k, v, w)` makes w = A·(the k-th search direction from v = V_k). Returns the coefficients y of
-/// the search directions; `residual` is the cycle's last residual norm, `steps_made` the steps.
+/// the search directions; `residual` is the cycle's last residual norm. V and the Hessenberg columns
+/// grow with the steps made (a restart of m + 1 must not allocate (m + 1)² entries up front).
 class Cycle {
  public:
-  Cycle(Eigen::Index n, int steps)
-      : V(n, steps + 1), H(Eigen::MatrixXd::Zero(steps + 1, steps)), cs(steps), sn(steps) {}
-
   template <class Step, class Keep>
   Eigen::VectorXd run(const Eigen::VectorXd& r, double beta, int steps, double target, Step&& step, Keep&& keep_going,
                       double& residual) {
-    V.col(0) = r / beta;
-    Eigen::VectorXd e = Eigen::VectorXd::Zero(steps + 1), w;
-    e(0) = beta;
-    H.setZero();
+    V.assign(1, r / beta);
+    std::vector<Eigen::VectorXd> H;  // column k of the Hessenberg matrix: k + 2 entries
+    std::vector<double> cs, sn, e{beta};
+    Eigen::VectorXd w;
     residual = beta;
     int k = 0;
     for (; k < steps && keep_going(); ++k) {
-      step(k, V.col(k), w);
+      step(k, V[std::size_t(k)], w);
+      Eigen::VectorXd h = Eigen::VectorXd::Zero(k + 2);
       for (int pass = 0; pass < 2; ++pass)
         for (int j = 0; j <= k; ++j) {
-          const double hjk = V.col(j).dot(w);
-          H(j, k) += hjk;
-          w -= hjk * V.col(j);
+          const double hjk = V[std::size_t(j)].dot(w);
+          h(j) += hjk;
+          w -= hjk * V[std::size_t(j)];
         }
-      H(k + 1, k) = w.norm();
-      if (H(k + 1, k) > 0) V.col(k + 1) = w / H(k + 1, k);
+      h(k + 1) = w.norm();
+      V.push_back(h(k + 1) > 0 ? Eigen::VectorXd(w / h(k + 1)) : w);
       for (int j = 0; j < k; ++j) {  // previous rotations
-        const double t = cs(j) * H(j, k) + sn(j) * H(j + 1, k);
-        H(j + 1, k) = -sn(j) * H(j, k) + cs(j) * H(j + 1, k);
-        H(j, k) = t;
+        const double t = cs[std::size_t(j)] * h(j) + sn[std::size_t(j)] * h(j + 1);
+        h(j + 1) = -sn[std::size_t(j)] * h(j) + cs[std::size_t(j)] * h(j + 1);
+        h(j) = t;
       }
-      const double denom = std::hypot(H(k, k), H(k + 1, k));
-      cs(k) = H(k, k) / denom;
-      sn(k) = H(k + 1, k) / denom;
-      H(k, k) = denom;
-      H(k + 1, k) = 0.0;
-      e(k + 1) = -sn(k) * e(k);
-      e(k) = cs(k) * e(k);
-      residual = std::abs(e(k + 1));
-      if (residual <= target || H(k, k) == 0.0) {
+      const double denom = std::hypot(h(k), h(k + 1));
+      cs.push_back(h(k) / denom);
+      sn.push_back(h(k + 1) / denom);
+      h(k) = denom;
+      h(k + 1) = 0.0;
+      e.push_back(-sn.back() * e[std::size_t(k)]);
+      e[std::size_t(k)] *= cs.back();
+      residual = std::abs(e.back());
+      H.push_back(std::move(h));
+      if (residual <= target || H.back()(k) == 0.0) {
         ++k;
         break;
       }
     }
     // H_k y = e_k (upper triangular)
-    return H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(e.head(k));
+    Eigen::MatrixXd R = Eigen::MatrixXd::Zero(k, k);
+    for (int j = 0; j < k; ++j) R.col(j).head(j + 1) = H[std::size_t(j)].head(j + 1);
+    return R.triangularView<Eigen::Upper>().solve(Eigen::Map<const Eigen::VectorXd>(e.data(), k));
   }
 
-  Eigen::MatrixXd V, H;
+  /// x += Σ_k y_k V_k
+  void add(const Eigen::VectorXd& y, Eigen::VectorXd& x) const {
+    for (Eigen::Index j = 0; j < y.size(); ++j) x += y(j) * V[std::size_t(j)];
+  }
 
  private:
-  Eigen::VectorXd cs, sn;
+  std::vector<Eigen::VectorXd> V;
 };
 
 }  // namespace
@@ -77,7 +82,7 @@ GmresReport gmres(const LinearOperator& apply, const Eigen::VectorXd& b, Eigen::
     return report;
   }
   const int restart = std::max(1, std::min<int>(options.restart, int(n)));
-  Cycle cycle(n, restart);
+  Cycle cycle;
   Eigen::VectorXd r(n), w(n);
   double previous_cycle = std::numeric_limits<double>::infinity();
   // One application of the cap is kept for the true residual of the final iterate.
@@ -105,7 +110,7 @@ GmresReport gmres(const LinearOperator& apply, const Eigen::VectorXd& b, Eigen::
           ++report.iterations;
         },
         keep_going, residual);
-    x += cycle.V.leftCols(y.size()) * y;
+    cycle.add(y, x);
   }
   apply(x, w);  // true residual of the final iterate
   ++report.iterations;
@@ -121,7 +126,7 @@ FlexibleGmresReport flexible_gmres(const LinearOperator& apply, const LinearOper
   report.converged = b_norm == 0.0;
   if (report.converged) return report;
   steps = std::max(1, std::min<int>(steps, int(b.size())));
-  Cycle cycle(b.size(), steps);
+  Cycle cycle;
   Eigen::VectorXd z;
   double residual = 0, previous = b_norm;
   bool gaining = true;
