@@ -10,7 +10,7 @@ namespace {
 
 /// One GMRES cycle from the residual r (β = ‖r‖ > 0): the Arnoldi basis V by modified Gram–Schmidt
 /// (twice, for stability) with Givens rotations, at most `steps` steps, stopping at ‖residual‖ ≤ target.
-/// `step(k, v, w)` makes w = A·(the k-th search direction from v = V_k). Returns the coefficients y of
+/// `step(v, w)` makes w = A·(the next search direction from v = V_k). Returns the coefficients y of
 /// the search directions; `residual` is the cycle's last residual norm. V and the Hessenberg columns
 /// grow with the steps made (a restart of m + 1 must not allocate (m + 1)² entries up front).
 class Cycle {
@@ -25,7 +25,7 @@ class Cycle {
     residual = beta;
     int k = 0;
     for (; k < steps && keep_going(); ++k) {
-      step(k, V[std::size_t(k)], w);
+      step(V[std::size_t(k)], w);
       Eigen::VectorXd h = Eigen::VectorXd::Zero(k + 2);
       for (int pass = 0; pass < 2; ++pass)
         for (int j = 0; j <= k; ++j) {
@@ -104,7 +104,7 @@ GmresReport gmres(const LinearOperator& apply, const Eigen::VectorXd& b, Eigen::
     double residual = 0;
     const Eigen::VectorXd y = cycle.run(
         r, beta, restart, options.relative_tolerance * b_norm,
-        [&](int, const auto& v, Eigen::VectorXd& out) {
+        [&](const auto& v, Eigen::VectorXd& out) {
           if (options.between_iterations) options.between_iterations();
           apply(v, out);
           ++report.iterations;
@@ -129,17 +129,16 @@ FlexibleGmresReport flexible_gmres(const LinearOperator& apply, const LinearOper
   Cycle cycle;
   Eigen::VectorXd z;
   double residual = 0, previous = b_norm;
-  bool gaining = true;
   report.coefficients = cycle.run(
       b, b_norm, steps, relative_tolerance * b_norm,
-      [&](int, const auto& v, Eigen::VectorXd& out) {
+      [&](const auto& v, Eigen::VectorXd& out) {
         precondition(v, z);
         apply(z, out);
         ++report.iterations;
       },
       [&] {  // after the first step: on while each step gains a factor 2 (round-off ends it)
-        gaining = report.iterations == 0 || residual < 0.5 * previous;
-        previous = report.iterations == 0 ? b_norm : residual;
+        const bool gaining = report.iterations == 0 || residual < 0.5 * previous;
+        previous = residual;
         return gaining;
       },
       residual);
