@@ -1,5 +1,7 @@
 #include "fictus/grid/dst_solver.hpp"
 
+#include <algorithm>
+#include <array>
 #include <stdexcept>
 
 #include "fftw_plan.hpp"
@@ -11,6 +13,32 @@ std::unique_ptr<FastSolver<dim>> make_fast_solver(const Grid<dim>& grid, double 
   if (grid.periodic()) return std::make_unique<PeriodicSolver<dim>>(grid, c, execution);
   return std::make_unique<DstSolver<dim>>(grid, c, execution);
 }
+
+template <int dim>
+Footprint footprint(const Grid<dim>& grid, std::initializer_list<const SparseRows*> rows) {
+  const std::size_t slowest = std::size_t(grid.periodic() ? grid.n(dim - 1) : grid.n(dim - 1) - 1);
+  const std::size_t columns = grid.n_unknowns() / slowest;
+  Footprint f;
+  f.columns.assign(columns, 0);
+  for (const SparseRows* R : rows)
+    for (const SparseRows::Entry& e : R->entries) f.columns[e.index % columns] = 1;
+  return f;
+}
+
+namespace {
+/// Adjacent lines along a slow axis transformed together: two cache lines per step along the axis.
+constexpr int chunk = 16;
+/// Rows along the fastest axis per task.
+constexpr int rows_per_task = 64;
+}  // namespace
+
+/// Plans for the lines of the grid: per axis a ≥ 1, `chunk` adjacent lines and the last, narrower chunk
+/// of each row; along axis 0, `rows_per_task` rows and the rest.
+template <int dim>
+struct DstSolver<dim>::Lines {
+  std::array<std::unique_ptr<detail::R2rLines>, dim> wide, narrow;
+  std::unique_ptr<detail::R2rLines> rows, last_rows;
+};
 
 template <int dim>
 DstSolver<dim>::DstSolver(const Grid<dim>& grid, double c, const Execution& execution)
@@ -56,6 +84,84 @@ void DstSolver<dim>::solve_in_place(GridVector& r) const {
 }
 
 template <int dim>
+std::vector<char> DstSolver<dim>::chunk_mask(const Footprint& f, int a) const {
+  const int L0 = grid_.n(0) - 1, chunks = (L0 + chunk - 1) / chunk;
+  std::size_t inner = 1;  // the coordinates of axes 1 … a−1
+  for (int d = 1; d < a; ++d) inner *= std::size_t(grid_.n(d) - 1);
+  std::vector<char> mask(inner * std::size_t(chunks), 0);
+  for (std::size_t col = 0; col < f.columns.size(); ++col)
+    if (f.columns[col]) {
+      const std::size_t x = col % std::size_t(L0), rest = col / std::size_t(L0);
+      mask[(rest % inner) * std::size_t(chunks) + x / chunk] = 1;
+    }
+  return mask;
+}
+
+template <int dim>
+void DstSolver<dim>::transform_lines(double* data, int a, const std::vector<char>& mask) const {
+  std::array<std::size_t, dim + 1> stride{1};
+  for (int d = 0; d < dim; ++d) stride[d + 1] = stride[d] * std::size_t(grid_.n(d) - 1);
+  const int L0 = grid_.n(0) - 1;
+  if (a == 0) {
+    const std::size_t rows = stride[dim] / stride[1], tasks = (rows + rows_per_task - 1) / rows_per_task;
+#pragma omp parallel for num_threads(threads_) schedule(dynamic, 1)
+    for (std::size_t t = 0; t < tasks; ++t) {
+      double* first = data + t * rows_per_task * std::size_t(L0);
+      (t + 1 < tasks ? lines_->rows : lines_->last_rows)->execute(first);
+    }
+    return;
+  }
+  const int chunks = (L0 + chunk - 1) / chunk;
+  const std::size_t inner = stride[a] / stride[1], outer = stride[dim] / stride[a + 1];
+  const std::size_t tasks = inner * outer;
+#pragma omp parallel for num_threads(threads_) schedule(dynamic, 8)
+  for (std::size_t t = 0; t < tasks; ++t) {
+    const std::size_t i = t % inner, o = t / inner;
+    const char* on = mask.data() + i * std::size_t(chunks);
+    for (int c = 0; c < chunks; ++c)
+      if (on[c]) {
+        double* first = data + o * stride[a + 1] + i * std::size_t(L0) + std::size_t(c) * chunk;
+        ((c + 1) * chunk <= L0 ? lines_->wide : lines_->narrow)[std::size_t(a)]->execute(first);
+      }
+  }
+}
+
+template <int dim>
+void DstSolver<dim>::solve_in_place_at(GridVector& r, const Footprint& load, const Footprint& wanted) const {
+  const std::size_t columns = grid_.n_unknowns() / std::size_t(grid_.n(dim - 1) - 1);
+  if (r.size() != grid_.n_unknowns() || load.columns.size() != columns || wanted.columns.size() != columns)
+    throw std::invalid_argument("DstSolver: vector or footprint size mismatch");
+  std::call_once(lines_planned_, [&] {
+    auto lines = std::make_unique<Lines>();
+    const int L0 = grid_.n(0) - 1;
+    std::ptrdiff_t stride = 1;
+    for (int a = 0; a < dim; ++a) {
+      const int n = grid_.n(a) - 1;
+      if (a > 0) {
+        if (L0 >= chunk)
+          lines->wide[std::size_t(a)] =
+              std::make_unique<detail::R2rLines>(n, stride, chunk, 1, detail::R2rKind::dst1, r.data());
+        if (L0 % chunk != 0)
+          lines->narrow[std::size_t(a)] =
+              std::make_unique<detail::R2rLines>(n, stride, L0 % chunk, 1, detail::R2rKind::dst1, r.data());
+      }
+      stride *= n;
+    }
+    const int rows = int(grid_.n_unknowns() / std::size_t(L0)),
+              last = rows - (rows - 1) / rows_per_task * rows_per_task;
+    lines->rows =
+        std::make_unique<detail::R2rLines>(L0, 1, std::min(rows, rows_per_task), L0, detail::R2rKind::dst1, r.data());
+    lines->last_rows = std::make_unique<detail::R2rLines>(L0, 1, last, L0, detail::R2rKind::dst1, r.data());
+    lines_ = std::move(lines);
+  });
+  for (int a = dim - 1; a >= 1; --a) transform_lines(r.data(), a, chunk_mask(load, a));
+  transform_lines(r.data(), 0, {});
+  scale_by(r, true);
+  transform_lines(r.data(), 0, {});
+  for (int a = 1; a < dim; ++a) transform_lines(r.data(), a, chunk_mask(wanted, a));
+}
+
+template <int dim>
 void DstSolver<dim>::transform(GridVector& v) const {
   plan_->execute(v.data());
 }
@@ -68,6 +174,8 @@ void DstSolver<dim>::apply(const GridVector& x, GridVector& y) const {
   plan_->execute(y.data());
 }
 
+template Footprint footprint(const Grid<2>&, std::initializer_list<const SparseRows*>);
+template Footprint footprint(const Grid<3>&, std::initializer_list<const SparseRows*>);
 template class DstSolver<2>;
 template class DstSolver<3>;
 template std::unique_ptr<FastSolver<2>> make_fast_solver(const Grid<2>&, double, const Execution&);

@@ -42,6 +42,23 @@ R2rPlan::~R2rPlan() {
 
 void R2rPlan::execute(double* data) const { fftw_execute_r2r(plan_, data, data); }
 
+R2rLines::R2rLines(int n, std::ptrdiff_t stride, int howmany, std::ptrdiff_t distance, R2rKind kind, double* example) {
+  std::lock_guard lock(planner_mutex());
+  init_threads_once();
+  fftw_plan_with_nthreads(1);
+  const fftw_iodim64 line{n, stride, stride}, lines{howmany, distance, distance};
+  const fftw_r2r_kind k = kind == R2rKind::dst1 ? FFTW_RODFT00 : FFTW_REDFT00;
+  plan_ = fftw_plan_guru64_r2r(1, &line, 1, &lines, example, example, &k, FFTW_ESTIMATE | FFTW_UNALIGNED);
+  if (plan_ == nullptr) throw std::runtime_error("FFTW: could not plan the transform of grid lines");
+}
+
+R2rLines::~R2rLines() {
+  std::lock_guard lock(planner_mutex());
+  fftw_destroy_plan(plan_);
+}
+
+void R2rLines::execute(double* first) const { fftw_execute_r2r(plan_, first, first); }
+
 RealDft::RealDft(const std::vector<int>& shape, int threads) {
   std::lock_guard lock(planner_mutex());
   init_threads_once();

@@ -28,6 +28,23 @@ class R2rPlan {
   fftw_plan plan_ = nullptr;
 };
 
+/// An in-place 1-D transform of `howmany` lines of length n, each line's entries `stride` apart and the
+/// lines `distance` apart, single-threaded and on any pointer (FFTW_UNALIGNED), so that callers run
+/// many of them at once on threads (a transform of chosen lines of a grid). Planned on `example`, an
+/// array of the extent the plan spans (FFTW_ESTIMATE does not touch it).
+class R2rLines {
+ public:
+  R2rLines(int n, std::ptrdiff_t stride, int howmany, std::ptrdiff_t distance, R2rKind kind, double* example);
+  ~R2rLines();
+  R2rLines(const R2rLines&) = delete;
+  R2rLines& operator=(const R2rLines&) = delete;
+
+  void execute(double* first) const;
+
+ private:
+  fftw_plan plan_ = nullptr;
+};
+
 /// Out-of-place real DFT pair (FFTW r2c / c2r, unnormalized) of a row-major real array of shape
 /// `shape` and its half spectrum (the fastest axis has shape.back()/2 + 1 entries).
 class RealDft {

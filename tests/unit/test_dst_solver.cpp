@@ -111,3 +111,67 @@ TEST(PeriodicSolver, SingularCaseIsThePseudoInverse) {
 }
 
 }  // namespace
+
+namespace {
+
+/// Rows of `count` nodes each, the nodes of a row in one small cluster around a random node: a load
+/// or readings near a few points, as the Schur complement's rows are.
+template <int dim>
+fictus::SparseRows clustered_rows(const fictus::Grid<dim>& grid, int n_rows, std::mt19937& rng) {
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  fictus::SparseRows R;
+  for (int r = 0; r < n_rows; ++r) {
+    typename fictus::Grid<dim>::Index centre;
+    for (int d = 0; d < dim; ++d) centre[d] = 2 + int(rng() % unsigned(grid.n(d) - 4));
+    for (int k = 0; k < 3 * dim; ++k) {
+      auto node = centre;
+      for (int d = 0; d < dim; ++d) node[d] += int(rng() % 3) - 1;
+      R.entries.push_back({grid.index(node), node[0], node[1], dim == 3 ? node[dim - 1] : 0, value(rng)});
+    }
+    R.row_begin.push_back(R.entries.size());
+  }
+  return R;
+}
+
+template <int dim>
+void expect_solve_at_matches_full_solve(const fictus::Grid<dim>& grid, double c, int threads) {
+  std::mt19937 rng(7);
+  const fictus::SparseRows loads = clustered_rows(grid, 9, rng), readings = clustered_rows(grid, 11, rng);
+  const fictus::DstSolver<dim> solver(grid, c, fictus::Execution(threads));
+  std::vector<double> lambda(9);
+  for (double& l : lambda) l = std::uniform_real_distribution<double>(-1.0, 1.0)(rng);
+  fictus::GridVector full(grid.n_unknowns(), 0.0);
+  loads.add_transposed(lambda, full);
+  fictus::GridVector pruned = full;
+  solver.solve_in_place(full);
+  const fictus::Footprint load = fictus::footprint(grid, {&loads}), wanted = fictus::footprint(grid, {&readings});
+  for (int repeat = 0; repeat < 2; ++repeat) {  // the second call runs on the plans of the first
+    fictus::GridVector u = pruned;
+    solver.solve_in_place_at(u, load, wanted);
+    std::vector<double> expected, got;
+    readings.multiply(full, expected);
+    readings.multiply(u, got);
+    double scale = 0;
+    for (double v : expected) scale = std::max(scale, std::abs(v));
+    ASSERT_GT(scale, 0.0);
+    for (std::size_t i = 0; i < got.size(); ++i) EXPECT_NEAR(got[i], expected[i], 1e-13 * scale) << "reading " << i;
+  }
+  // Footprints of another grid are refused.
+  fictus::GridVector u = pruned;
+  EXPECT_THROW(solver.solve_in_place_at(u, fictus::Footprint{}, wanted), std::invalid_argument);
+}
+
+}  // namespace
+
+// The pruned solve of the Schur complement's products: transforms along the slow axes of the lines that
+// meet the load and the readings only, the same readings as the full solve. The fastest axis has 47
+// unknowns (chunks of 16, 16 and 15 lines), 2-D and 3-D, one and two threads.
+TEST(DstSolver, SolveAtFootprintsMatchesTheFullSolve) {
+  for (int threads : {1, 2}) {
+    expect_solve_at_matches_full_solve(fictus::Grid2(fictus::Box2{{0.0, 0.0}, {1.0, 0.75}}, 48), 1.5, threads);
+    expect_solve_at_matches_full_solve(fictus::Grid3(fictus::Box3{{0.0, 0.0, 0.0}, {1.0, 0.75, 0.5}}, 48), 0.0,
+                                       threads);
+    expect_solve_at_matches_full_solve(fictus::Grid3(fictus::Box3{{0.0, 0.0, 0.0}, {0.25, 1.0, 1.0}}, 40), 2.0,
+                                       threads);
+  }
+}

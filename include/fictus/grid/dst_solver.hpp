@@ -5,6 +5,7 @@
 // Plans once in the constructor; solve_in_place() is const, allocation-free and reentrant for
 // distinct arrays.
 #include <memory>
+#include <mutex>
 
 #include "fictus/grid/fast_solver.hpp"
 
@@ -26,16 +27,26 @@ class DstSolver final : public FastSolver<dim> {
   const Grid<dim>& grid() const override { return grid_; }
   double c() const override { return symbol_.c(); }
   void solve_in_place(GridVector& r) const override;
+  /// By transforms along the slow axes of the lines that meet the footprints only (the fastest axis's
+  /// are all made): the same numbers as solve_in_place where `wanted` says.
+  void solve_in_place_at(GridVector& r, const Footprint& load, const Footprint& wanted) const override;
   void apply(const GridVector& x, GridVector& y) const override;
   /// One in-place DST-I (RODFT00) of a grid vector: the unit of cost benchmarks compare to.
   void transform(GridVector& v) const;
 
  private:
   void scale_by(GridVector& v, bool inverse) const;
+  struct Lines;
+  /// The transform of the lines along axis a ≥ 1 in the chunks `mask` names (transform_lines), or
+  /// along axis 0 of all of them (a = 0).
+  void transform_lines(double* data, int a, const std::vector<char>& mask) const;
+  std::vector<char> chunk_mask(const Footprint& f, int a) const;
   Grid<dim> grid_;
   Q1Symbol<dim> symbol_;
   int threads_;
   std::unique_ptr<detail::R2rPlan> plan_;
+  mutable std::once_flag lines_planned_;
+  mutable std::unique_ptr<Lines> lines_;  // planned by the first solve_in_place_at, on its array
 };
 
 }  // namespace fictus

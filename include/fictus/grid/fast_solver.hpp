@@ -7,14 +7,26 @@
 // λ(p) comes from Q1Symbol. Solvers plan once in the constructor; solve_in_place() is const and
 // allocation-free.
 #include <complex>
+#include <initializer_list>
 #include <memory>
 #include <vector>
 
 #include "fictus/grid/execution.hpp"
 #include "fictus/grid/grid.hpp"
 #include "fictus/grid/q1_symbol.hpp"
+#include "fictus/grid/sparse_rows.hpp"
 
 namespace fictus {
+
+/// The columns of a grid's unknowns (its lines along the slowest axis) that hold a node of some sparse
+/// rows: where a load Rᵀλ made from those rows can be non-zero, or where rows read a solve's answer.
+/// `columns` is indexed by Grid::index with the slowest axis dropped.
+struct Footprint {
+  std::vector<char> columns;
+};
+
+template <int dim>
+Footprint footprint(const Grid<dim>& grid, std::initializer_list<const SparseRows*> rows);
 
 template <int dim>
 class FastSolver {
@@ -24,6 +36,13 @@ class FastSolver {
   virtual double c() const = 0;
   /// Overwrites r (size n_unknowns) with A⁻¹r (A⁺r when singular()).
   virtual void solve_in_place(GridVector& r) const = 0;
+  /// The same for r zero outside the columns of `load`, exact where `wanted` says and unspecified
+  /// elsewhere: the Dirichlet solver transforms only the lines these meet (the Schur complement's
+  /// products, whose loads and readings lie near γ); the others solve everywhere.
+  virtual void solve_in_place_at(GridVector& r, const Footprint& load, const Footprint& wanted) const {
+    (void)load, (void)wanted;
+    solve_in_place(r);
+  }
   /// y = A x by the same transforms.
   virtual void apply(const GridVector& x, GridVector& y) const = 0;
   /// A has the constants as null space (periodic box with c = 0).

@@ -108,8 +108,10 @@ class ImplicitSchur final : public SchurComplement {
   template <int dim>
   ImplicitSchur(const FastSolver<dim>& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
                 const SparseRows& loads, const GmresOptions& options, DirectTerms direct = {})
-      : ImplicitSchur([&solver](GridVector& r) { solver.solve_in_place(r); }, solver.grid().n_unknowns(), B_gamma,
-                      C_gamma, loads, options, std::move(direct)) {}
+      : ImplicitSchur([&solver, load = footprint(solver.grid(), {&loads}),
+                       wanted = footprint(solver.grid(), {&B_gamma, &C_gamma})](
+                          GridVector& r) { solver.solve_in_place_at(r, load, wanted); },
+                      solver.grid().n_unknowns(), B_gamma, C_gamma, loads, options, std::move(direct)) {}
   /// With A⁻¹ as `solve_in_place` on vectors of `n_unknowns`.
   ImplicitSchur(std::function<void(GridVector&)> solve_in_place, std::size_t n_unknowns, const SparseRows& B_gamma,
                 const SparseRows& C_gamma, const SparseRows& loads, const GmresOptions& options,
