@@ -688,9 +688,19 @@ double CompressedBlocks::bytes() const {
   return 8.0 * n;
 }
 
-void CompressedBlocks::multiply(const Eigen::VectorXd& x, std::vector<Eigen::VectorXd>& y, int threads) const {
+void CompressedBlocks::multiply(const Eigen::VectorXd& x, std::vector<Eigen::VectorXd>& y, int threads,
+                                const std::vector<char>* set_of_row) const {
   Eigen::VectorXd xt(n_cols);  // x in the columns' tree order
   for (int j = 0; j < n_cols; ++j) xt(j) = x(col_item[std::size_t(j)]);
+  // wanted[s][t]: how many of the first t rows in tree order want set s.
+  std::vector<std::vector<int>> wanted(std::size_t(set_of_row ? n_sets : 0), std::vector<int>(n_rows + 1, 0));
+  for (std::size_t s = 0; s < wanted.size(); ++s)
+    for (int t = 0; t < n_rows; ++t)
+      wanted[s][std::size_t(t) + 1] =
+          wanted[s][std::size_t(t)] + ((*set_of_row)[std::size_t(row_item[std::size_t(t)])] == char(s));
+  const auto skip = [&](int s, const Cluster& cx) {
+    return set_of_row && wanted[std::size_t(s)][std::size_t(cx.end)] == wanted[std::size_t(s)][std::size_t(cx.begin)];
+  };
   // Each thread adds into its own copy (tree order), summed after.
   std::vector<Eigen::MatrixXd> partial(std::size_t(std::max(1, threads)));
   const int n_b = int(blocks.size());
@@ -706,9 +716,10 @@ void CompressedBlocks::multiply(const Eigen::VectorXd& x, std::vector<Eigen::Vec
       const auto xy = xt.segment(cy.begin, cy.end - cy.begin);
       if (!b.dense.empty()) {
         for (int s = 0; s < n_sets; ++s)
-          mine.col(s).segment(cx.begin, cx.end - cx.begin).noalias() += b.dense[std::size_t(s)] * xy;
+          if (!skip(s, cx)) mine.col(s).segment(cx.begin, cx.end - cx.begin).noalias() += b.dense[std::size_t(s)] * xy;
       } else {
         for (int s = 0; s < n_sets; ++s) {
+          if (skip(s, cx)) continue;
           w.noalias() = b.right[std::size_t(s)].transpose() * xy;
           mine.col(s).segment(cx.begin, cx.end - cx.begin).noalias() += b.left[std::size_t(s)] * w;
         }

@@ -116,11 +116,22 @@ struct HierarchicalSchur::Impl {
     if (D_C.nonZeros() > 0) sc += D_C * x;
   }
 
+  /// y = S̃_𝒜 x: of each block only the row set its rows take (S̃_B on 𝒜, S̃_C elsewhere).
   void apply_newton(const ActiveSet& active, const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
-    Eigen::VectorXd sb, sc;
-    apply(x, sb, sc);
+    std::vector<char> set_of_row(static_cast<std::size_t>(m));
+    for (int i = 0; i < m; ++i) set_of_row[std::size_t(i)] = active[std::size_t(i)] ? 0 : 1;
+    std::vector<Eigen::VectorXd> s;
+    blocks.multiply(x, s, threads, &set_of_row);
     y.resize(m);
-    for (int i = 0; i < m; ++i) y(i) = active[std::size_t(i)] ? sb(i) : sc(i);
+    for (int i = 0; i < m; ++i) y(i) = active[std::size_t(i)] ? s[0](i) : s[1](i);
+    const auto add_direct_rows = [&](const RowMajorSparse& D, bool on_active) {
+      if (D.nonZeros() == 0) return;
+      const Eigen::VectorXd d = D * x;
+      for (int i = 0; i < m; ++i)
+        if ((active[std::size_t(i)] != 0) == on_active) y(i) += d(i);
+    };
+    add_direct_rows(D_B, true);
+    add_direct_rows(D_C, false);
   }
 
   /// The preconditioner's LUs for 𝒜 (again only in groups where 𝒜 changed).

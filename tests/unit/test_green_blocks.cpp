@@ -138,6 +138,17 @@ TEST_P(GreenBlocksTest, CompressedBlocksAndTheirSolves) {
     EXPECT_LT(dense_error, 1e-2 * want.norm()) << "set " << s;
     entry_error[std::size_t(s)] = (interpolated[std::size_t(s)] - S).cwiseAbs().maxCoeff();
   }
+  // The Newton matrix's rows only: set 0 on the points above the sphere's equator, set 1 below, the same
+  // numbers as the full product where wanted.
+  std::vector<char> set_of_row(static_cast<std::size_t>(m));
+  for (int i = 0; i < m; ++i)
+    set_of_row[std::size_t(i)] = rows.B.entries[rows.B.row_begin[std::size_t(i)]].k > rows.grid.nz() / 2 ? 0 : 1;
+  std::vector<Eigen::VectorXd> selected;
+  c.multiply(x, selected, 2, &set_of_row);
+  for (int i = 0; i < m; ++i) {
+    const int s = set_of_row[std::size_t(i)];
+    EXPECT_NEAR(selected[std::size_t(s)](i), y[std::size_t(s)](i), 1e-13 * y[std::size_t(s)].norm()) << "row " << i;
+  }
   // Diagonal blocks of the groups: every point in one group, entries as in the product.
   int covered = 0;
   for (const int g : c.groups(64)) {

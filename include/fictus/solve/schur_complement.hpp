@@ -271,8 +271,11 @@ struct CompressedBlocks {
   std::vector<Block> blocks;
   std::vector<int> row_parent;  // the row tree's parents (−1: root)
   double bytes() const;
-  /// y[k] = (R_k G Qᵀ) x for every row set k.
-  void multiply(const Eigen::VectorXd& x, std::vector<Eigen::VectorXd>& y, int threads) const;
+  /// y[k] = (R_k G Qᵀ) x for every row set k; with `set_of_row`, row i is wanted of set set_of_row[i]
+  /// only (the Newton matrix's rows) and the blocks whose rows want none of a set skip it, so the other
+  /// entries of y are unspecified.
+  void multiply(const Eigen::VectorXd& x, std::vector<Eigen::VectorXd>& y, int threads,
+                const std::vector<char>* set_of_row = nullptr) const;
   /// Groups of rows: the row clusters of at most `size` items nearest the root (items in tree order).
   std::vector<int> groups(int size) const;
   /// The block of set k over the rows × the columns of row cluster g, both in the cluster's tree order
