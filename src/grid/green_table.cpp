@@ -1,5 +1,8 @@
 #include "fictus/grid/green_table.hpp"
 
+#include <algorithm>
+#include <climits>
+
 #include "fftw_plan.hpp"
 #include "fictus/grid/q1_symbol.hpp"
 
@@ -124,40 +127,62 @@ void GreenTable<dim>::G(const std::array<std::vector<int>, dim>& a, const std::a
 template <int dim>
 void GreenTable<dim>::G(const Index* a, std::size_t n_a, const Index* b, const double* w, std::size_t n_b,
                         double* out) const {
-  // The folded offsets of a_d ± b_d times the axes' strides in the table.
-  const std::size_t s1 = size_[0], s2 = dim == 3 ? size_[0] * size_[1] : 0;
-  const int p0 = period_[0], p1 = period_[1], p2 = period_[dim - 1];
+  std::fill(out, out + n_a, 0.0);
+  if (n_b == 0) return;
+  // b's coordinates from their least along each axis; then, for each a, the folded offsets of a_d − b_d
+  // and (Dirichlet) a_d + b_d times the axis's stride over that range, so the sums only look them up.
+  thread_local std::vector<int> from_low;
+  thread_local std::vector<std::size_t> offsets;
+  std::array<int, dim> low, width;
+  std::array<std::size_t, dim> stride, minus_at, plus_at;
+  low.fill(INT_MAX);
+  width.fill(0);
+  for (std::size_t k = 0; k < n_b; ++k)
+    for (int d = 0; d < dim; ++d) low[d] = std::min(low[d], b[k][d]);
+  from_low.resize(n_b * dim);
+  for (std::size_t k = 0; k < n_b; ++k)
+    for (int d = 0; d < dim; ++d) {
+      from_low[k * dim + std::size_t(d)] = b[k][d] - low[d];
+      width[d] = std::max(width[d], b[k][d] - low[d] + 1);
+    }
+  std::size_t total = 0;
+  for (int d = 0; d < dim; ++d) {
+    stride[d] = d == 0 ? 1 : stride[d - 1] * size_[d - 1];
+    minus_at[d] = total, total += std::size_t(width[d]);
+    plus_at[d] = total, total += std::size_t(width[d]);
+  }
+  offsets.resize(total);
   const double* t = table_.data();
+  const int* c = from_low.data();
   for (std::size_t u = 0; u < n_a; ++u) {
-    const Index& x = a[u];
+    for (int d = 0; d < dim; ++d)
+      for (int j = 0; j < width[d]; ++j) {
+        const int y = low[d] + j;
+        offsets[minus_at[d] + std::size_t(j)] = std::size_t(near_fold(a[u][d] - y, period_[d])) * stride[d];
+        if (!periodic_)
+          offsets[plus_at[d] + std::size_t(j)] = std::size_t(near_fold(a[u][d] + y, period_[d])) * stride[d];
+      }
+    const std::size_t *xm = offsets.data() + minus_at[0], *xp = offsets.data() + plus_at[0];
+    const std::size_t *ym = offsets.data() + minus_at[1], *yp = offsets.data() + plus_at[1];
     double sum = 0.0;
     if constexpr (dim == 2) {
       if (periodic_) {
-        for (std::size_t k = 0; k < n_b; ++k)
-          sum += t[std::size_t(near_fold(x[1] - b[k][1], p1)) * s1 + std::size_t(near_fold(x[0] - b[k][0], p0))] * w[k];
+        for (std::size_t k = 0; k < n_b; ++k) sum += t[ym[c[2 * k + 1]] + xm[c[2 * k]]] * w[k];
       } else {
         for (std::size_t k = 0; k < n_b; ++k) {
-          const double* tm = t + std::size_t(near_fold(x[1] - b[k][1], p1)) * s1;
-          const double* tp = t + std::size_t(near_fold(x[1] + b[k][1], p1)) * s1;
-          sum += reflections(tm, tp, std::size_t(near_fold(x[0] - b[k][0], p0)),
-                             std::size_t(near_fold(x[0] + b[k][0], p0))) *
-                 w[k];
+          const int cx = c[2 * k], cy = c[2 * k + 1];
+          sum += reflections(t + ym[cy], t + yp[cy], xm[cx], xp[cx]) * w[k];
         }
       }
     } else {
+      const std::size_t *zm = offsets.data() + minus_at[2], *zp = offsets.data() + plus_at[2];
       if (periodic_) {
-        for (std::size_t k = 0; k < n_b; ++k)
-          sum += t[std::size_t(near_fold(x[2] - b[k][2], p2)) * s2 + std::size_t(near_fold(x[1] - b[k][1], p1)) * s1 +
-                   std::size_t(near_fold(x[0] - b[k][0], p0))] *
-                 w[k];
+        for (std::size_t k = 0; k < n_b; ++k) sum += t[zm[c[3 * k + 2]] + ym[c[3 * k + 1]] + xm[c[3 * k]]] * w[k];
       } else {
         for (std::size_t k = 0; k < n_b; ++k) {
-          const std::size_t ym = std::size_t(near_fold(x[1] - b[k][1], p1)) * s1;
-          const std::size_t yp = std::size_t(near_fold(x[1] + b[k][1], p1)) * s1;
-          const std::size_t zm = std::size_t(near_fold(x[2] - b[k][2], p2)) * s2;
-          const std::size_t zp = std::size_t(near_fold(x[2] + b[k][2], p2)) * s2;
-          sum += reflections(t + ym + zm, t + yp + zm, t + ym + zp, t + yp + zp,
-                             std::size_t(near_fold(x[0] - b[k][0], p0)), std::size_t(near_fold(x[0] + b[k][0], p0))) *
+          const int cx = c[3 * k], cy = c[3 * k + 1], cz = c[3 * k + 2];
+          sum += reflections(t + ym[cy] + zm[cz], t + yp[cy] + zm[cz], t + ym[cy] + zp[cz], t + yp[cy] + zp[cz], xm[cx],
+                             xp[cx]) *
                  w[k];
         }
       }
