@@ -566,12 +566,29 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
       exact = std::make_unique<PreconditionedSchur>(*dense, *setup.exact, polish);
     else
       exact = std::make_unique<RefinedSchur>(*compressed, *setup.exact, far_field_gmres_tolerance);
-    NewtonOptions from_there = newton_options;  // solver.max_newton caps both runs together
+    NewtonOptions from_there = newton_options;  // solver.max_newton caps the runs together
     from_there.conditions = first.conditions;
     from_there.start = &sol.newton;
     from_there.max_iterations = std::max(1, newton_options.max_iterations - sol.newton.iterations);
+    NewtonResult search;
+    if (!dense && from_there.max_iterations > 1) {
+      // Compressed: each exact step costs a fast solve per GMRES step, so the steps that still change
+      // the active set stop at exact_search_tolerance; a last run solves to the full tolerance from
+      // there and confirms the set (or goes on where it changes).
+      auto& refined = static_cast<RefinedSchur&>(*exact);
+      refined.set_tolerance(exact_search_tolerance);
+      NewtonOptions searching = from_there;
+      searching.max_iterations = from_there.max_iterations - 1;
+      search = solve_semismooth_newton(*exact, setup.b0, setup.c0, g, searching, mode);
+      refined.set_tolerance(far_field_gmres_tolerance);
+      from_there.start = &search;
+      from_there.max_iterations = std::max(1, from_there.max_iterations - search.iterations);
+      sol.newton.iterations += search.iterations;
+      sol.newton.history.insert(sol.newton.history.end(), search.history.begin(), search.history.end());
+      sol.newton.inner_failed = sol.newton.inner_failed || search.inner_failed;
+    }
     NewtonResult second = solve_semismooth_newton(*exact, setup.b0, setup.c0, g, from_there, mode);
-    if (setup.far_field) sol.far_field = FarFieldUse{*setup.far_field, second.iterations};
+    if (setup.far_field) sol.far_field = FarFieldUse{*setup.far_field, search.iterations + second.iterations};
     second.iterations += sol.newton.iterations;
     second.history.insert(second.history.begin(), sol.newton.history.begin(), sol.newton.history.end());
     second.inner_failed = second.inner_failed || sol.newton.inner_failed;

@@ -35,6 +35,10 @@ inline constexpr double refinement_correction_tolerance = 1e-4;
 /// The GMRES tolerance of the Newton steps on S̃ alone, before the exact S takes over (SettlingSchur).
 inline constexpr double settling_tolerance = 1e-6;
 
+/// The relative residual of the Newton steps on the exact S while they may still change the active set
+/// (RefinedSchur::set_tolerance); the step that confirms the set is solved to the full tolerance.
+inline constexpr double exact_search_tolerance = 1e-8;
+
 struct HierarchicalOptions {
   FarField far_field;                         // how the entries are made: the dense assembly's far field (order > 0)
   FarField storage = hierarchical_far_field;  // the storage's partition (eta, leaf)
@@ -90,6 +94,8 @@ class RefinedSchur final : public SchurComplement {
         correction_tolerance_(correction_tolerance),
         max_steps_(max_steps) {}
   int size() const override { return exact_.size(); }
+  /// The relative residual of the solves from now on (the exact products kept so far stay valid).
+  void set_tolerance(double tolerance) { tolerance_ = tolerance; }
   void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override;
   LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
                           Eigen::VectorXd& lambda, double& alpha) const override;
