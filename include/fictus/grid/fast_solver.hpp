@@ -5,7 +5,7 @@
 //                        constants) and solve_in_place applies the pseudo-inverse A⁺ (the mean of r
 //                        is discarded and the result has zero mean).
 // λ(p) comes from Q1Symbol. Solvers plan once in the constructor; solve_in_place() is const and
-// allocation-free.
+// allocation-free (solve_in_place_at plans its transforms of lines at its first call).
 #include <complex>
 #include <initializer_list>
 #include <memory>
