@@ -113,16 +113,13 @@ void DstSolver<dim>::transform_lines(double* data, int a, const std::vector<char
   }
   const int chunks = (L0 + chunk - 1) / chunk;
   const std::size_t inner = stride[a] / stride[1], outer = stride[dim] / stride[a + 1];
-  const std::size_t tasks = inner * outer;
-#pragma omp parallel for num_threads(threads_) schedule(dynamic, 8)
+  const std::size_t tasks = inner * outer * std::size_t(chunks);  // one chunk each (2-D: only chunks)
+#pragma omp parallel for num_threads(threads_) schedule(dynamic, 16)
   for (std::size_t t = 0; t < tasks; ++t) {
-    const std::size_t i = t % inner, o = t / inner;
-    const char* on = mask.data() + i * std::size_t(chunks);
-    for (int c = 0; c < chunks; ++c)
-      if (on[c]) {
-        double* first = data + o * stride[a + 1] + i * std::size_t(L0) + std::size_t(c) * chunk;
-        ((c + 1) * chunk <= L0 ? lines_->wide : lines_->narrow)[std::size_t(a)]->execute(first);
-      }
+    const std::size_t c = t % std::size_t(chunks), line = t / std::size_t(chunks), i = line % inner, o = line / inner;
+    if (!mask[i * std::size_t(chunks) + c]) continue;
+    double* first = data + o * stride[a + 1] + i * std::size_t(L0) + c * chunk;
+    ((c + 1) * chunk <= std::size_t(L0) ? lines_->wide : lines_->narrow)[std::size_t(a)]->execute(first);
   }
 }
 

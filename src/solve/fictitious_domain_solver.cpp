@@ -588,8 +588,10 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
       sol.newton.inner_failed = sol.newton.inner_failed || search.inner_failed;
     }
     NewtonResult second = solve_semismooth_newton(*exact, setup.b0, setup.c0, g, from_there, mode);
-    if (setup.far_field) sol.far_field = FarFieldUse{*setup.far_field, search.iterations + second.iterations};
+    if (setup.far_field) sol.far_field = FarFieldUse{*setup.far_field, second.iterations};
     second.iterations += sol.newton.iterations;
+    if (!second.converged && second.failure.rfind("no convergence in ", 0) == 0)  // the runs' steps together
+      second.failure = "no convergence in " + std::to_string(second.iterations) + " Newton steps";
     second.history.insert(second.history.begin(), sol.newton.history.begin(), sol.newton.history.end());
     second.inner_failed = second.inner_failed || sol.newton.inner_failed;
     sol.newton = std::move(second);

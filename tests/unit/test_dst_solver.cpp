@@ -165,13 +165,15 @@ void expect_solve_at_matches_full_solve(const fictus::Grid<dim>& grid, double c,
 
 // The pruned solve of the Schur complement's products: transforms along the slow axes of the lines that
 // meet the load and the readings only, the same readings as the full solve. The fastest axis has 47
-// unknowns (chunks of 16, 16 and 15 lines), 2-D and 3-D, one and two threads.
+// unknowns (chunks of 16, 16 and 15 lines), 32 (two whole chunks) or 11 (one narrow chunk), 2-D and
+// 3-D, one and two threads.
 TEST(DstSolver, SolveAtFootprintsMatchesTheFullSolve) {
   for (int threads : {1, 2}) {
     expect_solve_at_matches_full_solve(fictus::Grid2(fictus::Box2{{0.0, 0.0}, {1.0, 0.75}}, 48), 1.5, threads);
+    expect_solve_at_matches_full_solve(fictus::Grid2(fictus::Box2{{0.0, 0.0}, {1.0, 1.0}}, 33), 0.0, threads);
     expect_solve_at_matches_full_solve(fictus::Grid3(fictus::Box3{{0.0, 0.0, 0.0}, {1.0, 0.75, 0.5}}, 48), 0.0,
                                        threads);
-    expect_solve_at_matches_full_solve(fictus::Grid3(fictus::Box3{{0.0, 0.0, 0.0}, {0.25, 1.0, 1.0}}, 40), 2.0,
-                                       threads);
+    expect_solve_at_matches_full_solve(fictus::Grid3(fictus::Box3{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}}, 33), 1.0, threads);
+    expect_solve_at_matches_full_solve(fictus::Grid3(fictus::Box3{{0.0, 0.0, 0.0}, {1.0, 2.0, 2.0}}, 12), 2.0, threads);
   }
 }

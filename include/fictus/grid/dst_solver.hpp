@@ -28,7 +28,8 @@ class DstSolver final : public FastSolver<dim> {
   double c() const override { return symbol_.c(); }
   void solve_in_place(GridVector& r) const override;
   /// By transforms along the slow axes of the lines that meet the footprints only (the fastest axis's
-  /// are all made): the same numbers as solve_in_place where `wanted` says.
+  /// are all made): solve_in_place's numbers where `wanted` says, up to rounding (1-D passes instead of
+  /// FFTW's multi-dimensional plan).
   void solve_in_place_at(GridVector& r, const Footprint& load, const Footprint& wanted) const override;
   void apply(const GridVector& x, GridVector& y) const override;
   /// One in-place DST-I (RODFT00) of a grid vector: the unit of cost benchmarks compare to.

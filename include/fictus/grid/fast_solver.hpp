@@ -5,7 +5,8 @@
 //                        constants) and solve_in_place applies the pseudo-inverse A⁺ (the mean of r
 //                        is discarded and the result has zero mean).
 // λ(p) comes from Q1Symbol. Solvers plan once in the constructor; solve_in_place() is const and
-// allocation-free (solve_in_place_at plans its transforms of lines at its first call).
+// allocation-free (solve_in_place_at plans its transforms of lines at its first call and makes a mask
+// of the lines, a few bytes per column, at each call).
 #include <complex>
 #include <initializer_list>
 #include <memory>
