@@ -941,17 +941,28 @@ double estimated_seconds(const BasicProblem<dim>& problem, const SolverOptions& 
   // Calibrated on the benchmark's 2-core machine (bench/results): in 2-D the grid work (load, u₀,
   // Green's table, final solve, errors) costs about 9e-9 s per node·log2(nodes) on one thread, the
   // Schur blocks 2.3e-6 s per pair of points, each Newton step one dense LU of 1e-10·m³ s (8 steps
-  // assumed); GMRES about 2.5 m iterations of 2.5 fast solves of 4.6e-10 s per node·log2(nodes). In 3-D
-  // the grid work (with the kink correction and the cut-voxel rules) is about 6e-8 s per node·log2(nodes)
-  // and the assembly 4e-6 s per pair, three LUs. Threads divide it, up to the cores there are.
+  // assumed); GMRES about 2.5 m iterations of 2.5 fast solves of 4.6e-10 s per node·log2(nodes).
+  // Threads divide it, up to the cores there are.
   const double threads = std::clamp(double(Execution(options.threads).threads()), 1.0,
                                     double(std::max(1u, std::thread::hardware_concurrency())));
-  // Compressed blocks: the same assembly, and instead of the LUs Newton's exact solves (about 9 fast
-  // solves) and GMRES on S̃, in all 3e-8 s per node·log2(nodes) on 2 threads (3-D, N = 256 … 512).
-  const double grid = (dim == 2 ? 4.5e-9 : 3e-8) * n_log_n, pairs = (dim == 2 ? 1.15e-6 : 2e-6) * m * m,
-               dense = compressed(problem, options, m) ? 3e-8 * n_log_n : (dim == 2 ? 8 : 3) * 0.5e-10 * m * m * m;
-  const double seconds =
-      options.inner == InnerSolver::green ? grid + pairs + dense : grid + 2.5 * m * 2.5 * 2.3e-10 * n_log_n;
+  double seconds = 0;
+  if constexpr (dim == 2) {
+    const double grid = 4.5e-9 * n_log_n, pairs = 1.15e-6 * m * m, lus = 8 * 0.5e-10 * m * m * m;
+    seconds = options.inner == InnerSolver::green ? grid + pairs + lus : grid + 2.5 * m * 2.5 * 2.3e-10 * n_log_n;
+  } else {
+    // 3-D, on 2 threads (the non-smooth sphere of bench/sphere_contact.toml, N = 128 … 768,
+    // bench/results/2026-11-28-pruned-products.md): the grid work 5.9e-9 s per node·log2(nodes) and,
+    // per point of γ, 3.2e-3 s (the kink correction, the cut voxels' rules, the nested start); the
+    // blocks 1.2e-7 s per pair with the far field interpolated (2e-6 exact), compressed
+    // 6.7e-5·m·log2(m); Newton one LU of 1.5e-11·m³ and about 18 fast solves (8e-9 per
+    // node·log2(nodes)), compressed its fast solves and GMRES on S̃ in 4.5e-9.
+    const bool kept_compressed = compressed(problem, options, m);
+    const double grid = 5.9e-9 * n_log_n + 3.2e-3 * m;
+    const double blocks =
+        kept_compressed ? 6.7e-5 * m * std::log2(std::max(m, 2.0)) : (options.far_field ? 1.2e-7 : 2e-6) * m * m;
+    const double newton = kept_compressed ? 4.5e-9 * n_log_n : 1.5e-11 * m * m * m + 8e-9 * n_log_n;
+    seconds = options.inner == InnerSolver::green ? grid + blocks + newton : grid + 2.5 * m * 2.5 * 2.3e-10 * n_log_n;
+  }
   return seconds * 2 / threads;
 }
 
