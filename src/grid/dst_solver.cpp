@@ -16,8 +16,7 @@ std::unique_ptr<FastSolver<dim>> make_fast_solver(const Grid<dim>& grid, double 
 
 template <int dim>
 Footprint footprint(const Grid<dim>& grid, std::initializer_list<const SparseRows*> rows) {
-  const std::size_t slowest = std::size_t(grid.periodic() ? grid.n(dim - 1) : grid.n(dim - 1) - 1);
-  const std::size_t columns = grid.n_unknowns() / slowest;
+  const std::size_t columns = grid.layer_size();
   Footprint f;
   f.columns.assign(columns, 0);
   for (const SparseRows* R : rows)
@@ -125,7 +124,7 @@ void DstSolver<dim>::transform_lines(double* data, int a, const std::vector<char
 
 template <int dim>
 void DstSolver<dim>::solve_in_place_at(GridVector& r, const Footprint& load, const Footprint& wanted) const {
-  const std::size_t columns = grid_.n_unknowns() / std::size_t(grid_.n(dim - 1) - 1);
+  const std::size_t columns = grid_.layer_size();
   if (r.size() != grid_.n_unknowns() || load.columns.size() != columns || wanted.columns.size() != columns)
     throw std::invalid_argument("DstSolver: vector or footprint size mismatch");
   std::call_once(lines_planned_, [&] {

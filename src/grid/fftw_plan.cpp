@@ -6,15 +6,17 @@
 
 namespace fictus::detail {
 
-namespace {
-std::mutex& planner_mutex() {  // the FFTW planner is not thread-safe
+std::mutex& planner_mutex() {
   static std::mutex m;
   return m;
 }
+
 void init_threads_once() {
   static const bool ok = fftw_init_threads() != 0;
   if (!ok) throw std::runtime_error("FFTW: fftw_init_threads failed");
 }
+
+namespace {
 std::size_t product(const std::vector<int>& shape) {
   std::size_t n = 1;
   for (int s : shape) n *= std::size_t(s);

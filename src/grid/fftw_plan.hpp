@@ -6,9 +6,15 @@
 
 #include <complex>
 #include <cstddef>
+#include <mutex>
 #include <vector>
 
 namespace fictus::detail {
+
+/// The FFTW planner is not thread-safe: every plan is made and destroyed under this lock.
+std::mutex& planner_mutex();
+/// fftw_init_threads, once per process (before any plan, and before fftw_mpi_init).
+void init_threads_once();
 
 enum class R2rKind { dst1, dct1 };  // FFTW RODFT00 / REDFT00, unnormalized
 

@@ -62,6 +62,10 @@ class Grid {
     for (int d = 0; d < dim; ++d) count *= std::size_t(periodic() ? n_[d] : n_[d] - 1);
     return count;
   }
+  /// The unknowns' layers along the slowest axis (dim − 1), and the unknowns in one layer: a process of
+  /// a distributed run holds whole layers (Slab, fast_solver.hpp).
+  int layers() const { return periodic() ? n_[dim - 1] : n_[dim - 1] - 1; }
+  std::size_t layer_size() const { return n_unknowns() / std::size_t(layers()); }
   std::size_t n_nodes() const {
     std::size_t count = 1;
     for (int d = 0; d < dim; ++d) count *= std::size_t(n_[d] + 1);

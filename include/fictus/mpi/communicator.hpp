@@ -1,0 +1,43 @@
+#pragma once
+// fictus under mpirun (the FICTUS_MPI build, library fictus_mpi): the MPI environment of a process and
+// the communicator its distributed work uses. A serial run never initializes MPI.
+#include <mpi.h>
+
+#include <cstddef>
+
+namespace fictus::mpi {
+
+/// Was this process started by an MPI launcher (mpirun, mpiexec, srun)? Read from the variables the
+/// launchers set (Open MPI, PMIx, PMI, Slurm), without initializing MPI.
+bool launched();
+
+/// MPI for the life of the object: MPI_Init_thread with MPI_THREAD_FUNNELED (only the thread that made
+/// it calls MPI; OpenMP and FFTW threads only compute), FFTW's threads and fftw_mpi_init; at the end
+/// fftw_mpi_cleanup and MPI_Finalize. One per process.
+class Environment {
+ public:
+  Environment(int& argc, char**& argv);
+  ~Environment();
+  Environment(const Environment&) = delete;
+  Environment& operator=(const Environment&) = delete;
+};
+
+/// A communicator's rank and size and the collectives fictus uses, on MPI_COMM_WORLD by default. The
+/// object does not own the communicator.
+class Communicator {
+ public:
+  explicit Communicator(MPI_Comm comm = MPI_COMM_WORLD);
+  MPI_Comm get() const { return comm_; }
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  /// values[i] ← Σ over the ranks of values[i], on every rank.
+  void sum(double* values, std::size_t n) const;
+  double max(double value) const;
+  void barrier() const;
+
+ private:
+  MPI_Comm comm_;
+  int rank_ = 0, size_ = 1;
+};
+
+}  // namespace fictus::mpi

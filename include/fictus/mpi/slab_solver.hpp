@@ -1,0 +1,52 @@
+#pragma once
+// The fast solver for A = K + c·M on FFTW-MPI slabs: the same operator as DstSolver (Dirichlet box) and
+// PeriodicSolver (periodic box), with the grid's unknowns distributed over the ranks of a communicator
+// in whole layers along the slowest axis (Slab, fast_solver.hpp), FFTW-MPI's block distribution.
+//   Dirichlet: fftw_mpi_plan_many_r2r (RODFT00 along every axis);
+//   periodic:  fftw_mpi_plan_many_dft_r2c / c2r.
+// The forward transform leaves its output transposed (FFTW_MPI_TRANSPOSED_OUT: the two slowest axes
+// swapped, distributed along the second), the division by λ runs there, and the backward transform takes
+// it back (FFTW_MPI_TRANSPOSED_IN): one global transposition per transform, not two. Every rank calls
+// solve_in_place and apply together (they are collective).
+#include <memory>
+
+#include "fictus/grid/fast_solver.hpp"
+#include "fictus/mpi/communicator.hpp"
+
+namespace fictus::mpi {
+
+/// FFTW-MPI's default distribution of `layers` layers over `size` ranks: blocks of ⌈layers/size⌉ in rank
+/// order (the last ranks may hold fewer, or none).
+Slab default_slab(int layers, int rank, int size);
+
+template <int dim>
+class SlabSolver final : public FastSolver<dim> {
+ public:
+  /// c ≥ 0; the threads of `execution` run FFTW's and the scaling's loops on each rank. The communicator
+  /// must outlive the solver.
+  SlabSolver(const Grid<dim>& grid, double c, const Communicator& comm, const Execution& execution = Execution{});
+  ~SlabSolver() override;
+  SlabSolver(const SlabSolver&) = delete;
+  SlabSolver& operator=(const SlabSolver&) = delete;
+
+  const Grid<dim>& grid() const override { return grid_; }
+  double c() const override { return symbol_.c(); }
+  Slab slab() const override { return slab_; }
+  /// r: this rank's layers (local_size() entries).
+  void solve_in_place(GridVector& r) const override;
+  void apply(const GridVector& x, GridVector& y) const override;
+  /// Bytes of the transforms' workspace on this rank (FFTW-MPI's local allocation).
+  std::size_t workspace_bytes() const;
+
+ private:
+  struct Plans;
+  void transform(GridVector& v, bool inverse) const;
+  void scale(bool inverse) const;
+  Grid<dim> grid_;
+  Q1Symbol<dim> symbol_;
+  int threads_;
+  Slab slab_;
+  std::unique_ptr<Plans> plans_;
+};
+
+}  // namespace fictus::mpi

@@ -1,0 +1,57 @@
+#include "fictus/mpi/communicator.hpp"
+
+#include <fftw3-mpi.h>
+
+#include <cstdlib>
+#include <stdexcept>
+
+#include "../grid/fftw_plan.hpp"
+
+namespace fictus::mpi {
+
+bool launched() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
+    if (std::getenv(name) != nullptr) return true;
+  return false;
+}
+
+Environment::Environment(int& argc, char**& argv) {
+  int provided = 0;
+  if (MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS)
+    throw std::runtime_error("MPI: MPI_Init_thread failed");
+  if (provided < MPI_THREAD_FUNNELED) {
+    MPI_Finalize();
+    throw std::runtime_error("MPI: the library does not support threads (MPI_THREAD_FUNNELED)");
+  }
+  std::lock_guard lock(detail::planner_mutex());
+  detail::init_threads_once();  // FFTW: the threads before the MPI part
+  fftw_mpi_init();
+}
+
+Environment::~Environment() {
+  {
+    std::lock_guard lock(detail::planner_mutex());
+    fftw_mpi_cleanup();
+  }
+  MPI_Finalize();
+}
+
+Communicator::Communicator(MPI_Comm comm) : comm_(comm) {
+  MPI_Comm_rank(comm_, &rank_);
+  MPI_Comm_size(comm_, &size_);
+}
+
+void Communicator::sum(double* values, std::size_t n) const {
+  constexpr std::size_t most = std::size_t(1) << 30;  // MPI counts are int
+  for (std::size_t first = 0; first < n; first += most)
+    MPI_Allreduce(MPI_IN_PLACE, values + first, int(std::min(most, n - first)), MPI_DOUBLE, MPI_SUM, comm_);
+}
+
+double Communicator::max(double value) const {
+  MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  return value;
+}
+
+void Communicator::barrier() const { MPI_Barrier(comm_); }
+
+}  // namespace fictus::mpi

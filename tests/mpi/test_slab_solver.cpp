@@ -1,0 +1,116 @@
+// The fast solvers on FFTW-MPI slabs against the serial ones, run by ctest under mpirun with 1, 2 and 3
+// ranks (3 divides none of the grids' layers): every rank solves the whole grid serially and compares
+// its own layers. The errors are reduced over the ranks before each check, so all ranks check the same.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fictus/mpi/slab_solver.hpp"
+
+namespace {
+
+using fictus::Boundary;
+using fictus::GridVector;
+using fictus::Slab;
+using fictus::mpi::Communicator;
+
+/// A fixed vector without structure: the same on every rank.
+GridVector data_of(std::size_t n) {
+  GridVector v(n);
+  for (std::size_t i = 0; i < n; ++i)
+    v[i] = std::sin(1.7 * double(i) + 0.3) + 0.25 * std::cos(0.11 * double(i) * double(i));
+  return v;
+}
+
+/// max over this rank's layers of |local − whole|, over max |whole|, the largest over the ranks.
+double relative_difference(const GridVector& local, const GridVector& whole, std::size_t offset,
+                           const Communicator& comm) {
+  double difference = 0, size = 0;
+  for (std::size_t i = 0; i < whole.size(); ++i) size = std::max(size, std::abs(whole[i]));
+  for (std::size_t i = 0; i < local.size(); ++i)
+    difference = std::max(difference, std::abs(local[i] - whole[offset + i]));
+  return comm.max(difference) / size;
+}
+
+template <int dim>
+void check(const fictus::Box<dim>& box, int n0, Boundary boundary, double c, int threads) {
+  const Communicator comm;
+  const fictus::Grid<dim> grid(box, n0, boundary);
+  const fictus::Execution execution(threads);
+  const fictus::mpi::SlabSolver<dim> slab_solver(grid, c, comm, execution);
+  const std::unique_ptr<fictus::FastSolver<dim>> serial = fictus::make_fast_solver(grid, c, execution);
+
+  const Slab slab = slab_solver.slab();
+  EXPECT_EQ(slab, fictus::mpi::default_slab(grid.layers(), comm.rank(), comm.size()));
+  double layers = slab.count;
+  comm.sum(&layers, 1);
+  EXPECT_EQ(int(layers), grid.layers());
+  const std::size_t offset = std::size_t(slab.first) * grid.layer_size();
+  ASSERT_EQ(slab_solver.local_size(), std::size_t(slab.count) * grid.layer_size());
+
+  const GridVector r = data_of(grid.n_unknowns());
+  GridVector whole = r,
+             local(r.begin() + std::ptrdiff_t(offset), r.begin() + std::ptrdiff_t(offset + slab_solver.local_size()));
+  serial->solve_in_place(whole);
+  slab_solver.solve_in_place(local);
+  EXPECT_LT(relative_difference(local, whole, offset, comm), 1e-12) << "solve, c = " << c;
+
+  GridVector y_whole, y_local,
+      x_local(r.begin() + std::ptrdiff_t(offset), r.begin() + std::ptrdiff_t(offset + slab_solver.local_size()));
+  serial->apply(r, y_whole);
+  slab_solver.apply(x_local, y_local);
+  EXPECT_LT(relative_difference(y_local, y_whole, offset, comm), 1e-12) << "apply, c = " << c;
+}
+
+const fictus::Box<2> box2{{-1.0, -0.5}, {1.0, 1.25}};
+const fictus::Box<3> box3{{-1.0, -0.5, 0.0}, {1.0, 1.0, 1.75}};
+
+TEST(SlabSolver, DirichletMatchesTheSerialSolverIn2d) {
+  // 40 × 35 cells: 34 layers of 39 unknowns.
+  for (double c : {0.0, 2.5}) check<2>(box2, 40, Boundary::dirichlet, c, 1);
+  check<2>(box2, 40, Boundary::dirichlet, 1.0, 2);
+}
+
+TEST(SlabSolver, PeriodicMatchesTheSerialSolverIn2d) {
+  // 16 × 14 cells: 14 layers; c = 0 is the pseudo-inverse.
+  for (double c : {0.0, 2.5}) check<2>(box2, 16, Boundary::periodic, c, 1);
+}
+
+TEST(SlabSolver, DirichletMatchesTheSerialSolverIn3d) {
+  // 16 × 12 × 14 cells: 13 layers of 15 × 11 unknowns.
+  for (double c : {0.0, 2.5}) check<3>(box3, 16, Boundary::dirichlet, c, 1);
+  check<3>(box3, 16, Boundary::dirichlet, 1.0, 2);
+}
+
+TEST(SlabSolver, PeriodicMatchesTheSerialSolverIn3d) {
+  // 16 × 12 × 14 cells: 14 layers of 16 × 12 unknowns.
+  for (double c : {0.0, 2.5}) check<3>(box3, 16, Boundary::periodic, c, 1);
+  check<3>(box3, 16, Boundary::periodic, 1.0, 2);
+}
+
+TEST(SlabSolver, DefaultSlabsCoverTheLayersInOrder) {
+  for (int layers : {1, 2, 7, 34})
+    for (int size : {1, 2, 3, 4, 8}) {
+      int next = 0;
+      for (int rank = 0; rank < size; ++rank) {
+        const Slab s = fictus::mpi::default_slab(layers, rank, size);
+        EXPECT_EQ(s.first, next);
+        EXPECT_GE(s.count, 0);
+        next += s.count;
+      }
+      EXPECT_EQ(next, layers);
+    }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  const fictus::mpi::Environment environment(argc, argv);
+  const int rank = Communicator().rank();
+  if (rank != 0) {  // one report: the other ranks print only their failures
+    ::testing::TestEventListeners& listeners = ::testing::UnitTest::GetInstance()->listeners();
+    delete listeners.Release(listeners.default_result_printer());
+  }
+  return RUN_ALL_TESTS();
+}
