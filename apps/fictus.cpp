@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -19,6 +20,9 @@
 #include <string>
 #include <vector>
 
+#ifdef FICTUS_WITH_MPI
+#include "fictus/mpi/communicator.hpp"
+#endif
 #include "fictus/io/problem_file.hpp"
 #include "fictus/io/process.hpp"
 #include "fictus/solve/convergence_table.hpp"
@@ -416,6 +420,28 @@ int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out,
 
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // a line at a time, also into a file or a pipe
+#ifdef FICTUS_WITH_MPI
+  // Under mpirun (or srun): MPI for the life of the process. The solve runs on one rank so far, so a run
+  // on more stops at once: the error line once (rank 0), the same exit code on every rank, no rank left
+  // waiting.
+  std::optional<fictus::mpi::Environment> mpi;
+  if (fictus::mpi::launched()) {
+    try {
+      mpi.emplace(argc, argv);
+    } catch (const std::exception& e) {
+      return report(e.what(), exit_internal);
+    }
+    const fictus::mpi::Communicator world;
+    if (world.size() > 1) {
+      if (world.rank() == 0)
+        report("started on " + std::to_string(world.size()) +
+                   " MPI ranks: the solve is not distributed yet; run fictus on one rank (mpirun -np 1, or "
+                   "without mpirun) with solver.threads for the cores",
+               exit_bad_input);
+      return exit_bad_input;
+    }
+  }
+#endif
   CLI::App app{"fictus: Signorini problems on curved domains by a fictitious domain method"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string(FICTUS_VERSION));
