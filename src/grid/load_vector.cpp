@@ -22,11 +22,26 @@ GridVector assemble_load(const Grid2& grid, const ScalarField& f, int q, const E
   return assemble_load(grid, vectorize(f), q, execution);
 }
 
-GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q, const Execution& execution) {
+namespace {
+/// Does the cell layer c (cells c along the slowest axis, nodes c and c + 1) touch a node of the slab?
+template <int dim>
+bool touches(const Grid<dim>& grid, const Slab& slab, int c) {
+  for (int node : {c, c + 1}) {
+    const bool unknown = grid.periodic() || (node > 0 && node < grid.n(dim - 1));
+    if (unknown && slab.holds(grid.layer(node))) return true;
+  }
+  return false;
+}
+}  // namespace
+
+GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q, const Execution& execution,
+                         std::optional<Slab> slab) {
   const GaussRule& rule = gauss_legendre(q);
   const int nx = grid.nx(), ny = grid.ny(), qq = q * q;
   const double h = grid.h(), area = h * h;
-  GridVector load(grid.n_unknowns(), 0.0);
+  const Slab s = slab.value_or(grid.every_layer());
+  const std::size_t offset = grid.slab_offset(s);
+  GridVector load(grid.slab_size(s), 0.0);
   std::vector<Q1Element<2>> elements;  // the shape functions at the q×q Gauss points of a cell
   for (int b = 0; b < q; ++b)
     for (int a = 0; a < q; ++a) elements.emplace_back(Point2{rule.nodes[a], rule.nodes[b]}, h);
@@ -39,7 +54,7 @@ GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q, con
 #pragma omp for schedule(dynamic, 4)
       for (int iy = parity; iy < ny; iy += 2) {
         if (omp_get_thread_num() == 0 && iy % 64 < 2 && execution.interrupt_requested()) stop = true;
-        if (stop) continue;
+        if (stop || !touches(grid, s, iy)) continue;
         for (int ix = 0, k = 0; ix < nx; ++ix)  // the row's quadrature points, cell by cell
           for (int b = 0; b < q; ++b)
             for (int a = 0; a < q; ++a, ++k) {
@@ -57,7 +72,7 @@ GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q, con
             }
           for (int k = 0; k < Q1Element<2>::n_nodes; ++k) {
             const int i = ix + Q1Element<2>::offset(k, 0), j = iy + Q1Element<2>::offset(k, 1);
-            if (grid.has_unknown(i, j)) load[grid.index(i, j)] += w[k];
+            if (grid.has_unknown(i, j) && s.holds(grid.layer(j))) load[grid.index(i, j) - offset] += w[k];
           }
         }
       }
@@ -77,11 +92,14 @@ GridVector assemble_load(const Grid3& grid, const ScalarField3& f, int q, const 
   return assemble_load(grid, vectorize(f), q, execution);
 }
 
-GridVector assemble_load(const Grid3& grid, const VectorizedField3& f, int q, const Execution& execution) {
+GridVector assemble_load(const Grid3& grid, const VectorizedField3& f, int q, const Execution& execution,
+                         std::optional<Slab> slab) {
   const GaussRule& rule = gauss_legendre(q);
   const int nx = grid.nx(), qqq = q * q * q;
   const double h = grid.h(), volume = h * h * h;
-  GridVector load(grid.n_unknowns(), 0.0);
+  const Slab s = slab.value_or(grid.every_layer());
+  const std::size_t offset = grid.slab_offset(s);
+  GridVector load(grid.slab_size(s), 0.0);
   std::vector<Q1Element<3>> elements;  // the shape functions at the q×q×q Gauss points of a voxel
   std::vector<double> weights;
   for (int c = 0; c < q; ++c)
@@ -100,7 +118,7 @@ GridVector assemble_load(const Grid3& grid, const VectorizedField3& f, int q, co
 #pragma omp for schedule(dynamic, 1)
       for (int iz = parity; iz < grid.nz(); iz += 2) {
         if (omp_get_thread_num() == 0 && execution.interrupt_requested()) stop = true;
-        if (stop) continue;
+        if (stop || !touches(grid, s, iz)) continue;
         for (int iy = 0; iy < grid.ny(); ++iy) {
           for (int ix = 0, k = 0; ix < nx; ++ix)
             for (int p = 0; p < qqq; ++p, ++k) {
@@ -118,7 +136,7 @@ GridVector assemble_load(const Grid3& grid, const VectorizedField3& f, int q, co
             for (int k = 0; k < Q1Element<3>::n_nodes; ++k) {
               const Grid3::Index node{ix + Q1Element<3>::offset(k, 0), iy + Q1Element<3>::offset(k, 1),
                                       iz + Q1Element<3>::offset(k, 2)};
-              if (grid.has_unknown(node)) load[grid.index(node)] += w[k];
+              if (grid.has_unknown(node) && s.holds(grid.layer(node[2]))) load[grid.index(node) - offset] += w[k];
             }
           }
         }

@@ -4,15 +4,27 @@
 
 namespace fictus {
 
-void SparseRows::multiply(const GridVector& u, std::vector<double>& out) const {
-  out.assign(n_rows(), 0.0);
-  for (int r = 0; r < n_rows(); ++r)
-    for (std::size_t k = row_begin[r]; k < row_begin[r + 1]; ++k) out[r] += entries[k].value * u[entries[k].index];
-}
+void SparseRows::multiply(const GridVector& u, std::vector<double>& out) const { multiply(u, 0, out); }
 
 void SparseRows::add_transposed(const std::vector<double>& lambda, GridVector& u) const {
+  add_transposed(lambda, u, 0);
+}
+
+void SparseRows::multiply(const GridVector& u, std::size_t offset, std::vector<double>& out) const {
+  out.assign(n_rows(), 0.0);
   for (int r = 0; r < n_rows(); ++r)
-    for (std::size_t k = row_begin[r]; k < row_begin[r + 1]; ++k) u[entries[k].index] += entries[k].value * lambda[r];
+    for (std::size_t k = row_begin[r]; k < row_begin[r + 1]; ++k) {
+      const std::size_t local = entries[k].index - offset;  // wraps below the slab: then ≥ u.size()
+      if (local < u.size()) out[r] += entries[k].value * u[local];
+    }
+}
+
+void SparseRows::add_transposed(const std::vector<double>& lambda, GridVector& u, std::size_t offset) const {
+  for (int r = 0; r < n_rows(); ++r)
+    for (std::size_t k = row_begin[r]; k < row_begin[r + 1]; ++k) {
+      const std::size_t local = entries[k].index - offset;
+      if (local < u.size()) u[local] += entries[k].value * lambda[r];
+    }
 }
 
 std::vector<double> SparseRows::row_sums() const {

@@ -29,15 +29,6 @@ struct Footprint {
 template <int dim>
 Footprint footprint(const Grid<dim>& grid, std::initializer_list<const SparseRows*> rows);
 
-/// The unknowns one process holds: the layers first ≤ l < first + count along the grid's slowest axis
-/// (Grid::layers), stored as the entries first·layer_size ≤ k < (first + count)·layer_size of the whole
-/// grid's vector. A serial solver holds every layer; the solvers on FFTW-MPI slabs (mpi/slab_solver.hpp)
-/// hold FFTW's block of them.
-struct Slab {
-  int first = 0, count = 0;
-  bool operator==(const Slab&) const = default;
-};
-
 template <int dim>
 class FastSolver {
  public:
@@ -46,8 +37,8 @@ class FastSolver {
   virtual double c() const = 0;
   /// The layers of the unknowns this process holds, and their number of entries: the size of the
   /// vectors solve_in_place and apply take.
-  virtual Slab slab() const { return Slab{0, grid().layers()}; }
-  std::size_t local_size() const { return std::size_t(slab().count) * grid().layer_size(); }
+  virtual Slab slab() const { return grid().every_layer(); }
+  std::size_t local_size() const { return grid().slab_size(slab()); }
   /// Overwrites r (size local_size(): n_unknowns when serial) with A⁻¹r (A⁺r when singular()).
   virtual void solve_in_place(GridVector& r) const = 0;
   /// The same for r zero outside the columns of `load`, exact where `wanted` says and unspecified

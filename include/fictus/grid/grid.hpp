@@ -22,6 +22,16 @@ namespace fictus {
 enum class Boundary { dirichlet, periodic };
 const char* to_string(Boundary b);
 
+/// The unknowns one process holds: the layers first ≤ l < first + count along the grid's slowest axis
+/// (Grid::layers), stored as the entries first·layer_size ≤ k < (first + count)·layer_size of the whole
+/// grid's vector (Grid::slab_offset). A serial run holds every layer (Grid::every_layer); a run under
+/// mpirun holds FFTW-MPI's block of them (mpi/slab_solver.hpp).
+struct Slab {
+  int first = 0, count = 0;
+  bool operator==(const Slab&) const = default;
+  bool holds(int layer) const { return layer >= first && layer < first + count; }
+};
+
 template <int dim>
 class Grid {
  public:
@@ -66,6 +76,13 @@ class Grid {
   /// a distributed run holds whole layers (Slab, fast_solver.hpp).
   int layers() const { return periodic() ? n_[dim - 1] : n_[dim - 1] - 1; }
   std::size_t layer_size() const { return n_unknowns() / std::size_t(layers()); }
+  Slab every_layer() const { return Slab{0, layers()}; }
+  /// Where a slab's entries begin in the whole vector, and how many there are.
+  std::size_t slab_offset(const Slab& s) const { return std::size_t(s.first) * layer_size(); }
+  std::size_t slab_size(const Slab& s) const { return std::size_t(s.count) * layer_size(); }
+  /// The layer of a node's unknown (its slowest coordinate, wrapped on a periodic box); precondition
+  /// has_unknown(i).
+  int layer(int slowest) const { return periodic() ? wrap(slowest, n_[dim - 1]) : slowest - 1; }
   std::size_t n_nodes() const {
     std::size_t count = 1;
     for (int d = 0; d < dim; ++d) count *= std::size_t(n_[d] + 1);

@@ -1,6 +1,7 @@
 #pragma once
 // Q1 load vector f_k = ∫_Ω f φ_k at the interior nodes, by a q×q Gauss rule on every cell.
 #include <functional>
+#include <optional>
 
 #include "fictus/grid/execution.hpp"
 #include "fictus/grid/grid.hpp"
@@ -19,8 +20,9 @@ VectorizedField vectorize(ScalarField f);
 /// q = Gauss points per direction (q = 2 is O(h⁴) per cell, enough for the Q1 rates when f is
 /// smooth inside cells). f must be thread-safe (it is called from `threads` threads).
 GridVector assemble_load(const Grid2& grid, const ScalarField& f, int q = 2, const Execution& execution = Execution{});
+/// With `slab`: only the slab's entries (a rank's layers, Slab; the cells that touch them evaluated).
 GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q = 2,
-                         const Execution& execution = Execution{});
+                         const Execution& execution = Execution{}, std::optional<Slab> slab = std::nullopt);
 
 /// 3-D: f_k = ∫_Ω f φ_k with the trilinear basis, q×q×q Gauss points per voxel (threaded over voxel
 /// layers; f must be thread-safe).
@@ -33,7 +35,7 @@ using GradientField3 = std::function<Point3(double x, double y, double z)>;
 VectorizedField3 vectorize(ScalarField3 f);
 GridVector assemble_load(const Grid3& grid, const ScalarField3& f, int q = 2, const Execution& execution = Execution{});
 GridVector assemble_load(const Grid3& grid, const VectorizedField3& f, int q = 2,
-                         const Execution& execution = Execution{});
+                         const Execution& execution = Execution{}, std::optional<Slab> slab = std::nullopt);
 
 /// The field types of a dimension: a value, a value in batches and a gradient at a point.
 template <int dim>

@@ -5,7 +5,9 @@
 
 #include <cmath>
 
+#include "fictus/grid/load_vector.hpp"
 #include "fictus/mpi/slab_solver.hpp"
+#include "scattered_rows.hpp"
 
 namespace {
 
@@ -86,6 +88,73 @@ TEST(SlabSolver, PeriodicMatchesTheSerialSolverIn3d) {
   // 16 × 12 × 14 cells: 14 layers of 16 × 12 unknowns.
   for (double c : {0.0, 2.5}) check<3>(box3, 16, Boundary::periodic, c, 1);
   check<3>(box3, 16, Boundary::periodic, 1.0, 2);
+}
+
+/// The grid steps of a solve on the ranks' slabs against one process: u₀ = A⁻¹F from the load F, its
+/// readings R u₀ (partial sums added over the ranks), and û = u₀ + A⁻¹Rᵀλ with its readings.
+template <int dim>
+void check_steps(const fictus::Box<dim>& box, int n0, Boundary boundary, double c) {
+  const Communicator comm;
+  const fictus::Grid<dim> grid(box, n0, boundary);
+  const fictus::mpi::SlabSolver<dim> slab_solver(grid, c, comm);
+  const std::unique_ptr<fictus::FastSolver<dim>> serial = fictus::make_fast_solver(grid, c);
+  const Slab slab = slab_solver.slab();
+  const std::size_t offset = grid.slab_offset(slab);
+  const fictus::SparseRows R = fictus::test_support::scattered_rows(grid, 23);
+  std::vector<double> lambda(23);
+  for (std::size_t r = 0; r < lambda.size(); ++r) lambda[r] = std::cos(double(r));
+
+  auto f3 = [](std::size_t n, const double* x, const double* y, const double* z, double* out) {
+    for (std::size_t k = 0; k < n; ++k) out[k] = 1.0 + x[k] * y[k] - (z ? std::sin(3 * z[k]) : 0.0);
+  };
+  auto f2 = [&](std::size_t n, const double* x, const double* y, double* out) { f3(n, x, y, nullptr, out); };
+  auto load = [&](std::optional<Slab> s) {
+    if constexpr (dim == 2)
+      return fictus::assemble_load(grid, fictus::VectorizedField(f2), 2, fictus::Execution{}, s);
+    else
+      return fictus::assemble_load(grid, fictus::VectorizedField3(f3), 2, fictus::Execution{}, s);
+  };
+  // One process.
+  GridVector u0 = load(std::nullopt), u_hat;
+  serial->solve_in_place(u0);
+  std::vector<double> readings0, readings1;
+  R.multiply(u0, readings0);
+  GridVector correction(grid.n_unknowns(), 0.0);
+  R.add_transposed(lambda, correction);
+  serial->solve_in_place(correction);
+  u_hat = u0;
+  for (std::size_t i = 0; i < u_hat.size(); ++i) u_hat[i] += correction[i];
+  R.multiply(u_hat, readings1);
+  // The ranks.
+  GridVector v0 = load(slab);
+  slab_solver.solve_in_place(v0);
+  std::vector<double> parts0, parts1;
+  R.multiply(v0, offset, parts0);
+  comm.sum(parts0.data(), parts0.size());
+  GridVector v_hat(v0.size(), 0.0);
+  R.add_transposed(lambda, v_hat, offset);
+  slab_solver.solve_in_place(v_hat);
+  for (std::size_t i = 0; i < v_hat.size(); ++i) v_hat[i] += v0[i];
+  R.multiply(v_hat, offset, parts1);
+  comm.sum(parts1.data(), parts1.size());
+
+  EXPECT_LT(relative_difference(v0, u0, offset, comm), 1e-12);
+  EXPECT_LT(relative_difference(v_hat, u_hat, offset, comm), 1e-12);
+  double scale = 0, difference = 0;
+  for (std::size_t r = 0; r < readings0.size(); ++r) {
+    scale = std::max({scale, std::abs(readings0[r]), std::abs(readings1[r])});
+    difference = std::max({difference, std::abs(parts0[r] - readings0[r]), std::abs(parts1[r] - readings1[r])});
+  }
+  EXPECT_LT(difference, 1e-12 * scale);
+}
+
+TEST(SlabSteps, LoadSolveAndReadingsMatchOneProcess) {
+  for (double c : {0.0, 1.0}) {
+    check_steps<2>(box2, 40, Boundary::dirichlet, c);
+    check_steps<2>(box2, 16, Boundary::periodic, c);
+    check_steps<3>(box3, 16, Boundary::dirichlet, c);
+    check_steps<3>(box3, 16, Boundary::periodic, c);
+  }
 }
 
 TEST(SlabSolver, DefaultSlabsCoverTheLayersInOrder) {
