@@ -9,7 +9,8 @@ DEBIAN_PACKAGES = cmake g++ make pkg-config libfftw3-dev libopenblas-openmp-dev 
                   nlohmann-json3-dev libfmt-dev zlib1g-dev libgtest-dev libbenchmark-dev \
                   libmuparser-dev libtomlplusplus-dev libcgal-dev python3 python3-dev python3-numpy python3-matplotlib \
                   python3-vtk9 python3-pytest pybind11-dev clang-format \
-                  python3-venv python3-pip python3-setuptools python3-wheel
+                  python3-venv python3-pip python3-setuptools python3-wheel \
+                  libopenmpi-dev openmpi-bin libfftw3-mpi-dev
 
 .PHONY: deps configure build run test sanitize fuzz bench references manufactured format options-table clean
 
@@ -23,7 +24,7 @@ deps:
 	fi
 
 configure: deps
-	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DFICTUS_MPI=ON
 
 build: configure
 	cmake --build $(BUILD_DIR) -j $(JOBS)
@@ -40,7 +41,7 @@ test: build
 # corpus. (Not the Python module: an instrumented module needs the sanitizer runtime preloaded.)
 SANITIZE_DIR ?= build-sanitize
 sanitize: deps
-	cmake -S . -B $(SANITIZE_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFICTUS_SANITIZE=ON \
+	cmake -S . -B $(SANITIZE_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFICTUS_SANITIZE=ON -DFICTUS_MPI=ON \
 	      -DFICTUS_BUILD_PYTHON=OFF -DFICTUS_BUILD_BENCH=OFF
 	cmake --build $(SANITIZE_DIR) -j $(JOBS)
 	cd $(SANITIZE_DIR) && ctest --output-on-failure -LE 'slow|convergence|regression' -E 'style|docs|plot' -j $(JOBS)
