@@ -432,11 +432,17 @@ int main(int argc, char** argv) {
       return report(e.what(), exit_internal);
     }
     const fictus::mpi::Communicator world;
+    const int declared = fictus::mpi::declared_size();
+    if (declared > world.size())  // every process alone: each says so
+      return report("started as one of " + std::to_string(declared) +
+                        " tasks, but MPI sees this process alone: the launcher is not the MPI fictus was built "
+                        "with (another MPI's mpirun, or srun without its MPI plugin)",
+                    exit_bad_input);
     if (world.size() > 1) {
       if (world.rank() == 0)
         report("started on " + std::to_string(world.size()) +
-                   " MPI ranks: the solve is not distributed yet; run fictus on one rank (mpirun -np 1, or "
-                   "without mpirun) with solver.threads for the cores",
+                   " MPI ranks: the solve is not distributed yet; run fictus on one rank (without mpirun, or "
+                   "mpirun -np 1 --bind-to none) with solver.threads for the cores",
                exit_bad_input);
       return exit_bad_input;
     }

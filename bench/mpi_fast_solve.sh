@@ -6,7 +6,7 @@
 set -e
 B=${1:-build}/bench/fictus_bench_mpi_solve
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-M="mpiexec --oversubscribe -n"
+M="mpiexec --oversubscribe --bind-to none -n"
 $B --dim 2 --N 64 --repeat 1 --header --path serial | sed -n '1,/^$/p'
 echo "## Ranks against threads"
 echo

@@ -23,14 +23,16 @@ GridVector assemble_load(const Grid2& grid, const ScalarField& f, int q, const E
 }
 
 namespace {
-/// Does the cell layer c (cells c along the slowest axis, nodes c and c + 1) touch a node of the slab?
+/// Which of the cell layer c's two node layers (c and c + 1 along the slowest axis) carry unknowns the
+/// slab holds.
 template <int dim>
-bool touches(const Grid<dim>& grid, const Slab& slab, int c) {
-  for (int node : {c, c + 1}) {
-    const bool unknown = grid.periodic() || (node > 0 && node < grid.n(dim - 1));
-    if (unknown && slab.holds(grid.layer(node))) return true;
+std::array<bool, 2> held_layers(const Grid<dim>& grid, const Slab& slab, int c) {
+  std::array<bool, 2> held{};
+  for (int side = 0; side < 2; ++side) {
+    const int node = c + side;
+    held[std::size_t(side)] = (grid.periodic() || (node > 0 && node < grid.n(dim - 1))) && slab.holds(grid.layer(node));
   }
-  return false;
+  return held;
 }
 }  // namespace
 
@@ -54,7 +56,8 @@ GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q, con
 #pragma omp for schedule(dynamic, 4)
       for (int iy = parity; iy < ny; iy += 2) {
         if (omp_get_thread_num() == 0 && iy % 64 < 2 && execution.interrupt_requested()) stop = true;
-        if (stop || !touches(grid, s, iy)) continue;
+        const std::array<bool, 2> held = held_layers(grid, s, iy);
+        if (stop || !(held[0] || held[1])) continue;
         for (int ix = 0, k = 0; ix < nx; ++ix)  // the row's quadrature points, cell by cell
           for (int b = 0; b < q; ++b)
             for (int a = 0; a < q; ++a, ++k) {
@@ -72,7 +75,7 @@ GridVector assemble_load(const Grid2& grid, const VectorizedField& f, int q, con
             }
           for (int k = 0; k < Q1Element<2>::n_nodes; ++k) {
             const int i = ix + Q1Element<2>::offset(k, 0), j = iy + Q1Element<2>::offset(k, 1);
-            if (grid.has_unknown(i, j) && s.holds(grid.layer(j))) load[grid.index(i, j) - offset] += w[k];
+            if (held[std::size_t(j - iy)] && grid.has_unknown(i, j)) load[grid.index(i, j) - offset] += w[k];
           }
         }
       }
@@ -118,7 +121,8 @@ GridVector assemble_load(const Grid3& grid, const VectorizedField3& f, int q, co
 #pragma omp for schedule(dynamic, 1)
       for (int iz = parity; iz < grid.nz(); iz += 2) {
         if (omp_get_thread_num() == 0 && execution.interrupt_requested()) stop = true;
-        if (stop || !touches(grid, s, iz)) continue;
+        const std::array<bool, 2> held = held_layers(grid, s, iz);
+        if (stop || !(held[0] || held[1])) continue;
         for (int iy = 0; iy < grid.ny(); ++iy) {
           for (int ix = 0, k = 0; ix < nx; ++ix)
             for (int p = 0; p < qqq; ++p, ++k) {
@@ -136,7 +140,7 @@ GridVector assemble_load(const Grid3& grid, const VectorizedField3& f, int q, co
             for (int k = 0; k < Q1Element<3>::n_nodes; ++k) {
               const Grid3::Index node{ix + Q1Element<3>::offset(k, 0), iy + Q1Element<3>::offset(k, 1),
                                       iz + Q1Element<3>::offset(k, 2)};
-              if (grid.has_unknown(node) && s.holds(grid.layer(node[2]))) load[grid.index(node) - offset] += w[k];
+              if (held[std::size_t(node[2] - iz)] && grid.has_unknown(node)) load[grid.index(node) - offset] += w[k];
             }
           }
         }

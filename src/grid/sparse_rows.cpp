@@ -4,10 +4,15 @@
 
 namespace fictus {
 
-void SparseRows::multiply(const GridVector& u, std::vector<double>& out) const { multiply(u, 0, out); }
+void SparseRows::multiply(const GridVector& u, std::vector<double>& out) const {
+  out.assign(n_rows(), 0.0);
+  for (int r = 0; r < n_rows(); ++r)
+    for (std::size_t k = row_begin[r]; k < row_begin[r + 1]; ++k) out[r] += entries[k].value * u[entries[k].index];
+}
 
 void SparseRows::add_transposed(const std::vector<double>& lambda, GridVector& u) const {
-  add_transposed(lambda, u, 0);
+  for (int r = 0; r < n_rows(); ++r)
+    for (std::size_t k = row_begin[r]; k < row_begin[r + 1]; ++k) u[entries[k].index] += entries[k].value * lambda[r];
 }
 
 void SparseRows::multiply(const GridVector& u, std::size_t offset, std::vector<double>& out) const {

@@ -2,6 +2,7 @@
 
 #include <fftw3-mpi.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <stdexcept>
 
@@ -9,10 +10,20 @@
 
 namespace fictus::mpi {
 
+int declared_size() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "SLURM_STEP_NUM_TASKS"})
+    if (const char* text = std::getenv(name)) {
+      char* end = nullptr;
+      const long n = std::strtol(text, &end, 10);
+      if (end != text && n > 0 && n < (1L << 30)) return int(n);
+    }
+  return 0;
+}
+
 bool launched() {
   for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
     if (std::getenv(name) != nullptr) return true;
-  return false;
+  return declared_size() > 1;  // e.g. srun without an MPI plugin: several tasks all the same
 }
 
 Environment::Environment(int& argc, char**& argv) {
@@ -23,9 +34,14 @@ Environment::Environment(int& argc, char**& argv) {
     MPI_Finalize();
     throw std::runtime_error("MPI: the library does not support threads (MPI_THREAD_FUNNELED)");
   }
-  std::lock_guard lock(detail::planner_mutex());
-  detail::init_threads_once();  // FFTW: the threads before the MPI part
-  fftw_mpi_init();
+  try {
+    std::lock_guard lock(detail::planner_mutex());
+    detail::init_threads_once();  // FFTW: the threads before the MPI part
+    fftw_mpi_init();
+  } catch (...) {
+    MPI_Finalize();
+    throw;
+  }
 }
 
 Environment::~Environment() {

@@ -53,8 +53,11 @@ SlabSolver<dim>::SlabSolver(const Grid<dim>& grid, double c, const Communicator&
       fftw_mpi_local_size_many_transposed(dim, p.spectrum.data(), 1, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK,
                                           comm.get(), &local_n0, &local_0_start, &p.spectral_count, &p.spectral_first);
   p.allocation = std::max<ptrdiff_t>(1, periodic ? 2 * units : units);
-  slab_ = Slab{int(local_0_start), int(local_n0)};
-  if (slab_ != default_slab(grid.layers(), comm.rank(), comm.size()))
+  // FFTW-MPI's blocks are default_slab's (a rank without layers may be told any start: it takes the
+  // default's). Checked on every rank together, so that all throw or none.
+  slab_ = default_slab(grid.layers(), comm.rank(), comm.size());
+  const bool same = local_n0 == slab_.count && (local_n0 == 0 || local_0_start == slab_.first);
+  if (comm.max(same ? 0.0 : 1.0) != 0.0)
     throw std::logic_error("SlabSolver: FFTW-MPI's distribution is not the default blocks");
 
   std::lock_guard lock(detail::planner_mutex());

@@ -1,5 +1,7 @@
 #include "fictus/solve/options.hpp"
 
+#include <sched.h>
+
 #include "fictus/grid/execution.hpp"
 #include "fictus/grid/q1_symbol.hpp"
 
@@ -287,7 +289,7 @@ void data_and_solver_specs(std::vector<OptionSpec>& specs) {
   {
     OptionSpec t = member(std::string("solver"), std::string("threads"), OptionType::integer, &SolverOptions::threads,
                           "threads for the transforms, loops and dense algebra; 0 = the machine's "
-                          "(OMP_NUM_THREADS when set, else the hardware threads)");
+                          "(OMP_NUM_THREADS when set, else the CPUs the process may run on)");
     t.rule = "in 0 … 4 × the hardware threads";
     t.violation = [](const OptionValue& v, int) {
       const std::int64_t n = std::get<std::int64_t>(v);
@@ -427,6 +429,8 @@ int default_threads() {
     const long n = std::strtol(text, &end, 10);  // "4" or "4,2" (nested levels): the first entry
     if (end != text && n > 0 && n <= max_threads()) return int(n);
   }
+  cpu_set_t allowed;  // the CPUs this process may run on: fewer than the machine's under a launcher's binding
+  if (sched_getaffinity(0, sizeof allowed, &allowed) == 0 && CPU_COUNT(&allowed) > 0) return CPU_COUNT(&allowed);
   return std::max(1, int(std::thread::hardware_concurrency()));
 }
 

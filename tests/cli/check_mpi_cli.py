@@ -1,5 +1,6 @@
 """fictus under mpirun: on one rank a solve runs as without mpirun; on more ranks the run stops with the
-error line once and a non-zero exit, and no rank is left waiting (a time limit).
+error line once and a non-zero exit, and no rank is left waiting (a time limit); started by a launcher
+that is not its MPI's, it refuses.
 
 usage: check_mpi_cli.py FICTUS OUT_DIR MPIEXEC [MPIEXEC_FLAG ...] NUMPROC_FLAG
 """
@@ -40,4 +41,10 @@ for key in ("force", "measure", "lambda_integral"):
     x, y = results["contact"][key], expected["contact"][key]
     assert abs(x - y) <= 1e-12 * abs(y), f"one rank: contact.{key} {x} against {y} without mpirun"
 assert results["contact"]["points"] == expected["contact"]["points"], "one rank: another contact set"
+# A launcher that is not this build's MPI (here: Slurm's task count without its PMI): each process would
+# run alone, so each refuses.
+alone = subprocess.run([fictus, "solve", "--N", "64", "--out", os.path.join(out, "alone")],
+                       env=dict(env, SLURM_STEP_NUM_TASKS="3"), capture_output=True, text=True, timeout=120)
+assert alone.returncode != 0 and "MPI sees this process alone" in alone.stderr, alone.stderr
+assert not os.path.exists(os.path.join(out, "alone")), "alone: wrote output"
 print("mpirun: one rank solves as without it; two ranks stop with one error line")

@@ -13,7 +13,8 @@ struct Interrupted : std::runtime_error {
 };
 
 /// The threads a solve uses when solver.threads is 0: OMP_NUM_THREADS when it is set to a positive
-/// number (its first entry), else the hardware threads (at least 1).
+/// number (its first entry), else the CPUs this process may run on (its affinity: all of the machine's,
+/// or the cores mpirun or a batch system bound it to; at least 1).
 int default_threads();
 
 class Execution {

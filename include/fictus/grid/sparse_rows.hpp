@@ -24,7 +24,8 @@ struct SparseRows {
   void add_transposed(const std::vector<double>& lambda, GridVector& u) const;
   /// The same on a slab of the grid's vector (a rank's layers, Slab): u holds the whole vector's entries
   /// from `offset` on, and only the rows' nodes among them count. multiply gives each row's partial sum
-  /// there (a distributed run adds them over its ranks); add_transposed writes only there.
+  /// there (a distributed run adds them over its ranks); add_transposed writes only there. (The whole
+  /// vector's forms above check no index: there u must hold every node of the rows.)
   void multiply(const GridVector& u, std::size_t offset, std::vector<double>& out) const;
   void add_transposed(const std::vector<double>& lambda, GridVector& u, std::size_t offset) const;
   /// R·1: the sum of each row's entries.

@@ -8,12 +8,17 @@
 namespace fictus::mpi {
 
 /// Was this process started by an MPI launcher (mpirun, mpiexec, srun)? Read from the variables the
-/// launchers set (Open MPI, PMIx, PMI, Slurm), without initializing MPI.
+/// launchers set (Open MPI, PMIx, PMI; Slurm's task count), without initializing MPI.
 bool launched();
+/// The number of processes the launcher says it started (0: it says nothing). When it is more than MPI's
+/// world size, the launcher is not this build's MPI (another MPI's mpirun, srun without its MPI plugin)
+/// and each process would run alone.
+int declared_size();
 
 /// MPI for the life of the object: MPI_Init_thread with MPI_THREAD_FUNNELED (only the thread that made
 /// it calls MPI; OpenMP and FFTW threads only compute), FFTW's threads and fftw_mpi_init; at the end
-/// fftw_mpi_cleanup and MPI_Finalize. One per process.
+/// fftw_mpi_cleanup (which also ends every FFTW plan: make the Environment before any plan, as main's
+/// first object) and MPI_Finalize. One per process.
 class Environment {
  public:
   Environment(int& argc, char**& argv);

@@ -6,8 +6,9 @@
 //   periodic:  fftw_mpi_plan_many_dft_r2c / c2r.
 // The forward transform leaves its output transposed (FFTW_MPI_TRANSPOSED_OUT: the two slowest axes
 // swapped, distributed along the second), the division by λ runs there, and the backward transform takes
-// it back (FFTW_MPI_TRANSPOSED_IN): one global transposition per transform, not two. Every rank calls
-// solve_in_place and apply together (they are collective).
+// it back (FFTW_MPI_TRANSPOSED_IN): one global transposition per transform, not two. The constructor,
+// the destructor, solve_in_place and apply are collective: every rank of the communicator calls them, in
+// the same order (a rank that fails alone leaves the others waiting).
 #include <memory>
 
 #include "fictus/grid/fast_solver.hpp"
