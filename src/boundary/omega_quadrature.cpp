@@ -137,6 +137,11 @@ void for_each_omega_point_in_voxel(const Grid3& grid, const Surface& gamma, cons
 
 void for_each_omega_row(const Grid3& grid, const Surface& gamma, int q, const Execution& execution,
                         const OmegaRowVisitor& visit) {
+  for_each_omega_row(grid, gamma, q, execution, grid.every_layer(), visit);
+}
+
+void for_each_omega_row(const Grid3& grid, const Surface& gamma, int q, const Execution& execution, const Slab& slab,
+                        const OmegaRowVisitor& visit) {
   const GaussRule& rule = gauss_legendre(q);
   const auto [first, last] = bounding_voxels(grid, gamma);
   std::atomic<bool> stop = false;
@@ -147,7 +152,7 @@ void for_each_omega_row(const Grid3& grid, const Surface& gamma, int q, const Ex
     for (int iz = first[2]; iz <= last[2]; ++iz) {
       const int thread = omp_get_thread_num();
       if (thread == 0 && execution.interrupt_requested()) stop = true;
-      if (stop) continue;
+      if (stop || !slab.holds(grid.cell_layer(iz))) continue;
       for (int iy = first[1]; iy <= last[1]; ++iy) {
         row.clear();
         for (int ix = first[0]; ix <= last[0]; ++ix) {

@@ -21,7 +21,11 @@ GradientField numerical_gradient(ScalarField u, double scale) {
 }
 
 Q1Sample sample_q1(const Grid2& grid, const GridVector& u_h, int ix, int iy, double x, double y) {
-  auto node = [&](int i, int j) { return grid.has_unknown(i, j) ? u_h[grid.index(i, j)] : 0.0; };
+  return sample_q1(grid, u_h, grid.every_layer(), ix, iy, x, y);
+}
+
+Q1Sample sample_q1(const Grid2& grid, const GridVector& u_h, const Slab& slab, int ix, int iy, double x, double y) {
+  auto node = [&](int i, int j) { return grid.has_unknown(i, j) ? u_h[grid.slab_index({i, j}, slab)] : 0.0; };
   const double h = grid.h();
   const Q1Element<2>::Sample s =
       Q1Element<2>::interpolate(node(ix, iy), node(ix + 1, iy), node(ix, iy + 1), node(ix + 1, iy + 1),
@@ -69,8 +73,9 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
 }
 
 void for_each_omega_sample(const GridVector& u_h, const CurveGridIntersection& gamma, int q, const Execution& execution,
-                           const OmegaSampleVisitor<2>& visit) {
+                           const OmegaSampleVisitor<2>& visit, std::optional<Slab> slab) {
   const Grid2& grid = gamma.grid();
+  const Slab s = slab.value_or(grid.every_layer());
 #pragma omp parallel num_threads(execution.threads())
   {
     const int thread = omp_get_thread_num();
@@ -78,15 +83,16 @@ void for_each_omega_sample(const GridVector& u_h, const CurveGridIntersection& g
     OmegaSamples<2> row;
 #pragma omp for schedule(dynamic, 8)
     for (int iy = 0; iy < grid.ny(); ++iy) {
+      if (!s.holds(grid.cell_layer(iy))) continue;
       gamma.row_rule(iy, q, points);
       const std::size_t n = points.size();
       if (n == 0) continue;
       for (auto* v : {&row.x[0], &row.x[1], &row.weight, &row.value, &row.gradient[0], &row.gradient[1]}) v->resize(n);
       for (std::size_t k = 0; k < n; ++k) {
         const CellQuadraturePoint& p = points[k];
-        const Q1Sample s = sample_q1(grid, u_h, p.ix, iy, p.x, p.y);
-        row.x[0][k] = p.x, row.x[1][k] = p.y, row.weight[k] = p.weight, row.value[k] = s.value;
-        row.gradient[0][k] = s.gradient.x, row.gradient[1][k] = s.gradient.y;
+        const Q1Sample sample = sample_q1(grid, u_h, s, p.ix, iy, p.x, p.y);
+        row.x[0][k] = p.x, row.x[1][k] = p.y, row.weight[k] = p.weight, row.value[k] = sample.value;
+        row.gradient[0][k] = sample.gradient.x, row.gradient[1][k] = sample.gradient.y;
       }
       visit(thread, row);
     }
@@ -191,12 +197,12 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
 namespace {
 
 /// û at the eight nodes of `cell` (local node k as in Q1Element; 0 where a node has no unknown).
-std::array<double, 8> nodal_values(const Grid3& grid, const GridVector& u, const Grid3::Index& cell) {
+std::array<double, 8> nodal_values(const Grid3& grid, const GridVector& u, const Slab& slab, const Grid3::Index& cell) {
   std::array<double, 8> v;
   for (int k = 0; k < 8; ++k) {
     const Grid3::Index node{cell[0] + Q1Element<3>::offset(k, 0), cell[1] + Q1Element<3>::offset(k, 1),
                             cell[2] + Q1Element<3>::offset(k, 2)};
-    v[std::size_t(k)] = grid.has_unknown(node) ? u[grid.index(node)] : 0.0;
+    v[std::size_t(k)] = grid.has_unknown(node) ? u[grid.slab_index(node, slab)] : 0.0;
   }
   return v;
 }
@@ -244,9 +250,10 @@ ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surfac
 }
 
 void for_each_omega_sample(const GridVector& u_h, const Grid3& grid, const Surface& gamma, int q,
-                           const Execution& execution, const OmegaSampleVisitor<3>& visit) {
+                           const Execution& execution, const OmegaSampleVisitor<3>& visit, std::optional<Slab> slab) {
+  const Slab s = slab.value_or(grid.every_layer());
   std::vector<OmegaSamples<3>> rows(std::size_t(execution.threads()));
-  for_each_omega_row(grid, gamma, q, execution, [&](int thread, const std::vector<OmegaPoint>& points) {
+  for_each_omega_row(grid, gamma, q, execution, s, [&](int thread, const std::vector<OmegaPoint>& points) {
     OmegaSamples<3>& row = rows[std::size_t(thread)];
     const std::size_t n = points.size();
     for (auto* v : {&row.x[0], &row.x[1], &row.x[2], &row.weight, &row.value, &row.gradient[0], &row.gradient[1],
@@ -255,7 +262,7 @@ void for_each_omega_sample(const GridVector& u_h, const Grid3& grid, const Surfa
     std::array<double, 8> nodal{};
     for (std::size_t k = 0; k < n; ++k) {
       const OmegaPoint& p = points[k];
-      if (k == 0 || p.cell != points[k - 1].cell) nodal = nodal_values(grid, u_h, p.cell);
+      if (k == 0 || p.cell != points[k - 1].cell) nodal = nodal_values(grid, u_h, s, p.cell);
       Point3 xi;
       for (int d = 0; d < 3; ++d) xi[d] = (p.x[d] - grid.coordinate(d, p.cell[d])) / grid.h();
       const auto [value, slope] = Q1Element<3>::interpolate(nodal, xi, grid.h());

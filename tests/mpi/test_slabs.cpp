@@ -5,8 +5,13 @@
 
 #include <cmath>
 
+#include "fictus/boundary/curve.hpp"
+#include "fictus/boundary/curve_grid_intersection.hpp"
+#include "fictus/boundary/surface.hpp"
 #include "fictus/grid/load_vector.hpp"
+#include "fictus/mpi/next_layer.hpp"
 #include "fictus/mpi/slab_solver.hpp"
+#include "fictus/solve/error_norms.hpp"
 #include "scattered_rows.hpp"
 
 namespace {
@@ -163,6 +168,62 @@ TEST(SlabSteps, LoadSolveAndReadingsMatchOneProcess) {
     check_steps<2>(box2, 16, Boundary::periodic, c);
     check_steps<3>(box3, 16, Boundary::dirichlet, c);
     check_steps<3>(box3, 16, Boundary::periodic, c);
+  }
+}
+
+/// Σ w, Σ w·û², Σ w·|∇û|² over ω's samples, with the sampler given (whole grid or a slab).
+template <int dim, class Sampler>
+std::array<double, 3> omega_sums(int threads, const Sampler& for_each_sample) {
+  std::vector<std::array<double, 3>> per_thread(std::size_t(threads), std::array<double, 3>{});
+  for_each_sample([&](int thread, const fictus::OmegaSamples<dim>& row) {
+    std::array<double, 3>& s = per_thread[std::size_t(thread)];
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      double g2 = 0;
+      for (int d = 0; d < dim; ++d) g2 += row.gradient[d][k] * row.gradient[d][k];
+      s[0] += row.weight[k], s[1] += row.weight[k] * row.value[k] * row.value[k], s[2] += row.weight[k] * g2;
+    }
+  });
+  std::array<double, 3> total{};
+  for (const auto& s : per_thread)
+    for (int c = 0; c < 3; ++c) total[std::size_t(c)] += s[std::size_t(c)];
+  return total;
+}
+
+/// The integrals over ω of a grid field on the ranks' slabs (each with the next layer from its
+/// neighbour) against one process.
+template <int dim, class Sample>
+void check_omega(const fictus::Grid<dim>& grid, const Sample& sample) {
+  const Communicator comm;
+  const Slab slab = fictus::mpi::default_slab(grid.layers(), comm.rank(), comm.size());
+  GridVector u(grid.n_unknowns());
+  for (std::size_t i = 0; i < u.size(); ++i) u[i] = std::sin(0.37 * double(i)) + 0.5;
+  const std::array<double, 3> whole = omega_sums<dim>(2, [&](const auto& visit) { sample(u, visit, std::nullopt); });
+  const std::size_t offset = grid.slab_offset(slab);
+  const GridVector local(u.begin() + std::ptrdiff_t(offset), u.begin() + std::ptrdiff_t(offset + grid.slab_size(slab)));
+  const GridVector extended = fictus::mpi::with_next_layer(grid, slab, local, comm);
+  std::array<double, 3> parts = omega_sums<dim>(2, [&](const auto& visit) { sample(extended, visit, slab); });
+  comm.sum(parts.data(), 3);
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(parts[std::size_t(c)], whole[std::size_t(c)], 1e-12 * whole[std::size_t(c)]) << "sum " << c;
+  EXPECT_GT(whole[1], 0.0);
+}
+
+TEST(SlabSteps, IntegralsOverOmegaMatchOneProcess) {
+  const fictus::Execution execution(2);
+  for (auto boundary : {Boundary::dirichlet, Boundary::periodic}) {
+    // 70 layers (periodic) or 69; ω reaches the last cells (h = 1/32 from the top), where a periodic
+    // box's last rank reads layer 0 from the first.
+    const fictus::Grid<2> grid2(box2, 16 * 4, boundary);
+    const fictus::Ellipse circle({0.1, 0.64}, 0.6, 0.6);
+    const fictus::CurveGridIntersection curve(circle, grid2);
+    check_omega<2>(grid2, [&](const GridVector& v, const fictus::OmegaSampleVisitor<2>& visit, std::optional<Slab> s) {
+      fictus::for_each_omega_sample(v, curve, 3, execution, visit, s);
+    });
+    const fictus::Grid<3> grid3(box3, 16, boundary);
+    const fictus::Ellipsoid ellipsoid({0.05, 0.2, 1.14}, {0.5, 0.4, 0.6});  // to z = 1.74 (h = 1/8)
+    check_omega<3>(grid3, [&](const GridVector& v, const fictus::OmegaSampleVisitor<3>& visit, std::optional<Slab> s) {
+      fictus::for_each_omega_sample(v, grid3, ellipsoid, 3, execution, visit, s);
+    });
   }
 }
 

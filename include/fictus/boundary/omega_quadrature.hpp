@@ -29,6 +29,9 @@ struct OmegaPoint {
 using OmegaRowVisitor = std::function<void(int thread, const std::vector<OmegaPoint>& row)>;
 void for_each_omega_row(const Grid3& grid, const Surface& gamma, int q, const Execution& execution,
                         const OmegaRowVisitor& visit);
+/// The same for the voxel layers that belong to the slab's layers only (Grid::cell_layer).
+void for_each_omega_row(const Grid3& grid, const Surface& gamma, int q, const Execution& execution, const Slab& slab,
+                        const OmegaRowVisitor& visit);
 
 /// May γ come within `radius` of `center`? (|level| ≤ 2·radius·|∇level| there: the distance is about
 /// |level|/|∇level| near γ, with a factor 2 to spare.)

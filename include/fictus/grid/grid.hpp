@@ -83,6 +83,18 @@ class Grid {
   /// The layer of a node's unknown (its slowest coordinate, wrapped on a periodic box); precondition
   /// has_unknown(i).
   int layer(int slowest) const { return periodic() ? wrap(slowest, n_[dim - 1]) : slowest - 1; }
+  /// The layer that cell layer c (the cells between node layers c and c + 1 of the slowest axis) belongs
+  /// to: its lower nodes' (layer 0 for the Dirichlet box's first cells, whose lower nodes carry no
+  /// unknown). A rank of a distributed run visits the cells of its layers, which read its layers and the
+  /// next one.
+  int cell_layer(int c) const { return periodic() ? c : std::max(c - 1, 0); }
+  /// Where node i's unknown is in a vector that holds slab s's layers and then the next layer (the next
+  /// after a periodic box's last layer is layer 0): the whole vector's index for every_layer();
+  /// precondition has_unknown(i) and i's layer held there.
+  std::size_t slab_index(const Index& i, const Slab& s) const {
+    const int l = layer(i[dim - 1]);
+    return index(i) - std::size_t(s.first) * layer_size() + (l < s.first ? n_unknowns() : 0);
+  }
   std::size_t n_nodes() const {
     std::size_t count = 1;
     for (int d = 0; d < dim; ++d) count *= std::size_t(n_[d] + 1);

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "fictus/grid/execution.hpp"
@@ -48,6 +49,8 @@ struct Q1Sample {
   Point2 gradient;
 };
 Q1Sample sample_q1(const Grid2& grid, const GridVector& u_h, int ix, int iy, double x, double y);
+/// The same with u_h a slab's layers and the next one (Grid::slab_index).
+Q1Sample sample_q1(const Grid2& grid, const GridVector& u_h, const Slab& slab, int ix, int iy, double x, double y);
 
 /// 3-D: errors of the trilinear û against `exact` in ω (L², H¹) and on γ from the points
 /// (Σ_p |patch p|·(û − u)(x_p)²)^½, absolute and relative.
@@ -72,10 +75,14 @@ struct OmegaSamples {
 /// Called from `execution.threads()` threads at once, `thread` in [0, threads): keep sums per thread.
 template <int dim>
 using OmegaSampleVisitor = std::function<void(int thread, const OmegaSamples<dim>& row)>;
+/// With `slab`: only the cells of the slab's layers (Grid::cell_layer), u_h holding the slab's layers and
+/// the next one (Grid::slab_index): a rank's part of the integrals, which a distributed run adds over
+/// its ranks.
 void for_each_omega_sample(const GridVector& u_h, const CurveGridIntersection& gamma, int q, const Execution& execution,
-                           const OmegaSampleVisitor<2>& visit);
+                           const OmegaSampleVisitor<2>& visit, std::optional<Slab> slab = std::nullopt);
 void for_each_omega_sample(const GridVector& u_h, const Grid3& grid, const Surface& gamma, int q,
-                           const Execution& execution, const OmegaSampleVisitor<3>& visit);
+                           const Execution& execution, const OmegaSampleVisitor<3>& visit,
+                           std::optional<Slab> slab = std::nullopt);
 
 /// The Q1 field u_h of `grid` at the points x (one array per coordinate; points outside the box take
 /// the nearest cell's extension), into `out`.
