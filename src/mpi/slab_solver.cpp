@@ -6,6 +6,7 @@
 #include <array>
 #include <complex>
 #include <cstring>
+#include <mutex>
 #include <new>
 #include <stdexcept>
 
@@ -27,8 +28,9 @@ struct SlabSolver<dim>::Plans {
   std::array<ptrdiff_t, dim> n{};         // the transform's sizes (unknowns per axis), FFTW order
   std::array<ptrdiff_t, dim> spectrum{};  // the spectrum's sizes, FFTW order (periodic: last n/2 + 1)
   ptrdiff_t spectral_first = 0, spectral_count = 0;
-  ptrdiff_t allocation = 0;  // doubles of the workspace
-  double* work = nullptr;
+  ptrdiff_t allocation = 0;  // doubles of FFTW-MPI's local array
+  double* work = nullptr;    // made at the first solve that cannot run on its caller's vector
+  std::once_flag work_made;
   fftw_plan forward = nullptr, backward = nullptr;
   ~Plans() {
     std::lock_guard lock(detail::planner_mutex());
@@ -63,25 +65,31 @@ SlabSolver<dim>::SlabSolver(const Grid<dim>& grid, double c, const Communicator&
   std::lock_guard lock(detail::planner_mutex());
   detail::init_threads_once();
   fftw_plan_with_nthreads(threads_ < 1 ? 1 : threads_);
-  p.work = fftw_alloc_real(std::size_t(p.allocation));
-  if (p.work == nullptr) throw std::bad_alloc();
+  // Planned on a scratch array (FFTW_ESTIMATE does not touch it), executed on the caller's vector or the
+  // workspace: both aligned as FFTW's allocator aligns.
+  struct Scratch {
+    double* data;
+    ~Scratch() { fftw_free(data); }
+  } scratch{fftw_alloc_real(std::size_t(p.allocation))};
+  if (scratch.data == nullptr) throw std::bad_alloc();
+  double* const planned = scratch.data;
   const unsigned out = FFTW_ESTIMATE | FFTW_MPI_TRANSPOSED_OUT, in = FFTW_ESTIMATE | FFTW_MPI_TRANSPOSED_IN;
   if (periodic) {
-    fftw_complex* spectrum = reinterpret_cast<fftw_complex*>(p.work);
-    p.forward = fftw_mpi_plan_many_dft_r2c(dim, p.n.data(), 1, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, p.work,
+    fftw_complex* spectrum = reinterpret_cast<fftw_complex*>(planned);
+    p.forward = fftw_mpi_plan_many_dft_r2c(dim, p.n.data(), 1, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, planned,
                                            spectrum, comm.get(), out);
     p.backward = fftw_mpi_plan_many_dft_c2r(dim, p.n.data(), 1, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK,
-                                            spectrum, p.work, comm.get(), in);
+                                            spectrum, planned, comm.get(), in);
   } else {
     const std::array<fftw_r2r_kind, dim> kinds = [] {
       std::array<fftw_r2r_kind, dim> k;
       k.fill(FFTW_RODFT00);
       return k;
     }();
-    p.forward = fftw_mpi_plan_many_r2r(dim, p.n.data(), 1, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, p.work,
-                                       p.work, comm.get(), kinds.data(), out);
-    p.backward = fftw_mpi_plan_many_r2r(dim, p.n.data(), 1, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, p.work,
-                                        p.work, comm.get(), kinds.data(), in);
+    p.forward = fftw_mpi_plan_many_r2r(dim, p.n.data(), 1, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, planned,
+                                       planned, comm.get(), kinds.data(), out);
+    p.backward = fftw_mpi_plan_many_r2r(dim, p.n.data(), 1, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, planned,
+                                        planned, comm.get(), kinds.data(), in);
   }
   if (p.forward == nullptr || p.backward == nullptr)
     throw std::runtime_error("FFTW-MPI: could not plan the transforms");
@@ -92,11 +100,19 @@ SlabSolver<dim>::~SlabSolver() = default;
 
 template <int dim>
 std::size_t SlabSolver<dim>::workspace_bytes() const {
-  return std::size_t(plans_->allocation) * sizeof(double);
+  return plans_->work != nullptr ? std::size_t(plans_->allocation) * sizeof(double) : 0;
 }
 
 template <int dim>
-void SlabSolver<dim>::scale(bool inverse) const {
+GridVector SlabSolver<dim>::make_vector() const {
+  GridVector v;
+  if (!grid_.periodic()) v.reserve(std::max(this->local_size(), std::size_t(plans_->allocation)));
+  v.resize(this->local_size(), 0.0);
+  return v;
+}
+
+template <int dim>
+void SlabSolver<dim>::scale(double* data, bool inverse) const {
   const Plans& p = *plans_;
   // The transposed spectrum's axes, slowest first: FFTW's 1, 0, 2, …; its rows run along the last. Each
   // spectral axis is the grid axis dim − 1 − (FFTW axis): in 3-D the rows run along grid axis 0, in 2-D
@@ -128,7 +144,7 @@ void SlabSolver<dim>::scale(bool inverse) const {
       K = K * m + M * k;
       M *= m;
     }
-    double* row = plans_->work + std::size_t(r) * std::size_t(row_length) * std::size_t(width);
+    double* row = data + std::size_t(r) * std::size_t(row_length) * std::size_t(width);
     for (ptrdiff_t q = 0; q < row_length; ++q) {
       const double lambda = k_inner[std::size_t(q)] * M + m_inner[std::size_t(q)] * K + c * m_inner[std::size_t(q)] * M;
       const double factor = inverse ? (lambda > 0 ? norm / lambda : 0.0) : norm * lambda;  // λ = 0: constants, c = 0
@@ -149,17 +165,35 @@ void SlabSolver<dim>::transform(GridVector& v, bool inverse) const {
     for (std::size_t r = 0; r < rows; ++r)
       std::memcpy(to + r * to_stride, from + r * from_stride, row * sizeof(double));
   };
-  copy_rows(v.data(), row, p.work, padded);
+  // A Dirichlet box's slab is FFTW-MPI's input layout: in place on the caller's vector where its
+  // capacity holds FFTW-MPI's local array (make_vector), else through the workspace.
+  const std::size_t allocation = std::size_t(p.allocation), local = v.size();
+  const bool in_place = !grid_.periodic() && v.capacity() >= allocation;
+  double* data = nullptr;
+  if (in_place) {
+    v.resize(std::max(local, allocation), 0.0);
+    data = v.data();
+  } else {
+    std::call_once(plans_->work_made, [&] {
+      plans_->work = fftw_alloc_real(allocation);
+      if (plans_->work == nullptr) throw std::bad_alloc();
+    });
+    data = p.work;
+    copy_rows(v.data(), row, data, padded);
+  }
   if (grid_.periodic())
-    fftw_mpi_execute_dft_r2c(p.forward, p.work, reinterpret_cast<fftw_complex*>(p.work));
+    fftw_mpi_execute_dft_r2c(p.forward, data, reinterpret_cast<fftw_complex*>(data));
   else
-    fftw_mpi_execute_r2r(p.forward, p.work, p.work);
-  scale(inverse);
+    fftw_mpi_execute_r2r(p.forward, data, data);
+  scale(data, inverse);
   if (grid_.periodic())
-    fftw_mpi_execute_dft_c2r(p.backward, reinterpret_cast<fftw_complex*>(p.work), p.work);
+    fftw_mpi_execute_dft_c2r(p.backward, reinterpret_cast<fftw_complex*>(data), data);
   else
-    fftw_mpi_execute_r2r(p.backward, p.work, p.work);
-  copy_rows(p.work, padded, v.data(), row);
+    fftw_mpi_execute_r2r(p.backward, data, data);
+  if (in_place)
+    v.resize(local);
+  else
+    copy_rows(data, padded, v.data(), row);
 }
 
 template <int dim>

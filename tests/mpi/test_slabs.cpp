@@ -3,6 +3,7 @@
 // its own layers. The errors are reduced over the ranks before each check, so all ranks check the same.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "fictus/boundary/curve.hpp"
@@ -58,8 +59,15 @@ void check(const fictus::Box<dim>& box, int n0, Boundary boundary, double c, int
   GridVector whole = r,
              local(r.begin() + std::ptrdiff_t(offset), r.begin() + std::ptrdiff_t(offset + slab_solver.local_size()));
   serial->solve_in_place(whole);
+  GridVector in_place = slab_solver.make_vector();  // transformed where it lies (Dirichlet)
+  std::copy(local.begin(), local.end(), in_place.begin());
   slab_solver.solve_in_place(local);
   EXPECT_LT(relative_difference(local, whole, offset, comm), 1e-12) << "solve, c = " << c;
+  const double* storage = in_place.data();
+  slab_solver.solve_in_place(in_place);
+  EXPECT_EQ(in_place.size(), local.size());
+  EXPECT_EQ(in_place.data(), storage);  // no new storage
+  EXPECT_LT(relative_difference(in_place, whole, offset, comm), 1e-12) << "solve in place, c = " << c;
 
   GridVector y_whole, y_local,
       x_local(r.begin() + std::ptrdiff_t(offset), r.begin() + std::ptrdiff_t(offset + slab_solver.local_size()));

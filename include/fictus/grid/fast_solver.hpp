@@ -39,6 +39,9 @@ class FastSolver {
   /// vectors solve_in_place and apply take.
   virtual Slab slab() const { return grid().every_layer(); }
   std::size_t local_size() const { return grid().slab_size(slab()); }
+  /// A vector of local_size() zeros for solve_in_place (a solver may reserve the capacity it transforms
+  /// in, as the one on FFTW-MPI slabs does).
+  virtual GridVector make_vector() const { return GridVector(local_size(), 0.0); }
   /// Overwrites r (size local_size(): n_unknowns when serial) with A⁻¹r (A⁺r when singular()).
   virtual void solve_in_place(GridVector& r) const = 0;
   /// The same for r zero outside the columns of `load`, exact where `wanted` says and unspecified

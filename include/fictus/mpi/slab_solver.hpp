@@ -33,16 +33,19 @@ class SlabSolver final : public FastSolver<dim> {
   const Grid<dim>& grid() const override { return grid_; }
   double c() const override { return symbol_.c(); }
   Slab slab() const override { return slab_; }
-  /// r: this rank's layers (local_size() entries).
+  /// r: this rank's layers (local_size() entries). On a Dirichlet box a vector from make_vector() is
+  /// transformed where it lies (its capacity holds FFTW-MPI's local array); any other goes through a
+  /// workspace of that size, made at the first such call and kept.
   void solve_in_place(GridVector& r) const override;
   void apply(const GridVector& x, GridVector& y) const override;
-  /// Bytes of the transforms' workspace on this rank (FFTW-MPI's local allocation).
+  GridVector make_vector() const override;
+  /// Bytes of the workspace on this rank (0 while every solve ran in place).
   std::size_t workspace_bytes() const;
 
  private:
   struct Plans;
   void transform(GridVector& v, bool inverse) const;
-  void scale(bool inverse) const;
+  void scale(double* data, bool inverse) const;
   Grid<dim> grid_;
   Q1Symbol<dim> symbol_;
   int threads_;
