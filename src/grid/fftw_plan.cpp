@@ -61,38 +61,74 @@ R2rLines::~R2rLines() {
 
 void R2rLines::execute(double* first) const { fftw_execute_r2r(plan_, first, first); }
 
-RealDft::RealDft(const std::vector<int>& shape, int threads) {
+namespace {
+/// Adjacent lines along the slowest axis per complex DFT plan of RealDft (two cache lines of complex).
+constexpr int dft_chunk = 8;
+}  // namespace
+
+RealDft::RealDft(const std::vector<int>& shape, int threads) : threads_(threads < 1 ? 1 : threads) {
+  if (shape.size() < 2) throw std::invalid_argument("RealDft: needs at least two axes");
   std::lock_guard lock(planner_mutex());
   init_threads_once();
-  fftw_plan_with_nthreads(threads < 1 ? 1 : threads);
-  const std::size_t n_real = product(shape);
-  const std::size_t n_complex = n_real / std::size_t(shape.back()) * std::size_t(shape.back() / 2 + 1);
-  double* real = static_cast<double*>(fftw_malloc(sizeof(double) * n_real));
-  fftw_complex* spectrum = static_cast<fftw_complex*>(fftw_malloc(sizeof(fftw_complex) * n_complex));
+  const int layers = shape.front(), rank = int(shape.size()) - 1;
+  const std::vector<int> inner(shape.begin() + 1, shape.end());
+  const std::size_t real_layer = product(inner);
+  layer_ = real_layer / std::size_t(inner.back()) * std::size_t(inner.back() / 2 + 1);
+  double* real = static_cast<double*>(fftw_malloc(sizeof(double) * real_layer * std::size_t(layers)));
+  fftw_complex* spectrum = static_cast<fftw_complex*>(fftw_malloc(sizeof(fftw_complex) * layer_ * std::size_t(layers)));
   if (real == nullptr || spectrum == nullptr) {
     fftw_free(real);
     fftw_free(spectrum);
     throw std::bad_alloc();
   }
-  forward_ = fftw_plan_dft_r2c(int(shape.size()), shape.data(), real, spectrum, FFTW_ESTIMATE);
-  backward_ = fftw_plan_dft_c2r(int(shape.size()), shape.data(), spectrum, real, FFTW_ESTIMATE);
+  fftw_plan_with_nthreads(threads_);
+  layers_forward_ = fftw_plan_many_dft_r2c(rank, inner.data(), layers, real, nullptr, 1, int(real_layer), spectrum,
+                                           nullptr, 1, int(layer_), FFTW_ESTIMATE);
+  layers_backward_ = fftw_plan_many_dft_c2r(rank, inner.data(), layers, spectrum, nullptr, 1, int(layer_), real,
+                                            nullptr, 1, int(real_layer), FFTW_ESTIMATE);
+  fftw_plan_with_nthreads(1);
+  const int narrow = int(layer_ % dft_chunk);
+  auto lines = [&](int howmany, int sign) {
+    return fftw_plan_many_dft(1, &layers, howmany, spectrum, nullptr, int(layer_), 1, spectrum, nullptr, int(layer_), 1,
+                              sign, FFTW_ESTIMATE | FFTW_UNALIGNED);
+  };
+  if (layer_ >= std::size_t(dft_chunk))
+    lines_forward_ = lines(dft_chunk, FFTW_FORWARD), lines_backward_ = lines(dft_chunk, FFTW_BACKWARD);
+  if (narrow > 0) narrow_forward_ = lines(narrow, FFTW_FORWARD), narrow_backward_ = lines(narrow, FFTW_BACKWARD);
   fftw_free(real);
   fftw_free(spectrum);
-  if (forward_ == nullptr || backward_ == nullptr) throw std::runtime_error("FFTW: could not plan the real DFT");
+  const bool lines_ok = (layer_ < std::size_t(dft_chunk) || (lines_forward_ && lines_backward_)) &&
+                        (narrow == 0 || (narrow_forward_ && narrow_backward_));
+  if (layers_forward_ == nullptr || layers_backward_ == nullptr || !lines_ok)
+    throw std::runtime_error("FFTW: could not plan the real DFT");
 }
 
 RealDft::~RealDft() {
   std::lock_guard lock(planner_mutex());
-  fftw_destroy_plan(forward_);
-  fftw_destroy_plan(backward_);
+  for (fftw_plan p :
+       {layers_forward_, layers_backward_, lines_forward_, lines_backward_, narrow_forward_, narrow_backward_})
+    if (p != nullptr) fftw_destroy_plan(p);
+}
+
+void RealDft::along_slowest(std::complex<double>* spectrum, bool forward) const {
+  const std::ptrdiff_t chunks = std::ptrdiff_t((layer_ + dft_chunk - 1) / dft_chunk);
+  const fftw_plan wide = forward ? lines_forward_ : lines_backward_,
+                  narrow = forward ? narrow_forward_ : narrow_backward_;
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (std::ptrdiff_t c = 0; c < chunks; ++c) {
+    fftw_complex* first = reinterpret_cast<fftw_complex*>(spectrum + c * dft_chunk);
+    fftw_execute_dft(std::size_t(c + 1) * dft_chunk <= layer_ ? wide : narrow, first, first);
+  }
 }
 
 void RealDft::forward(double* real, std::complex<double>* spectrum) const {
-  fftw_execute_dft_r2c(forward_, real, reinterpret_cast<fftw_complex*>(spectrum));
+  fftw_execute_dft_r2c(layers_forward_, real, reinterpret_cast<fftw_complex*>(spectrum));
+  along_slowest(spectrum, true);
 }
 
 void RealDft::backward(std::complex<double>* spectrum, double* real) const {
-  fftw_execute_dft_c2r(backward_, reinterpret_cast<fftw_complex*>(spectrum), real);
+  along_slowest(spectrum, false);
+  fftw_execute_dft_c2r(layers_backward_, reinterpret_cast<fftw_complex*>(spectrum), real);
 }
 
 }  // namespace fictus::detail

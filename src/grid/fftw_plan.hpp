@@ -51,8 +51,12 @@ class R2rLines {
   fftw_plan plan_ = nullptr;
 };
 
-/// Out-of-place real DFT pair (FFTW r2c / c2r, unnormalized) of a row-major real array of shape
-/// `shape` and its half spectrum (the fastest axis has shape.back()/2 + 1 entries).
+/// Out-of-place real DFT pair (unnormalized) of a row-major real array of shape `shape` (at least two
+/// axes) and its half spectrum (the fastest axis has shape.back()/2 + 1 entries). Made as layers: one
+/// FFTW r2c/c2r of the other axes for every layer of the slowest axis, then FFTW's complex DFTs along the
+/// slowest axis on chunks of adjacent lines, single-threaded plans run on `threads` threads. FFTW's
+/// estimated plan for the whole array strides along the slowest axis unbuffered: at 256³ it takes 3×
+/// as long (bench/results/2026-11-28-mpi-fast-solve.md).
 class RealDft {
  public:
   RealDft(const std::vector<int>& shape, int threads);
@@ -64,7 +68,12 @@ class RealDft {
   void backward(std::complex<double>* spectrum, double* real) const;  // overwrites `spectrum`
 
  private:
-  fftw_plan forward_ = nullptr, backward_ = nullptr;
+  void along_slowest(std::complex<double>* spectrum, bool forward) const;
+  fftw_plan layers_forward_ = nullptr, layers_backward_ = nullptr;
+  fftw_plan lines_forward_ = nullptr, lines_backward_ = nullptr;    // `chunk` lines
+  fftw_plan narrow_forward_ = nullptr, narrow_backward_ = nullptr;  // the last, fewer
+  std::size_t layer_ = 0;  // complex entries per layer of the spectrum (the lines along the slowest axis)
+  int threads_ = 1;
 };
 
 }  // namespace fictus::detail
