@@ -11,7 +11,7 @@ import sys
 
 LAYERS = ["grid", "boundary", "solve"]
 BESIDE = ["io", "mpi"]
-INCLUDE = re.compile(r'#include\s+"(?:fictus/)?((?:\w+/)?\w+)\.hpp"')
+INCLUDE = re.compile(r'#include\s+"(?:\.\./)?(?:fictus/)?((?:\w+/)?\w+)\.hpp"')  # "../grid/x.hpp" too
 
 
 def layer_of(path):
