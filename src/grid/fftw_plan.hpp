@@ -69,6 +69,7 @@ class RealDft {
 
  private:
   void along_slowest(std::complex<double>* spectrum, bool forward) const;
+  void destroy_plans();  // under the planner's lock
   fftw_plan layers_forward_ = nullptr, layers_backward_ = nullptr;
   fftw_plan lines_forward_ = nullptr, lines_backward_ = nullptr;    // `chunk` lines
   fftw_plan narrow_forward_ = nullptr, narrow_backward_ = nullptr;  // the last, fewer

@@ -93,6 +93,12 @@ SlabSolver<dim>::SlabSolver(const Grid<dim>& grid, double c, const Communicator&
   }
   if (p.forward == nullptr || p.backward == nullptr)
     throw std::runtime_error("FFTW-MPI: could not plan the transforms");
+  // The periodic box's padded rows always go through the workspace: made here, every rank's success
+  // agreed, so that all ranks throw or none (a Dirichlet box makes it at the first solve that needs it).
+  if (periodic) {
+    std::call_once(p.work_made, [&] { p.work = fftw_alloc_real(std::size_t(p.allocation)); });
+    if (comm.max(p.work == nullptr ? 1.0 : 0.0) != 0.0) throw std::bad_alloc();
+  }
 }
 
 template <int dim>

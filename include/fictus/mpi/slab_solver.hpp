@@ -33,9 +33,10 @@ class SlabSolver final : public FastSolver<dim> {
   const Grid<dim>& grid() const override { return grid_; }
   double c() const override { return symbol_.c(); }
   Slab slab() const override { return slab_; }
-  /// r: this rank's layers (local_size() entries). On a Dirichlet box a vector from make_vector() is
-  /// transformed where it lies (its capacity holds FFTW-MPI's local array); any other goes through a
-  /// workspace of that size, made at the first such call and kept.
+  /// r: this rank's layers (local_size() entries). On a Dirichlet box a vector whose capacity holds
+  /// FFTW-MPI's local array (make_vector()'s do; a copy of one need not) is transformed where it lies;
+  /// any other goes through a workspace of that size, made at the first such call and kept. A periodic
+  /// box always uses the workspace, made by the constructor.
   void solve_in_place(GridVector& r) const override;
   void apply(const GridVector& x, GridVector& y) const override;
   GridVector make_vector() const override;
