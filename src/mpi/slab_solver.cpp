@@ -143,16 +143,10 @@ void SlabSolver<dim>::scale(double* data, bool inverse) const {
     } else {
       mode[0] = int(p.spectral_first + r);
     }
-    double K = 0, M = 1;  // Σ_d k_d Π_{e≠d} m_e and Π m over the other axes
-    for (int d = 0; d < dim; ++d) {
-      if (d == inner_axis) continue;
-      const double k = symbol_.axis(d).stiffness[std::size_t(mode[d])], m = symbol_.axis(d).mass[std::size_t(mode[d])];
-      K = K * m + M * k;
-      M *= m;
-    }
+    const typename Q1Symbol<dim>::Row factors = symbol_.row_without(inner_axis, mode);
     double* row = data + std::size_t(r) * std::size_t(row_length) * std::size_t(width);
     for (ptrdiff_t q = 0; q < row_length; ++q) {
-      const double lambda = k_inner[std::size_t(q)] * M + m_inner[std::size_t(q)] * K + c * m_inner[std::size_t(q)] * M;
+      const double lambda = Q1Symbol<dim>::lambda(k_inner[std::size_t(q)], m_inner[std::size_t(q)], c, factors);
       const double factor = inverse ? (lambda > 0 ? norm / lambda : 0.0) : norm * lambda;  // λ = 0: constants, c = 0
       for (int w = 0; w < width; ++w) row[q * width + w] *= factor;
     }

@@ -36,12 +36,16 @@ class Q1Symbol {
   struct Row {
     double K = 0, M = 1;
   };
-  Row row(const std::array<int, dim>& slow) const {
+  Row row(const std::array<int, dim>& slow) const { return row_without(0, slow); }
+  /// The same factors for any one axis left out (`inner`: the axis a loop runs along), from the modes
+  /// of the others: λ = lambda(k_inner, m_inner, c, row_without(inner, modes)).
+  Row row_without(int inner, const std::array<int, dim>& modes) const {
     Row r;
-    for (int d = 1; d < dim; ++d) {
-      const double k = axes_[d].stiffness[slow[d]], m = axes_[d].mass[slow[d]];
-      r.K = d == 1 ? k : r.K * m + r.M * k;
-      r.M = d == 1 ? m : r.M * m;
+    for (int d = 0; d < dim; ++d) {
+      if (d == inner) continue;
+      const double k = axes_[d].stiffness[modes[d]], m = axes_[d].mass[modes[d]];
+      r.K = r.K * m + r.M * k;
+      r.M *= m;
     }
     return r;
   }
