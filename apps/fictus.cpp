@@ -5,7 +5,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include <cerrno>
+#include <algorithm>
 #include <chrono>
+#include <exception>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -21,7 +23,10 @@
 #include <vector>
 
 #ifdef FICTUS_WITH_MPI
+#include <fcntl.h>
+
 #include "fictus/mpi/communicator.hpp"
+#include "fictus/mpi/distribution.hpp"
 #endif
 #include "fictus/io/problem_file.hpp"
 #include "fictus/io/process.hpp"
@@ -58,6 +63,53 @@ int report(const std::string& message, int code) {
     if (c == '\n' || c == '\r') c = ' ';
   std::fprintf(stderr, "fictus: error: %s\n", line.c_str());
   return code;
+}
+
+#ifdef FICTUS_WITH_MPI
+/// A run on several MPI ranks: rank 0 prints and writes; the others' stdout and stderr go to /dev/null
+/// (`own_stderr` keeps theirs for a failure of their own), and `errors` is a communicator of its own for
+/// agreeing on a failure (never matched against the solve's collectives).
+struct Ranks {
+  int rank = 0, size = 1;
+  int own_stderr = -1;
+  MPI_Comm errors = MPI_COMM_NULL;
+};
+Ranks ranks;
+
+/// A failure under mpirun. Every check a solve makes on one rank's part is agreed by all ranks
+/// (Distribution::all), so a failure normally reaches every rank at the same step: rank 0 prints the
+/// line, and all return rank 0's exit code. A rank that fails alone (the others do not join within
+/// `wait`) says so on its own stderr and stops every rank with MPI_Abort: none is left waiting.
+int distributed_failure(const std::string& message, int code) {
+  if (ranks.rank == 0) report(message, code);
+  MPI_Request request;
+  MPI_Ibarrier(ranks.errors, &request);
+  const auto start = std::chrono::steady_clock::now();
+  constexpr double wait = 10;  // seconds
+  int joined = 0;
+  while (!joined && std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < wait) {
+    MPI_Test(&request, &joined, MPI_STATUS_IGNORE);
+    if (!joined) usleep(2000);
+  }
+  if (joined) {
+    MPI_Bcast(&code, 1, MPI_INT, 0, ranks.errors);
+    return code;
+  }
+  if (ranks.rank != 0)
+    dprintf(ranks.own_stderr, "fictus: error: rank %d of %d: %s\n", ranks.rank, ranks.size,
+            message.substr(0, 200).c_str());
+  dprintf(ranks.own_stderr, "fictus: error: rank %d failed alone: stopping all %d ranks\n", ranks.rank, ranks.size);
+  MPI_Abort(MPI_COMM_WORLD, code);
+  return code;
+}
+#endif
+
+/// The error line and exit code of a command that failed (under mpirun: agreed by the ranks).
+int fail(const std::string& message, int code) {
+#ifdef FICTUS_WITH_MPI
+  if (ranks.size > 1) return distributed_failure(message, code);
+#endif
+  return report(message, code);
 }
 
 /// CLI11's parse errors in the "<what>: <why>" form of every other error; an unknown flag names the
@@ -287,6 +339,21 @@ fictus::BasicProblemSpec<dim> solve_spec(std::string text, const SolveCommand& c
   return spec;
 }
 
+/// Runs `work` (a check of the file system, the printing and the files) on rank 0 only, and throws on
+/// every rank when it threw there.
+void on_rank_0(const fictus::Distribution& distribution, const std::function<void()>& check) {
+  if (!distribution.distributed()) return check();
+  std::exception_ptr failure;
+  if (distribution.rank() == 0) try {
+      check();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  if (distribution.all(!failure)) return;
+  if (failure) std::rethrow_exception(failure);
+  throw fictus::cli::OutputError("output.dir: refused on rank 0");
+}
+
 /// `fictus solve` in either dimension: the problem, the estimate before any work, the solve with
 /// progress lines on long runs, the summary and the output files.
 template <int dim>
@@ -294,7 +361,9 @@ int run_solve_in(const std::string& text, const SolveCommand& command) {
   const fictus::BasicProblemSpec<dim> spec = solve_spec<dim>(text, command);
   for (const std::string& w : spec.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
   const json input = json::parse(spec.input_json);
-  if (!spec.output.dir.empty()) fictus::cli::check_output_folder(spec.output.dir, spec.output.files);
+  const fictus::Distribution& distribution = *fictus::process_distribution();
+  if (!spec.output.dir.empty())
+    on_rank_0(distribution, [&] { fictus::cli::check_output_folder(spec.output.dir, spec.output.files); });
   fictus::check_memory(spec.problem, spec.options);
   const double seconds = fictus::estimated_seconds(spec.problem, spec.options);
   const bool long_run = seconds >= 2 && !command.quiet;
@@ -307,13 +376,23 @@ int run_solve_in(const std::string& text, const SolveCommand& command) {
   if (long_run) solver.set_progress(progress_lines());
   fictus::BasicSolution<dim> s = solver.solve(spec.problem, spec.options, true, false);
   s.peak_memory_bytes = fictus::peak_memory_bytes();
+  if (distribution.distributed()) {  // each rank's peak; the field on rank 0 for the files
+    std::vector<double> peaks(std::size_t(distribution.size()), 0.0);
+    peaks[std::size_t(distribution.rank())] = double(s.peak_memory_bytes);
+    distribution.sum(peaks);
+    for (double p : peaks) s.rank_peak_memory_bytes.push_back(std::size_t(p));
+    s.peak_memory_bytes = s.rank_peak_memory_bytes[0];
+    const bool field_file = std::count(spec.output.files.begin(), spec.output.files.end(), "solution.vti") > 0;
+    s.u = field_file && !spec.output.dir.empty() ? distribution.gather(s.grid, s.u, false) : fictus::GridVector();
+  }
   for (const std::string& w : s.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
-  if (!s.newton.converged) throw NewtonFailure(fictus::describe_newton_failure(s));
-  if (!command.quiet) print_summary(s);
-  if (spec.output.dir.empty()) return 0;
-  const std::vector<fictus::cli::OutputFile> files = output_files(spec, s, input);
-  fictus::cli::write_output_set(spec.output.dir, files);
-  if (!command.quiet) {
+  if (!s.newton.converged) throw NewtonFailure(fictus::describe_newton_failure(s));  // the same on every rank
+  on_rank_0(distribution, [&] {  // rank 0 speaks and writes for all
+    if (!command.quiet) print_summary(s);
+    if (spec.output.dir.empty()) return;
+    const std::vector<fictus::cli::OutputFile> files = output_files(spec, s, input);
+    fictus::cli::write_output_set(spec.output.dir, files);
+    if (command.quiet) return;
     std::uintmax_t bytes = 0;
     std::error_code error;
     for (const auto& f : files) {
@@ -322,7 +401,7 @@ int run_solve_in(const std::string& text, const SolveCommand& command) {
     }
     std::printf("wrote %zu files to %s/ (%.3g MiB; the VTK files are zlib-compressed)\n", files.size(),
                 spec.output.dir.c_str(), bytes / 1048576.0);
-  }
+  });
   return 0;
 }
 
@@ -421,9 +500,8 @@ int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out,
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // a line at a time, also into a file or a pipe
 #ifdef FICTUS_WITH_MPI
-  // Under mpirun (or srun): MPI for the life of the process. The solve runs on one rank so far, so a run
-  // on more stops at once: the error line once (rank 0), the same exit code on every rank, no rank left
-  // waiting.
+  // Under mpirun (or srun): MPI for the life of the process. On more than one rank, `fictus solve` runs
+  // distributed (the process's Distribution is the ranks' slabs); rank 0 prints and writes.
   std::optional<fictus::mpi::Environment> mpi;
   if (fictus::mpi::launched()) {
     try {
@@ -439,12 +517,23 @@ int main(int argc, char** argv) {
                         "with (another MPI's mpirun, or srun without its MPI plugin)",
                     exit_bad_input);
     if (world.size() > 1) {
-      if (world.rank() == 0)
-        report("started on " + std::to_string(world.size()) +
-                   " MPI ranks: the solve is not distributed yet; run fictus on one rank (without mpirun, or "
-                   "mpirun -np 1 --bind-to none) with solver.threads for the cores",
-               exit_bad_input);
-      return exit_bad_input;
+      ranks.rank = world.rank(), ranks.size = world.size();
+      MPI_Comm_dup(MPI_COMM_WORLD, &ranks.errors);
+      if (ranks.rank != 0) {  // quiet: rank 0 speaks for all
+        std::fflush(stdout), std::fflush(stderr);
+        ranks.own_stderr = dup(STDERR_FILENO);
+        const int null = open("/dev/null", O_WRONLY);
+        if (null >= 0) dup2(null, STDOUT_FILENO), dup2(null, STDERR_FILENO), close(null);
+      } else {
+        ranks.own_stderr = STDERR_FILENO;
+      }
+      fictus::set_process_distribution(std::make_shared<fictus::mpi::SlabDistribution>(world));
+      const std::string command = argc > 1 ? argv[1] : "";
+      if (command == "plot" || command == "reproduce" || command == "sweep")
+        return fail("started on " + std::to_string(ranks.size) + " MPI ranks: only fictus solve runs distributed (" +
+                        (command.empty() ? std::string("no command") : command.substr(0, 40)) +
+                        " runs on one rank: without mpirun, or mpirun -np 1)",
+                    exit_bad_input);
     }
   }
 #endif
@@ -530,7 +619,7 @@ int main(int argc, char** argv) {
 
   const std::set<std::string> commands = {"solve", "plot", "reproduce", "sweep", "options"};
   if (argc > 1 && argv[1][0] != '-' && !commands.count(argv[1]))
-    return report(std::string(argv[1]) + ": not a command (solve, plot, reproduce, sweep, options; see fictus --help)",
+    return fail(std::string(argv[1]) + ": not a command (solve, plot, reproduce, sweep, options; see fictus --help)",
                   exit_bad_input);
   try {
     app.parse(argc, argv);
@@ -545,7 +634,7 @@ int main(int argc, char** argv) {
     const std::vector<CLI::App*> given = app.get_subcommands();
     for (const CLI::Option* option : (given.empty() ? &app : given.front())->get_options())
       for (const std::string& name : option->get_lnames()) flags.push_back("--" + name);
-    return report(parse_error_line(e.what(), flags) + " (see fictus --help)", exit_bad_input);
+    return fail(parse_error_line(e.what(), flags) + " (see fictus --help)", exit_bad_input);
   }
   try {
     if (*solve_cmd) return run_solve(solve);
@@ -568,15 +657,15 @@ int main(int argc, char** argv) {
       return 0;
     }
   } catch (const std::invalid_argument& e) {
-    return report(e.what(), exit_bad_input);
+    return fail(e.what(), exit_bad_input);
   } catch (const NewtonFailure& e) {
-    return report(e.what(), exit_newton);
+    return fail(e.what(), exit_newton);
   } catch (const fictus::cli::OutputError& e) {
-    return report(e.what(), exit_output);
+    return fail(e.what(), exit_output);
   } catch (const std::bad_alloc&) {
-    return report("out of memory (a smaller N, or check solver.max_memory)", exit_internal);
+    return fail("out of memory (a smaller N, or check solver.max_memory)", exit_internal);
   } catch (const std::exception& e) {
-    return report(e.what(), exit_internal);
+    return fail(e.what(), exit_internal);
   }
   return 0;
 }

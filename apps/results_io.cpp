@@ -257,6 +257,13 @@ json solution_to_json(const BasicProblem<dim>& problem, const BasicSolution<dim>
   warnings.insert(warnings.end(), s.warnings.begin(), s.warnings.end());
   j["warnings"] = warnings;
   j["peak_memory_bytes"] = s.peak_memory_bytes;
+  if (!s.rank_peak_memory_bytes.empty()) {  // a run on several MPI ranks
+    std::size_t total = 0;
+    for (std::size_t b : s.rank_peak_memory_bytes) total += b;
+    j["ranks"] = json{{"count", s.rank_peak_memory_bytes.size()},
+                      {"peak_memory_bytes", s.rank_peak_memory_bytes},
+                      {"total_peak_memory_bytes", total}};
+  }
   return j;
 }
 

@@ -344,11 +344,14 @@ KinkCorrection::KinkCorrection(const CurveGridIntersection& gamma, const Colloca
   state_->galerkin = merge_rows(by_cell, m, grid);
 }
 
-void KinkCorrection::add_kinks(const std::vector<double>& lambda, GridVector& u) const {
+void KinkCorrection::add_kinks(const std::vector<double>& lambda, GridVector& u, std::optional<Slab> slab) const {
   const Grid2& grid = state_->gamma.grid();
+  const Slab s = slab.value_or(grid.every_layer());
+  const std::size_t offset = grid.slab_offset(s);
   state_->nodes.for_each([&](int i, int j, const Kink& kink) {
     const double psi = kink.psi();
-    if (psi != 0.0 && grid.has_unknown(i, j)) u[grid.index(i, j)] += lambda[state_->arc_of(kink.t)] * psi;
+    if (psi != 0.0 && grid.has_unknown(i, j) && s.holds(grid.layer(j)))
+      u[grid.index(i, j) - offset] += lambda[state_->arc_of(kink.t)] * psi;
   });
 }
 

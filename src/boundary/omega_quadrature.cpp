@@ -173,18 +173,22 @@ void for_each_omega_point(const Grid3& grid, const Surface& gamma, int q, const 
   });
 }
 
-GridVector omega_load(const Grid3& grid, const Surface& gamma, int q, const Execution& execution) {
+GridVector omega_load(const Grid3& grid, const Surface& gamma, int q, const Execution& execution,
+                      std::optional<Slab> slab) {
   const double h = grid.h();
   const GaussRule& rule = gauss_legendre(q);
   const auto [first, last] = bounding_voxels(grid, gamma);
-  GridVector load(grid.n_unknowns(), 0.0);
+  const Slab s = slab.value_or(grid.every_layer());
+  const std::size_t offset = grid.slab_offset(s);
+  const auto held = [&](int z) { return (grid.periodic() || (z > 0 && z < grid.n(2))) && s.holds(grid.layer(z)); };
+  GridVector load(grid.slab_size(s), 0.0);
   // A voxel adds to the node planes z = k and k + 1 only, so the layers of one parity run in parallel.
   std::atomic<bool> stop = false;
   for (int parity = 0; parity < 2; ++parity) {
 #pragma omp parallel for num_threads(execution.threads()) schedule(dynamic, 1)
     for (int iz = first[2] + parity; iz <= last[2]; iz += 2) {
       if (omp_get_thread_num() == 0 && execution.interrupt_requested()) stop = true;
-      if (stop) continue;
+      if (stop || (!held(iz) && !held(iz + 1))) continue;
       for (int iy = first[1]; iy <= last[1]; ++iy)
         for (int ix = first[0]; ix <= last[0]; ++ix) {
           const Grid3::Index cell{ix, iy, iz};
@@ -203,7 +207,8 @@ GridVector omega_load(const Grid3& grid, const Surface& gamma, int q, const Exec
           for (int l = 0; l < 8; ++l) {
             const Grid3::Index node{ix + Q1Element<3>::offset(l, 0), iy + Q1Element<3>::offset(l, 1),
                                     iz + Q1Element<3>::offset(l, 2)};
-            if (grid.has_unknown(node)) load[grid.index(node)] += sums[std::size_t(l)];
+            if (grid.has_unknown(node) && s.holds(grid.layer(node[2])))
+              load[grid.index(node) - offset] += sums[std::size_t(l)];
           }
         }
     }

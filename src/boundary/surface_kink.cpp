@@ -558,18 +558,23 @@ Eigen::SparseMatrix<double> SurfaceKink::direct(const SparseRows& rows) const {
   return D;
 }
 
-void SurfaceKink::add_kinks(const std::vector<double>& lambda, GridVector& u) const {
+void SurfaceKink::add_kinks(const std::vector<double>& lambda, GridVector& u, std::optional<Slab> slab) const {
   const State& st = *state_;
+  const Slab s = slab.value_or(st.grid.every_layer());
+  const std::size_t offset = st.grid.slab_offset(s);
   for (const BandNode& b : st.band)
-    if (b.patch >= 0 && st.grid.has_unknown(b.node)) u[st.grid.index(b.node)] += lambda[std::size_t(b.patch)] * b.psi;
+    if (b.patch >= 0 && st.grid.has_unknown(b.node) && s.holds(st.grid.layer(b.node[2])))
+      u[st.grid.index(b.node) - offset] += lambda[std::size_t(b.patch)] * b.psi;
 }
 
-std::vector<double> SurfaceKink::band_sums(const GridVector& weights) const {
+std::vector<double> SurfaceKink::band_sums(const GridVector& weights, std::optional<Slab> slab) const {
   const State& st = *state_;
+  const Slab s = slab.value_or(st.grid.every_layer());
+  const std::size_t offset = st.grid.slab_offset(s);
   std::vector<double> sums(std::size_t(st.m), 0.0);
   for (const BandNode& b : st.band)
-    if (b.patch >= 0 && st.grid.has_unknown(b.node))
-      sums[std::size_t(b.patch)] += b.psi * weights[st.grid.index(b.node)];
+    if (b.patch >= 0 && st.grid.has_unknown(b.node) && s.holds(st.grid.layer(b.node[2])))
+      sums[std::size_t(b.patch)] += b.psi * weights[st.grid.index(b.node) - offset];
   return sums;
 }
 
@@ -636,22 +641,25 @@ namespace {
 /// layer on patch j (one fast solve).
 Eigen::VectorXd missed_fluxes(const SurfaceKink& kink, const SparseRows& C_gamma, const SparseRows& loads,
                               const Eigen::SparseMatrix<double>& D_C, const GridVector& load_of_omega,
-                              const FastSolver<3>& fast, const Eigen::VectorXd& a, int& fast_solves) {
+                              const FastSolver<3>& fast, const Distribution& distribution, const Eigen::VectorXd& a,
+                              int& fast_solves) {
   const int m = int(a.size());
   // Σ_i a_i S_ij = (B_Γ + R)_j·A⁻¹C_γᵀa + (D_Cᵀa)_j (an adjoint solve), less c∫_ω of the field of a
   // unit layer on patch j, I_h w_j = A⁻¹(B_Γ + R)ᵀe_j + I_hψ_j: c((B_Γ + R)_j·A⁻¹ℓ + Σ_k ψ_j(x_k)ℓ_k)
   // with ℓ_k = ∫_ω φ_k. A is symmetric: both solves are one, A⁻¹(C_γᵀa − cℓ).
-  GridVector y(fast.grid().n_unknowns(), 0.0);
-  C_gamma.add_transposed(std::vector<double>(a.begin(), a.end()), y);
+  // Distributed: y and ℓ are this rank's layers, the readings and band sums added over the ranks.
+  GridVector y = fast.make_vector();
+  add_rows(C_gamma, fast.grid(), std::vector<double>(a.begin(), a.end()), y, distribution);
   std::vector<double> band(std::size_t(m), 0.0);
   if (fast.c() != 0.0) {
-    band = kink.band_sums(load_of_omega);
+    band = kink.band_sums(load_of_omega, fast.slab());
+    distribution.sum(band);
     for (std::size_t k = 0; k < y.size(); ++k) y[k] -= fast.c() * load_of_omega[k];
   }
   fast.solve_in_place(y);
   ++fast_solves;
   std::vector<double> share;
-  loads.multiply(y, share);
+  read_rows(loads, fast.grid(), y, distribution, share);
   const Eigen::VectorXd from_direct = D_C.transpose() * a;
   Eigen::VectorXd beta(m);
   for (int j = 0; j < m; ++j) beta[j] = share[std::size_t(j)] + from_direct[j] - fast.c() * band[std::size_t(j)];
@@ -719,18 +727,20 @@ Eigen::SparseMatrix<double> balance_correction(const SparseRows& B_Gamma, const 
 
 FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, const SparseRows& C_gamma,
                          const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C,
-                         const GridVector& load_of_omega, const FastSolver<3>& fast) {
+                         const GridVector& load_of_omega, const FastSolver<3>& fast,
+                         const Distribution& distribution) {
   const int m = B_Gamma.n_rows();
   if (fast.singular()) throw std::invalid_argument("flux_balance: A is singular (a periodic box with c = 0)");
   if (C_gamma.n_rows() != m || loads.n_rows() != m || D_C.rows() != m || D_C.cols() != m ||
-      (fast.c() != 0.0 && load_of_omega.size() != fast.grid().n_unknowns()))
+      (fast.c() != 0.0 && load_of_omega.size() != fast.local_size()))
     throw std::invalid_argument("flux_balance: the rows, D_C and the load of ω do not match");
   FluxBalance result;
   const std::vector<double> areas = B_Gamma.row_sums();  // ∫_{P_j} 1 dS (no wall node lies near γ)
   result.area = Eigen::Map<const Eigen::VectorXd>(areas.data(), Eigen::Index(areas.size()));
   const Eigen::VectorXd& a = result.area;
 
-  const Eigen::VectorXd beta = missed_fluxes(kink, C_gamma, loads, D_C, load_of_omega, fast, a, result.fast_solves);
+  const Eigen::VectorXd beta =
+      missed_fluxes(kink, C_gamma, loads, D_C, load_of_omega, fast, distribution, a, result.fast_solves);
   {
     double mean = 0, square = 0;
     for (int j = 0; j < m; ++j) mean += beta[j] / a[j] / m;

@@ -5,13 +5,13 @@
 #include <stdexcept>
 
 #include "fftw_plan.hpp"
+#include "fictus/grid/distribution.hpp"
 
 namespace fictus {
 
 template <int dim>
 std::unique_ptr<FastSolver<dim>> make_fast_solver(const Grid<dim>& grid, double c, const Execution& execution) {
-  if (grid.periodic()) return std::make_unique<PeriodicSolver<dim>>(grid, c, execution);
-  return std::make_unique<DstSolver<dim>>(grid, c, execution);
+  return execution.distribution().fast_solver(grid, c, execution);
 }
 
 template <int dim>

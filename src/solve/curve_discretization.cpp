@@ -10,6 +10,7 @@
 #include <string>
 
 #include "fictus/boundary/shapes.hpp"
+#include "fictus/grid/distribution.hpp"
 #include "solve_steps.hpp"
 
 namespace fictus {
@@ -222,23 +223,27 @@ void CurveDiscretization::make_trace_rows(const Grid2& grid, const SolverOptions
 }
 
 void CurveDiscretization::finish_field(const std::vector<double>& lambda, GridVector& u) const {
-  if (kink_) kink_->add_kinks(lambda, u);
+  if (kink_) kink_->add_kinks(lambda, u, execution_.distribution().slab(gamma_geometry_->grid()));
 }
 
 std::optional<std::vector<double>> CurveDiscretization::independent_normal_derivative(const GridVector& u,
                                                                                       std::string& rule) const {
   std::vector<double> d;
+  const Grid2& grid = gamma_geometry_->grid();
+  const Distribution& distribution = execution_.distribution();
   if (kink_) {
     rule = "bicubic interpolant of the kink-corrected field";
-    normal_derivative_rows_centered(gamma_geometry_->grid(), points(), normals(), 3).multiply(u, d);
+    read_rows(normal_derivative_rows_centered(grid, points(), normals(), 3), grid, u, distribution, d);
     return d;
   }
   rule = "one-sided quadratic least-squares fit through the nodes of omega";
-  try {
-    one_sided_rows(*gamma_geometry_, points(), normals(), OneSidedTrace::normal_derivative, 2, 2.5).multiply(u, d);
+  std::optional<SparseRows> rows;
+  try {  // the same on every rank: the rows are made from γ alone
+    rows.emplace(one_sided_rows(*gamma_geometry_, points(), normals(), OneSidedTrace::normal_derivative, 2, 2.5));
   } catch (const std::runtime_error&) {  // ω too thin for the fit: no check, not a failed solve
     return std::nullopt;
   }
+  read_rows(*rows, grid, u, distribution, d);
   return d;
 }
 
@@ -263,7 +268,11 @@ std::vector<double> CurveDiscretization::obstacle(const Data& data) const {
 
 void CurveDiscretization::for_each_omega_sample(const GridVector& u, int quadrature,
                                                 const OmegaSampleVisitor<2>& visit) const {
-  fictus::for_each_omega_sample(u, *gamma_geometry_, quadrature, execution_, visit);
+  const Distribution& distribution = execution_.distribution();
+  if (!distribution.distributed()) return fictus::for_each_omega_sample(u, *gamma_geometry_, quadrature, execution_, visit);
+  const Grid2& grid = gamma_geometry_->grid();
+  fictus::for_each_omega_sample(distribution.with_next_layer(grid, u), *gamma_geometry_, quadrature, execution_, visit,
+                                distribution.slab(grid));
 }
 
 ErrorNorms CurveDiscretization::errors(const GridVector& u, const std::vector<double>&, const Data& data,

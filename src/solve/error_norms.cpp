@@ -9,6 +9,7 @@
 
 #include "fictus/boundary/curve_grid_intersection.hpp"
 #include "fictus/boundary/omega_quadrature.hpp"
+#include "fictus/grid/distribution.hpp"
 #include "fictus/grid/q1_element.hpp"
 
 namespace fictus {
@@ -138,6 +139,7 @@ std::array<double, 4> omega_error_sums(const Sampler& for_each_sample, const Exa
   std::array<double, 4> total{};
   for (const auto& s : sums)
     for (int c = 0; c < 4; ++c) total[std::size_t(c)] += s[std::size_t(c)];
+  execution.distribution().sum(total.data(), total.size());  // the ranks' cells
   return total;
 }
 
@@ -164,8 +166,13 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
                           const VectorizedGradient& exact_gradient, int q, const Execution& execution) {
   const Grid2& grid = gamma.grid();
   const double e = 1e-6 * (grid.box().upper.x - grid.box().lower.x);
+  // Distributed: u_h is this rank's layers; the cells of its layers read them and the next one.
+  const Distribution& distribution = execution.distribution();
+  const Slab slab = distribution.slab(grid);
+  const GridVector held = distribution.distributed() ? distribution.with_next_layer(grid, u_h) : GridVector();
+  const GridVector& u = distribution.distributed() ? held : u_h;
   const std::array<double, 4> omega = omega_error_sums<2>(
-      [&](const OmegaSampleVisitor<2>& visit) { for_each_omega_sample(u_h, gamma, q, execution, visit); },
+      [&](const OmegaSampleVisitor<2>& visit) { for_each_omega_sample(u, gamma, q, execution, visit, slab); },
       [&](const std::array<std::vector<double>, 2>& x, std::vector<double>& u, std::array<std::vector<double>, 2>& du) {
         evaluate_at(exact, x, u);
         gradient_at(exact, exact_gradient, e, x[0], x[1], du[0], du[1]);
@@ -174,7 +181,7 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
 
   // Along γ: the Gauss points of every piece, one batch; [e², u²].
   const GaussRule& rule = gauss_legendre(q);
-  std::vector<double> x, y, w, u;
+  std::vector<double> x, y, w, values;
   std::vector<int> cell_x, cell_y;
   for (const CurvePiece& piece : gamma.pieces())
     for (int g = 0; g < q; ++g) {
@@ -183,15 +190,17 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
       x.push_back(p.x), y.push_back(p.y), cell_x.push_back(piece.ix), cell_y.push_back(piece.iy);
       w.push_back(rule.weights[g] * (piece.t1 - piece.t0) * gamma.curve().speed(t));
     }
-  u.resize(x.size());
-  exact(x.size(), x.data(), y.data(), u.data());
-  double boundary_error = 0, boundary_norm = 0;
+  values.resize(x.size());
+  exact(x.size(), x.data(), y.data(), values.data());
+  std::array<double, 2> boundary{};  // [e², u²]
   for (std::size_t k = 0; k < x.size(); ++k) {
-    const double err = sample_q1(grid, u_h, cell_x[k], cell_y[k], x[k], y[k]).value - u[k];
-    boundary_error += w[k] * err * err;
-    boundary_norm += w[k] * u[k] * u[k];
+    if (!slab.holds(grid.cell_layer(cell_y[k]))) continue;
+    const double err = sample_q1(grid, u, slab, cell_x[k], cell_y[k], x[k], y[k]).value - values[k];
+    boundary[0] += w[k] * err * err;
+    boundary[1] += w[k] * values[k] * values[k];
   }
-  return norms_from(omega, boundary_error, boundary_norm);
+  distribution.sum(boundary.data(), boundary.size());
+  return norms_from(omega, boundary[0], boundary[1]);
 }
 
 namespace {
@@ -307,8 +316,13 @@ ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surfac
                           const std::vector<double>& trace, const VectorizedField3& exact,
                           const GradientField3& exact_gradient, int q, const Execution& execution) {
   const double e = 1e-6 * grid.box().width(0);
+  const Distribution& distribution = execution.distribution();  // as in 2-D
+  const GridVector held = distribution.distributed() ? distribution.with_next_layer(grid, u_h) : GridVector();
+  const GridVector& u_held = distribution.distributed() ? held : u_h;
   const std::array<double, 4> omega = omega_error_sums<3>(
-      [&](const OmegaSampleVisitor<3>& visit) { for_each_omega_sample(u_h, grid, gamma, q, execution, visit); },
+      [&](const OmegaSampleVisitor<3>& visit) {
+        for_each_omega_sample(u_held, grid, gamma, q, execution, visit, distribution.slab(grid));
+      },
       [&](const std::array<std::vector<double>, 3>& x, std::vector<double>& u, std::array<std::vector<double>, 3>& du) {
         evaluate_at(exact, x, u);
         gradient_at(exact, exact_gradient, e, x, du);

@@ -9,6 +9,7 @@
 #include <string>
 #include <thread>
 
+#include "fictus/grid/distribution.hpp"
 #include "fictus/grid/execution.hpp"
 #include "fictus/grid/fast_solver.hpp"
 #include "fictus/grid/green_table.hpp"
@@ -214,22 +215,31 @@ BoundarySetup<dim>& boundary_setup(State<dim>& st, const BasicContactData<dim>& 
 template <int dim>
 void load_and_u0(State<dim>& st, PhaseClock& clock, std::size_t& fast_solves) {
   if (st.have_u0) return;
-  st.u0 = st.f_vectorized ? assemble_load(st.grid, st.f_vectorized, st.load_quadrature, st.execution)
-                          : assemble_load(st.grid, st.f, st.load_quadrature, st.execution);
-  st.load_total = 0;
-  for (double v : st.u0) {
-    if (!std::isfinite(v)) throw std::invalid_argument("data.f: not finite somewhere in the box");
-    st.load_total += v;
+  const Distribution& distribution = st.execution.distribution();
+  if (!distribution.distributed()) {
+    st.u0 = st.f_vectorized ? assemble_load(st.grid, st.f_vectorized, st.load_quadrature, st.execution)
+                            : assemble_load(st.grid, st.f, st.load_quadrature, st.execution);
+  } else {  // this rank's layers, into the vector the slab solver transforms in place
+    const GridVector load = assemble_load(st.grid, st.f_vectorized ? st.f_vectorized : vectorize(st.f),
+                                          st.load_quadrature, st.execution, st.fast->slab());
+    st.u0 = st.fast->make_vector();
+    std::copy(load.begin(), load.end(), st.u0.begin());
   }
+  st.load_total = 0;
+  bool finite = true;
+  for (double v : st.u0) finite = finite && std::isfinite(v), st.load_total += v;
+  if (!distribution.all(finite)) throw std::invalid_argument("data.f: not finite somewhere in the box");
+  st.load_total = distribution.sum(st.load_total);
   clock.mark("load");
   st.execution.throw_if_interrupted();
-  const double largest_load = max_abs(st.u0);
+  const double largest_load = distribution.max(max_abs(st.u0));
   st.fast->solve_in_place(st.u0);
   ++fast_solves;
-  if (!all_finite(st.u0) || max_abs(st.u0) > largest_scale)
-    throw std::invalid_argument("data.f: u0 = A^-1 f reaches " + format_number(max_abs(st.u0)) +
-                                " (load entries up to " + format_number(largest_load) + "), beyond " +
-                                format_number(largest_scale) + ": rescale the problem (u, f and g by one factor)");
+  const double largest_u0 = distribution.max(max_abs(st.u0));
+  if (!distribution.all(all_finite(st.u0)) || largest_u0 > largest_scale)
+    throw std::invalid_argument("data.f: u0 = A^-1 f reaches " + format_number(largest_u0) + " (load entries up to " +
+                                format_number(largest_load) + "), beyond " + format_number(largest_scale) +
+                                ": rescale the problem (u, f and g by one factor)");
   st.have_u0 = true;
   clock.mark("u0");
 }
@@ -245,8 +255,10 @@ void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
   const MarkPhase mark = [&clock](const std::string& phase) { clock.mark(phase); };
   setup.fast_solves += b.finish_setup(*st.fast, mark);
   const GmresOptions gmres = detail::gmres_options(options, b.n_points(), st.execution);
+  const Distribution& distribution = st.execution.distribution();
   if (options.inner == InnerSolver::krylov) {
-    setup.schur = std::make_unique<ImplicitSchur>(*st.fast, b.B_gamma(), b.C_gamma(), b.loads(), gmres, b.direct());
+    setup.schur = std::make_unique<ImplicitSchur>(*st.fast, b.B_gamma(), b.C_gamma(), b.loads(), gmres, b.direct(),
+                                                  &distribution);
     return;
   }
   if (!st.green) {
@@ -254,10 +266,14 @@ void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
     clock.mark("green_table");
   }
   const int m = b.n_points();
-  const bool hierarchical = compressed_schur(options.schur_storage, dim, m, st.fast->singular());
+  // Distributed, the blocks are dense: each rank makes them from its own copy of the table and takes rank
+  // 0's, so that Newton runs the same on every rank (compressed blocks are not shared yet).
+  const bool compressible = compressed_schur(options.schur_storage, dim, m, st.fast->singular());
+  const bool hierarchical = compressible && !distribution.distributed();
   if (options.schur_storage == SchurStorageKind::hierarchical && !hierarchical)
     setup.storage_warning =
-        "solver.schur_storage: a periodic box with c = 0 (A singular) keeps the Schur complement dense";
+        compressible ? "solver.schur_storage: a run on several MPI ranks keeps the Schur complement dense"
+                     : "solver.schur_storage: a periodic box with c = 0 (A singular) keeps the Schur complement dense";
   if (hierarchical) {
     GmresOptions inner = gmres;
     inner.relative_tolerance = hierarchical_gmres_tolerance;
@@ -272,8 +288,10 @@ void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
     setup.schur = std::move(h);
   } else {
     FarFieldReport report;
-    setup.schur = std::make_unique<ExplicitSchur>(*st.green, b.B_gamma(), b.C_gamma(), b.loads(), st.execution,
-                                                  b.direct(), b.far_field(options), &report);
+    auto dense_blocks = std::make_unique<ExplicitSchur>(*st.green, b.B_gamma(), b.C_gamma(), b.loads(), st.execution,
+                                                        b.direct(), b.far_field(options), &report);
+    dense_blocks->share(distribution);
+    setup.schur = std::move(dense_blocks);
     SchurStorage dense;
     dense.bytes = dense.dense_bytes = 2.0 * 8.0 * double(m) * double(m);
     setup.storage = dense;
@@ -281,7 +299,8 @@ void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
   }
   if (!keep) st.green.reset();
   if (hierarchical || setup.far_field)  // Newton finishes on the exact S
-    setup.exact = std::make_unique<ImplicitSchur>(*st.fast, b.B_gamma(), b.C_gamma(), b.loads(), gmres, b.direct());
+    setup.exact = std::make_unique<ImplicitSchur>(*st.fast, b.B_gamma(), b.C_gamma(), b.loads(), gmres, b.direct(),
+                                                  &distribution);
   clock.mark("schur");
   st.execution.throw_if_interrupted();
 }
@@ -293,8 +312,8 @@ void load_terms(const State<dim>& st, BoundarySetup<dim>& setup) {
   if (setup.load_version == st.load_version) return;
   const BoundaryDiscretization<dim>& boundary = *setup.boundary;
   std::vector<double> b0, c0;
-  boundary.B_gamma().multiply(st.u0, b0);
-  boundary.C_gamma().multiply(st.u0, c0);
+  read_rows(boundary.B_gamma(), st.grid, st.u0, st.execution.distribution(), b0);
+  read_rows(boundary.C_gamma(), st.grid, st.u0, st.execution.distribution(), c0);
   setup.shift = boundary.reading_shift(st.u0, st.f_vectorized ? st.f_vectorized : vectorize(st.f), st.load_quadrature);
   if (setup.shift != 0.0)  // the data's readings: their area-weighted sum is c∫_ω u₀ − ∫_ω f
     for (double& v : c0) v += setup.shift;
@@ -606,6 +625,9 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
   if (!setup.storage_warning.empty()) sol.warnings.push_back(setup.storage_warning);
   for (const NewtonStep& step : sol.newton.history) sol.inner_iterations += step.inner_iterations;
   if (options.condition_number && dim == 2) sol.condition_number = setup.schur->condition_number(sol.newton.active);
+  // Distributed: every rank ran the same steps on the same numbers; rank 0's λ and α are the answer.
+  st.execution.distribution().broadcast(sol.newton.lambda.data(), std::size_t(sol.newton.lambda.size()));
+  st.execution.distribution().broadcast(&sol.newton.alpha, 1);
   sol.lambda.assign(sol.newton.lambda.data(), sol.newton.lambda.data() + sol.newton.lambda.size());
   sol.lambda_total = row_sums(setup.boundary->B_Gamma()).dot(sol.newton.lambda);
   sol.alpha = sol.newton.alpha;
@@ -620,17 +642,18 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
 template <int dim>
 void field(const State<dim>& st, const BoundarySetup<dim>& setup, BasicSolution<dim>& sol) {
   const BoundaryDiscretization<dim>& boundary = *setup.boundary;
-  GridVector u(st.grid.n_unknowns(), 0.0);
-  boundary.loads().add_transposed(sol.lambda, u);
+  const Distribution& distribution = st.execution.distribution();
+  GridVector u = st.fast->make_vector();  // this rank's layers (all of them serially)
+  add_rows(boundary.loads(), st.grid, sol.lambda, u, distribution);
   st.fast->solve_in_place(u);
   ++sol.fast_solves;
   for (std::size_t k = 0; k < u.size(); ++k) u[k] += st.u0[k] + sol.alpha;
   boundary.finish_field(sol.lambda, u);
-  if (!all_finite(u))
+  if (!distribution.all(all_finite(u)))
     throw std::invalid_argument("data: the field u is not finite: the data are too large for double precision");
   sol.u = std::move(u);
-  boundary.B_gamma().multiply(sol.u, sol.trace);
-  boundary.C_gamma().multiply(sol.u, sol.normal_derivative);
+  read_rows(boundary.B_gamma(), st.grid, sol.u, distribution, sol.trace);
+  read_rows(boundary.C_gamma(), st.grid, sol.u, distribution, sol.normal_derivative);
   boundary.finish_readings(sol.lambda, sol.normal_derivative);
   if (setup.shift != 0.0)
     for (double& v : sol.normal_derivative) v += setup.shift;
@@ -679,7 +702,8 @@ void errors(const State<dim>& st, const BoundaryDiscretization<dim>& boundary, c
 template <int dim>
 DomainQuantities domain_quantities(const State<dim>& st, const BoundaryDiscretization<dim>& boundary,
                                    const GridVector& u, int quadrature, const BasicSolution<dim>* coarse,
-                                   const typename Fields<dim>::Vectorized& exact, double& difference2,
+                                   const GridVector& coarse_u, const typename Fields<dim>::Vectorized& exact,
+                                   double& difference2,
                                    std::array<double, 2>& exact_integrals) {
   const typename Fields<dim>::Vectorized f = st.f_vectorized ? st.f_vectorized : vectorize(st.f);
   constexpr int K = 9;  // |ω|, ∫û, ∫û², ∫|∇û|², ∫f, ∫fû, ∫(û − û_{N/2})², ∫u, ∫fu (u: the exact solution)
@@ -690,7 +714,7 @@ DomainQuantities domain_quantities(const State<dim>& st, const BoundaryDiscretiz
     std::vector<double>& cv = coarse_at[std::size_t(thread)];
     std::vector<double>& ev = exact_at[std::size_t(thread)];
     evaluate_at(f, row.x, fv);
-    if (coarse) sample_q1_at<dim>(coarse->grid, coarse->u, row.x, cv);
+    if (coarse) sample_q1_at<dim>(coarse->grid, coarse_u, row.x, cv);
     if (exact) evaluate_at(exact, row.x, ev);
     std::array<double, K> r{};  // per row, then per thread
     for (std::size_t k = 0; k < row.size(); ++k) {
@@ -706,6 +730,7 @@ DomainQuantities domain_quantities(const State<dim>& st, const BoundaryDiscretiz
   std::array<double, K> t{};
   for (const auto& s : sums)
     for (int c = 0; c < K; ++c) t[std::size_t(c)] += s[std::size_t(c)];
+  st.execution.distribution().sum(t.data(), t.size());  // the ranks' cells
   if (!std::isfinite(t[4]) || !std::isfinite(t[5])) throw std::invalid_argument("data.f: not finite somewhere in ω");
   DomainQuantities q;
   q.volume = t[0], q.integral_u = t[1], q.integral_u2 = t[2], q.integral_grad2 = t[3];
@@ -787,7 +812,14 @@ void quantities_step(const State<dim>& st, const BoundaryDiscretization<dim>& bo
   std::array<double, 2> exact{};  // ∫u, ∫fu of the exact solution
   typename Fields<dim>::Vectorized exact_u;
   if (sol.errors) exact_u = data.exact_vectorized ? data.exact_vectorized : vectorize(data.exact);
-  sol.domain = domain_quantities<dim>(st, boundary, sol.u, quantity_quadrature, from, exact_u, difference2, exact);
+  // Distributed, each rank samples the whole coarse field at the points of its cells (an eighth of a grid
+  // vector in 3-D, a quarter in 2-D).
+  const Distribution& distribution = st.execution.distribution();
+  const GridVector coarse_whole =
+      from && distribution.distributed() ? distribution.gather(from->grid, from->u) : GridVector();
+  sol.domain = domain_quantities<dim>(st, boundary, sol.u, quantity_quadrature, from,
+                                      distribution.distributed() ? coarse_whole : from ? from->u : coarse_whole,
+                                      exact_u, difference2, exact);
   if (sol.errors) {
     ErrorNorms& e = *sol.errors;
     const double energy =

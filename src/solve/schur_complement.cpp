@@ -5,7 +5,7 @@
 
 namespace fictus {
 
-ImplicitSchur::ImplicitSchur(std::function<void(GridVector&)> solve_in_place, std::size_t n_unknowns,
+ImplicitSchur::ImplicitSchur(std::function<void(GridVector&)> solve_in_place, GridVector work,
                              const SparseRows& B_gamma, const SparseRows& C_gamma, const SparseRows& loads,
                              const GmresOptions& options, DirectTerms direct)
     : solve_in_place_(std::move(solve_in_place)),
@@ -14,18 +14,28 @@ ImplicitSchur::ImplicitSchur(std::function<void(GridVector&)> solve_in_place, st
       B_Gamma_(loads),
       options_(options),
       direct_(std::move(direct)),
-      work_(n_unknowns) {}
+      work_(std::move(work)) {}
 
 void ImplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const {
   lambda_.assign(lambda.data(), lambda.data() + lambda.size());
   std::fill(work_.begin(), work_.end(), 0.0);
-  B_Gamma_.add_transposed(lambda_, work_);
+  if (distribution_)
+    B_Gamma_.add_transposed(lambda_, work_, offset_);
+  else
+    B_Gamma_.add_transposed(lambda_, work_);
   solve_in_place_(work_);
   ++fast_solves_;
-  B_gamma_.multiply(work_, rows_);
-  sb = Eigen::Map<const Eigen::VectorXd>(rows_.data(), Eigen::Index(rows_.size()));
-  C_gamma_.multiply(work_, rows_);
-  sc = Eigen::Map<const Eigen::VectorXd>(rows_.data(), Eigen::Index(rows_.size()));
+  const auto read = [this](const SparseRows& rows, Eigen::VectorXd& out) {
+    if (distribution_) {
+      rows.multiply(work_, offset_, rows_);
+      distribution_->sum(rows_);
+    } else {
+      rows.multiply(work_, rows_);
+    }
+    out = Eigen::Map<const Eigen::VectorXd>(rows_.data(), Eigen::Index(rows_.size()));
+  };
+  read(B_gamma_, sb);
+  read(C_gamma_, sc);
   if (!direct_.empty()) {
     sb += direct_.trace * lambda;
     sc += direct_.normal_derivative * lambda;
@@ -238,6 +248,12 @@ LinearSolveReport ExplicitSchur::solve(const ActiveSet& active, const Eigen::Vec
   const double rn = rhs.norm();
   report.relative_residual = rn > 0 ? (y - rhs).norm() / rn : 0.0;
   return report;
+}
+
+void ExplicitSchur::share(const Distribution& distribution) {
+  if (!distribution.distributed()) return;
+  distribution.broadcast(S_B_.data(), std::size_t(S_B_.size()));
+  distribution.broadcast(S_C_.data(), std::size_t(S_C_.size()));
 }
 
 std::optional<double> ExplicitSchur::condition_number(const ActiveSet& active) const {

@@ -8,6 +8,7 @@
 
 #include "fictus/boundary/omega_quadrature.hpp"
 #include "fictus/boundary/surface_kink.hpp"
+#include "fictus/grid/distribution.hpp"
 #include "solve_steps.hpp"
 
 namespace fictus {
@@ -192,9 +193,11 @@ std::size_t SurfaceDiscretization::finish_setup(const FastSolver<3>& fast, const
   // The flux balance (flux_balance in surface_kink.hpp): X joins D_C.
   if (!kink_ || !balance_wanted_ || fast.singular()) return 0;
   constexpr int load_points = 3;  // per Gauss line of the cut-voxel rule, as the error integrals'
-  load_of_omega_ = c_ != 0.0 ? omega_load(grid_, *gamma_, load_points, execution_) : GridVector();
-  FluxBalance b =
-      fictus::flux_balance(kink_->model, B_Gamma_, C_gamma_, loads_, direct_.normal_derivative, load_of_omega_, fast);
+  const Distribution& distribution = execution_.distribution();
+  load_of_omega_ =
+      c_ != 0.0 ? omega_load(grid_, *gamma_, load_points, execution_, distribution.slab(grid_)) : GridVector();
+  FluxBalance b = fictus::flux_balance(kink_->model, B_Gamma_, C_gamma_, loads_, direct_.normal_derivative,
+                                       load_of_omega_, fast, distribution);
   direct_.normal_derivative += b.correction;
   kink_->balance = std::move(b.correction);
   kink_->area = std::move(b.area);
@@ -210,15 +213,18 @@ double SurfaceDiscretization::reading_shift(const GridVector& u0, const Vectoriz
                                             int load_quadrature) const {
   if (!kink_ || !kink_->balanced) return 0;
   constexpr int load_points = 3;  // as finish_setup's ℓ
-  double u0_integral = 0;         // ∫_ω u₀
+  double u0_integral = 0;         // ∫_ω u₀ (distributed: over this rank's layers, then added)
+  const Distribution& distribution = execution_.distribution();
   if (c_ != 0.0) {
-    const GridVector load_of_omega =
-        load_of_omega_.empty() ? omega_load(grid_, *gamma_, load_points, execution_) : std::move(load_of_omega_);
+    const GridVector load_of_omega = load_of_omega_.empty()
+                                         ? omega_load(grid_, *gamma_, load_points, execution_, distribution.slab(grid_))
+                                         : std::move(load_of_omega_);
     load_of_omega_ = GridVector();
     for (std::size_t k = 0; k < load_of_omega.size(); ++k) u0_integral += load_of_omega[k] * u0[k];
+    u0_integral = distribution.sum(u0_integral);
   }
   std::vector<double> c_u0;
-  C_gamma_.multiply(u0, c_u0);
+  read_rows(C_gamma_, grid_, u0, distribution, c_u0);
   const double readings = kink_->area.dot(to_eigen(c_u0)), area_total = kink_->area.sum();
   const double f_integral = omega_integral(grid_, *gamma_, f, load_quadrature, execution_);
   if (!std::isfinite(f_integral)) throw std::invalid_argument("data.f: not finite somewhere in ω");
@@ -241,7 +247,7 @@ std::vector<double> SurfaceDiscretization::obstacle(const Data& data) const {
 }
 
 void SurfaceDiscretization::finish_field(const std::vector<double>& lambda, GridVector& u) const {
-  if (kink_) kink_->model.add_kinks(lambda, u);  // the kink-corrected field I_h w
+  if (kink_) kink_->model.add_kinks(lambda, u, execution_.distribution().slab(grid_));  // the kink-corrected I_h w
 }
 
 void SurfaceDiscretization::finish_readings(const std::vector<double>& lambda,
@@ -259,7 +265,10 @@ std::optional<std::vector<double>> SurfaceDiscretization::independent_normal_der
 
 void SurfaceDiscretization::for_each_omega_sample(const GridVector& u, int quadrature,
                                                   const OmegaSampleVisitor<3>& visit) const {
-  fictus::for_each_omega_sample(u, grid_, *gamma_, quadrature, execution_, visit);
+  const Distribution& distribution = execution_.distribution();
+  if (!distribution.distributed()) return fictus::for_each_omega_sample(u, grid_, *gamma_, quadrature, execution_, visit);
+  fictus::for_each_omega_sample(distribution.with_next_layer(grid_, u), grid_, *gamma_, quadrature, execution_, visit,
+                                distribution.slab(grid_));
 }
 
 ErrorNorms SurfaceDiscretization::errors(const GridVector& u, const std::vector<double>& trace, const Data& data,

@@ -11,6 +11,7 @@
 // So a trace row R of I_h w is  R û_h + (R A⁻¹ Σ_j λ_j r_j) + D λ  with D_ij = Σ_k R_ik ψ_j(x_k):
 // the rows r_j are added to those of B_Γ in the Schur complement, and D is added to its blocks.
 #include <memory>
+#include <optional>
 
 #include <Eigen/Sparse>
 
@@ -36,8 +37,9 @@ class KinkCorrection {
   /// D_ij = Σ_k R_ik ψ_j(x_k). Not thread-safe (caches the nodes it meets).
   Eigen::SparseMatrix<double> direct(const SparseRows& rows) const;
   /// u += Σ_j λ_j ψ_j at the nodes within two cells of the cut cells (the band where the kink
-  /// model holds): turns u₀ + A⁻¹(B_Γ + R)ᵀλ into the kink-corrected field I_h w.
-  void add_kinks(const std::vector<double>& lambda, GridVector& u) const;
+  /// model holds): turns u₀ + A⁻¹(B_Γ + R)ᵀλ into the kink-corrected field I_h w. With `slab`, u holds
+  /// that slab's layers (a rank's) and only their nodes change.
+  void add_kinks(const std::vector<double>& lambda, GridVector& u, std::optional<Slab> slab = std::nullopt) const;
 
  private:
   struct State;

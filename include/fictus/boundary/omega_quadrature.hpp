@@ -3,6 +3,7 @@
 // by γ by a rule that follows γ (docs/math.md, "Quadrature"). The load of 1_ω, ∫_ω f and the error
 // integrals use it.
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "fictus/boundary/surface.hpp"
@@ -44,8 +45,10 @@ void for_each_omega_point_in_voxel(const Grid3& grid, const Surface& gamma, cons
 
 /// ∫_ω φ_k for every node with an unknown: h³/8 per corner of a voxel wholly inside γ, the rule above
 /// on the voxels near γ (the load of f = 1_ω). γ must stay a cell away from the walls (solve checks
-/// 2h), so that no two of the parallel voxel layers write one node plane of a periodic grid.
-GridVector omega_load(const Grid3& grid, const Surface& gamma, int q = 3, const Execution& execution = Execution{});
+/// 2h), so that no two of the parallel voxel layers write one node plane of a periodic grid. With
+/// `slab`: only that slab's layers (a rank's; the voxels that touch them visited).
+GridVector omega_load(const Grid3& grid, const Surface& gamma, int q = 3, const Execution& execution = Execution{},
+                      std::optional<Slab> slab = std::nullopt);
 
 /// ∫_ω f by that rule, f evaluated one voxel row at a time and the rows summed in order (the same
 /// result on any number of threads).

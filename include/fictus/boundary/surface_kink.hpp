@@ -13,6 +13,7 @@
 //   and two rings of voxels around them),
 // so a trace row R of I_h w is R û_h + R A⁻¹ Σ_j λ_j r_j + D λ with D_ij = Σ_k R_ik ψ_j(x_k).
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -20,6 +21,7 @@
 
 #include "fictus/boundary/surface.hpp"
 #include "fictus/boundary/trace_operators.hpp"
+#include "fictus/grid/distribution.hpp"
 #include "fictus/grid/execution.hpp"
 #include "fictus/grid/fast_solver.hpp"
 #include "fictus/grid/grid.hpp"
@@ -69,10 +71,12 @@ class SurfaceKink {
   /// D (rows × m) for trace rows R on the same grid: D_ij = Σ_k R_ik ψ_j(x_k).
   Eigen::SparseMatrix<double> direct(const SparseRows& rows) const;
   /// u += Σ_j λ_j ψ_j at the nodes of the band (0 < d ≤ 6h: every trace stencil and the voxels of
-  /// r stay in it): turns u₀ + A⁻¹(B_Γ + R)ᵀλ into the kink-corrected field I_h w.
-  void add_kinks(const std::vector<double>& lambda, GridVector& u) const;
+  /// r stay in it): turns u₀ + A⁻¹(B_Γ + R)ᵀλ into the kink-corrected field I_h w. With `slab`, u holds
+  /// that slab's layers (a rank's) and only their nodes change.
+  void add_kinks(const std::vector<double>& lambda, GridVector& u, std::optional<Slab> slab = std::nullopt) const;
   /// Σ_k ψ_j(x_k)·weights_k over the band's nodes, per patch (with weights ℓ_k = ∫_ω φ_k: ∫_ω I_hψ_j).
-  std::vector<double> band_sums(const GridVector& weights) const;
+  /// With `slab`: weights holds that slab's layers, and the sums are over its nodes.
+  std::vector<double> band_sums(const GridVector& weights, std::optional<Slab> slab = std::nullopt) const;
   /// The number of cut voxels (for reports).
   std::size_t cut_voxels() const;
 
@@ -89,8 +93,8 @@ class SurfaceKink {
 /// neighbouring patches (W_ij = Σ_k (B_Γ)_ik (B_Γ)_jk > 0, their rows' overlap) adds the same
 /// W_ij(φ_i − φ_j)(λ_j − λ_i) to both of their area-weighted readings (nothing when λ_i = λ_j), with
 /// Lφ = (β − μa)/2 for the weighted graph Laplacian L of W on each connected part of γ and μ = Σβ/Σa
-/// there. load_of_omega: ℓ_k = ∫_ω φ_k (unused when c = 0). One fast solve;
-/// throws std::invalid_argument for a singular A.
+/// there. load_of_omega: ℓ_k = ∫_ω φ_k (unused when c = 0), on the solver's slab. One fast solve
+/// (collective when distributed); throws std::invalid_argument for a singular A.
 struct FluxBalance {
   Eigen::SparseMatrix<double> correction;  // X, m × m
   Eigen::VectorXd area;                    // a_j = ∫_{P_j} 1 dS, B_Γ's row sums
@@ -100,6 +104,7 @@ struct FluxBalance {
 };
 FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, const SparseRows& C_gamma,
                          const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C,
-                         const GridVector& load_of_omega, const FastSolver<3>& fast);
+                         const GridVector& load_of_omega, const FastSolver<3>& fast,
+                         const Distribution& distribution = Distribution{});
 
 }  // namespace fictus

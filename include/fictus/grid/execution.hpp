@@ -2,10 +2,15 @@
 // Where grid-level work runs: the number of threads (and, for a distributed run, the communicator
 // that will join it). Made once from the options and passed to the objects that do the work.
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
 namespace fictus {
+
+class Distribution;
+/// The process's distribution (distribution.hpp): serial unless a program under mpirun set another.
+std::shared_ptr<const Distribution> process_distribution();
 
 /// Thrown when the interruption check of an Execution says stop (e.g. Ctrl-C in Python).
 struct Interrupted : std::runtime_error {
@@ -20,10 +25,14 @@ int default_threads();
 class Execution {
  public:
   /// threads ≥ 1, or 0 for default_threads() (the options' rule, options.hpp, caps it further).
-  explicit Execution(int threads = 1) : threads_(threads == 0 ? default_threads() : threads) {
+  /// The distribution is the process's (serial unless a program under mpirun set another).
+  explicit Execution(int threads = 1)
+      : threads_(threads == 0 ? default_threads() : threads), distribution_(process_distribution()) {
     if (threads < 0) throw std::invalid_argument("solver.threads: must be >= 0, got " + std::to_string(threads));
   }
   int threads() const { return threads_; }
+  /// Where the grid's vectors lie: one process, or slabs over MPI ranks (distribution.hpp).
+  const Distribution& distribution() const { return *distribution_; }
 
   /// A check for a request to stop, polled between the steps of a solve, in Newton and GMRES
   /// iterations and in the long assembly loops, always on the thread that called solve (OpenMP's
@@ -50,6 +59,7 @@ class Execution {
 
  private:
   int threads_;
+  std::shared_ptr<const Distribution> distribution_;
   std::function<bool()> interrupt_check_;
   mutable bool interrupted_ = false;  // asked and answered on the calling thread only
   std::function<void(const std::string&, double)> progress_;

@@ -28,6 +28,9 @@ namespace fictus {
 /// Called with a step's name as it ends (the solver's phase clock).
 using MarkPhase = std::function<void(const std::string& phase)>;
 
+/// Every rank of a distributed run (the execution's Distribution) holds the whole boundary part: the
+/// points, the rows, the Schur blocks. Its grid vectors (the GridVector arguments) are the rank's layers,
+/// and the members that read them (readings, integrals over ω) add the ranks' parts: each is collective.
 template <int dim>
 class BoundaryDiscretization {
  public:
@@ -72,7 +75,8 @@ class BoundaryDiscretization {
   /// ∂u/∂n at the points by a rule independent of C_γ, and its name; nullopt where there is none.
   virtual std::optional<std::vector<double>> independent_normal_derivative(const GridVector& u,
                                                                            std::string& rule) const = 0;
-  /// u at the quadrature points of ω, a row at a time (the integrals over ω of a solution).
+  /// u at the quadrature points of ω, a row at a time (the integrals over ω of a solution). Distributed,
+  /// the rows of this rank's cells: the caller adds its sums over the ranks.
   virtual void for_each_omega_sample(const GridVector& u, int quadrature,
                                      const OmegaSampleVisitor<dim>& visit) const = 0;
   /// Errors of u against the exact solution of `data` in ω and on γ (`trace`: B_γu).

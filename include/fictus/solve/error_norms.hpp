@@ -52,6 +52,9 @@ Q1Sample sample_q1(const Grid2& grid, const GridVector& u_h, int ix, int iy, dou
 /// The same with u_h a slab's layers and the next one (Grid::slab_index).
 Q1Sample sample_q1(const Grid2& grid, const GridVector& u_h, const Slab& slab, int ix, int iy, double x, double y);
 
+/// Distributed (the execution's distribution), u_h is this rank's layers: the integrals over ω are made
+/// of each rank's cells and added over the ranks (collective).
+///
 /// 3-D: errors of the trilinear û against `exact` in ω (L², H¹) and on γ from the points
 /// (Σ_p |patch p|·(û − u)(x_p)²)^½, absolute and relative.
 ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,

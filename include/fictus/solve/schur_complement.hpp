@@ -18,6 +18,7 @@
 #include <Eigen/Sparse>
 
 #include "fictus/boundary/trace_operators.hpp"
+#include "fictus/grid/distribution.hpp"
 #include "fictus/grid/fast_solver.hpp"
 #include "fictus/grid/green_table.hpp"
 #include "fictus/solve/dense_lu.hpp"
@@ -104,18 +105,26 @@ class SchurComplement {
 
 class ImplicitSchur final : public SchurComplement {
  public:
-  /// `loads`: the rows whose transposes carry λ into the grid (B_Γ, or B_Γ + R). Any dimension.
+  /// `loads`: the rows whose transposes carry λ into the grid (B_Γ, or B_Γ + R). Any dimension. With a
+  /// distribution, the solver's vectors are this rank's slab and the readings are added over the ranks
+  /// (each product is then collective).
   template <int dim>
   ImplicitSchur(const FastSolver<dim>& solver, const SparseRows& B_gamma, const SparseRows& C_gamma,
-                const SparseRows& loads, const GmresOptions& options, DirectTerms direct = {})
+                const SparseRows& loads, const GmresOptions& options, DirectTerms direct = {},
+                const Distribution* distribution = nullptr)
       : ImplicitSchur([&solver, load = footprint(solver.grid(), {&loads}),
                        wanted = footprint(solver.grid(), {&B_gamma, &C_gamma})](
                           GridVector& r) { solver.solve_in_place_at(r, load, wanted); },
-                      solver.grid().n_unknowns(), B_gamma, C_gamma, loads, options, std::move(direct)) {}
+                      solver.make_vector(), B_gamma, C_gamma, loads, options, std::move(direct)) {
+    if (distribution && distribution->distributed())
+      distribution_ = distribution, offset_ = solver.grid().slab_offset(solver.slab());
+  }
   /// With A⁻¹ as `solve_in_place` on vectors of `n_unknowns`.
   ImplicitSchur(std::function<void(GridVector&)> solve_in_place, std::size_t n_unknowns, const SparseRows& B_gamma,
                 const SparseRows& C_gamma, const SparseRows& loads, const GmresOptions& options,
-                DirectTerms direct = {});
+                DirectTerms direct = {})
+      : ImplicitSchur(std::move(solve_in_place), GridVector(n_unknowns), B_gamma, C_gamma, loads, options,
+                      std::move(direct)) {}
   int size() const override { return B_Gamma_.n_rows(); }
   void apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const override;
   LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
@@ -127,10 +136,14 @@ class ImplicitSchur final : public SchurComplement {
                     Eigen::VectorXd& y) const;
 
  private:
+  ImplicitSchur(std::function<void(GridVector&)> solve_in_place, GridVector work, const SparseRows& B_gamma,
+                const SparseRows& C_gamma, const SparseRows& loads, const GmresOptions& options, DirectTerms direct);
   std::function<void(GridVector&)> solve_in_place_;
   const SparseRows &B_gamma_, &C_gamma_, &B_Gamma_;
   GmresOptions options_;
   DirectTerms direct_;
+  const Distribution* distribution_ = nullptr;  // a distributed run's: work_ is this rank's slab
+  std::size_t offset_ = 0;                      // where the slab begins in the whole vector
   mutable GridVector work_;
   mutable std::vector<double> lambda_, rows_;
   mutable std::size_t fast_solves_ = 0;
@@ -200,6 +213,9 @@ class ExplicitSchur final : public SchurComplement {
   /// y = S_𝒜 x without forming S_𝒜.
   void apply_newton(const ActiveSet& active, const ConstantMode* mode, const Eigen::VectorXd& x,
                     Eigen::VectorXd& y) const;
+  /// Every rank takes rank 0's blocks (a distributed run: the ranks then run the same Newton steps on
+  /// the same numbers, bit for bit, as their collective products need). Collective.
+  void share(const Distribution& distribution);
   /// The solver of S_𝒜, kept between calls (NewtonFactorization); valid until the next call. `solve`
   /// and this change that kept state: one ExplicitSchur serves one thread.
   const NewtonFactorization& factorization(const ActiveSet& active, const ConstantMode* mode) const;

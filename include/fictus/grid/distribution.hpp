@@ -1,0 +1,81 @@
+#pragma once
+// Where a solve's grid lies. Serial (the default): one process holds every layer of every grid vector.
+// Distributed (fictus_mpi's, under mpirun): each rank holds whole layers along the slowest axis (a
+// Slab, grid.hpp), the fast solves run on FFTW-MPI, and what sums over the grid (readings of sparse
+// rows, integrals over ω) is added over the ranks. The boundary's unknowns (λ, the Schur blocks,
+// Newton) are small and every rank holds all of them.
+//
+// Every member that touches other ranks is collective: each rank calls it, in the same order. A rank
+// that failed alone would leave the others waiting, so a check whose answer may differ between ranks
+// (a NaN in one rank's layers) asks all() first and every rank throws together.
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "fictus/grid/grid.hpp"
+#include "fictus/grid/sparse_rows.hpp"
+
+namespace fictus {
+
+class Execution;
+template <int dim>
+class FastSolver;
+
+class Distribution {
+ public:
+  virtual ~Distribution() = default;
+  virtual int rank() const { return 0; }
+  virtual int size() const { return 1; }
+  bool distributed() const { return size() > 1; }
+
+  /// The layers this rank holds of a grid with `layers` layers (serial: all of them).
+  virtual Slab slab(int layers) const { return Slab{0, layers}; }
+  template <int dim>
+  Slab slab(const Grid<dim>& grid) const {
+    return slab(grid.layers());
+  }
+
+  /// values[i] ← Σ over the ranks of values[i], on every rank (serial: unchanged).
+  virtual void sum(double* values, std::size_t n) const { (void)values, (void)n; }
+  void sum(std::vector<double>& values) const { sum(values.data(), values.size()); }
+  double sum(double value) const {
+    sum(&value, 1);
+    return value;
+  }
+  virtual double max(double value) const { return value; }
+  /// values ← rank 0's values, on every rank.
+  virtual void broadcast(double* values, std::size_t n) const { (void)values, (void)n; }
+  /// Is `ok` true on every rank? The same answer on all of them.
+  bool all(bool ok) const { return max(ok ? 0.0 : 1.0) == 0.0; }
+
+  /// The fast solver of A = K + c·M for this distribution (serial: make_fast_solver's).
+  virtual std::unique_ptr<FastSolver<2>> fast_solver(const Grid<2>& grid, double c, const Execution& execution) const;
+  virtual std::unique_ptr<FastSolver<3>> fast_solver(const Grid<3>& grid, double c, const Execution& execution) const;
+
+  /// This rank's layers (`local`, its slab's) followed by the next layer, from the rank that holds it;
+  /// zeros where there is none. What the samplers over ω take with a slab. Serial: never asked.
+  virtual GridVector with_next_layer(const Grid<2>& grid, const GridVector& local) const;
+  virtual GridVector with_next_layer(const Grid<3>& grid, const GridVector& local) const;
+  /// The whole grid vector from each rank's layers: on every rank, or (`everywhere` false) on rank 0
+  /// only (the others get an empty vector).
+  virtual GridVector gather(const Grid<2>& grid, const GridVector& local, bool everywhere = true) const;
+  virtual GridVector gather(const Grid<3>& grid, const GridVector& local, bool everywhere = true) const;
+};
+
+/// The process's distribution: what an Execution made without one takes. Serial until a program that
+/// runs under mpirun sets its own (the CLI does, on more than one rank); the library and the Python
+/// module never do.
+std::shared_ptr<const Distribution> process_distribution();
+void set_process_distribution(std::shared_ptr<const Distribution> distribution);
+
+/// out = rows·u with u this rank's part of a grid vector (its slab of `grid`, from the distribution of
+/// `execution`): each rank's partial sums, added over the ranks. Serial: rows.multiply(u, out).
+template <int dim>
+void read_rows(const SparseRows& rows, const Grid<dim>& grid, const GridVector& u, const Distribution& distribution,
+               std::vector<double>& out);
+/// u += rowsᵀλ on this rank's part of a grid vector.
+template <int dim>
+void add_rows(const SparseRows& rows, const Grid<dim>& grid, const std::vector<double>& lambda, GridVector& u,
+              const Distribution& distribution);
+
+}  // namespace fictus

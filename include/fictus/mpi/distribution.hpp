@@ -1,0 +1,34 @@
+#pragma once
+// The distribution of a run under mpirun (Distribution, distribution.hpp): each rank of a communicator
+// holds FFTW-MPI's default slab of every grid vector (default_slab), the fast solves are SlabSolver's,
+// and the sums and broadcasts are MPI's collectives on that communicator.
+#include "fictus/grid/distribution.hpp"
+#include "fictus/mpi/communicator.hpp"
+
+namespace fictus::mpi {
+
+class SlabDistribution final : public Distribution {
+ public:
+  /// The communicator must outlive the distribution and every solver made from it.
+  explicit SlabDistribution(Communicator comm = Communicator{}) : comm_(comm) {}
+  const Communicator& communicator() const { return comm_; }
+  int rank() const override { return comm_.rank(); }
+  int size() const override { return comm_.size(); }
+  Slab slab(int layers) const override;
+  using Distribution::slab;
+  void sum(double* values, std::size_t n) const override { comm_.sum(values, n); }
+  using Distribution::sum;
+  double max(double value) const override { return comm_.max(value); }
+  void broadcast(double* values, std::size_t n) const override;
+  std::unique_ptr<FastSolver<2>> fast_solver(const Grid<2>& grid, double c, const Execution& execution) const override;
+  std::unique_ptr<FastSolver<3>> fast_solver(const Grid<3>& grid, double c, const Execution& execution) const override;
+  GridVector with_next_layer(const Grid<2>& grid, const GridVector& local) const override;
+  GridVector with_next_layer(const Grid<3>& grid, const GridVector& local) const override;
+  GridVector gather(const Grid<2>& grid, const GridVector& local, bool everywhere = true) const override;
+  GridVector gather(const Grid<3>& grid, const GridVector& local, bool everywhere = true) const override;
+
+ private:
+  Communicator comm_;
+};
+
+}  // namespace fictus::mpi

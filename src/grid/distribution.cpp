@@ -1,0 +1,75 @@
+#include "fictus/grid/distribution.hpp"
+
+#include <atomic>
+#include <stdexcept>
+#include <utility>
+
+#include "fictus/grid/execution.hpp"
+#include "fictus/grid/dst_solver.hpp"
+
+namespace fictus {
+
+namespace {
+
+std::shared_ptr<const Distribution>& process_slot() {
+  static std::shared_ptr<const Distribution> slot = std::make_shared<const Distribution>();
+  return slot;
+}
+
+template <int dim>
+std::unique_ptr<FastSolver<dim>> serial_fast_solver(const Grid<dim>& grid, double c, const Execution& execution) {
+  if (grid.periodic()) return std::make_unique<PeriodicSolver<dim>>(grid, c, execution);
+  return std::make_unique<DstSolver<dim>>(grid, c, execution);
+}
+
+[[noreturn]] void serial_only(const char* what) {
+  throw std::logic_error(std::string("Distribution::") + what + ": asked of a serial run");
+}
+
+}  // namespace
+
+std::shared_ptr<const Distribution> process_distribution() { return std::atomic_load(&process_slot()); }
+
+void set_process_distribution(std::shared_ptr<const Distribution> distribution) {
+  if (!distribution) distribution = std::make_shared<const Distribution>();
+  std::atomic_store(&process_slot(), std::move(distribution));
+}
+
+std::unique_ptr<FastSolver<2>> Distribution::fast_solver(const Grid<2>& grid, double c,
+                                                         const Execution& execution) const {
+  return serial_fast_solver(grid, c, execution);
+}
+std::unique_ptr<FastSolver<3>> Distribution::fast_solver(const Grid<3>& grid, double c,
+                                                         const Execution& execution) const {
+  return serial_fast_solver(grid, c, execution);
+}
+GridVector Distribution::with_next_layer(const Grid<2>&, const GridVector&) const { serial_only("with_next_layer"); }
+GridVector Distribution::with_next_layer(const Grid<3>&, const GridVector&) const { serial_only("with_next_layer"); }
+GridVector Distribution::gather(const Grid<2>&, const GridVector& local, bool) const { return local; }
+GridVector Distribution::gather(const Grid<3>&, const GridVector& local, bool) const { return local; }
+
+template <int dim>
+void read_rows(const SparseRows& rows, const Grid<dim>& grid, const GridVector& u, const Distribution& distribution,
+               std::vector<double>& out) {
+  if (!distribution.distributed()) return rows.multiply(u, out);
+  rows.multiply(u, grid.slab_offset(distribution.slab(grid)), out);
+  distribution.sum(out);
+}
+
+template <int dim>
+void add_rows(const SparseRows& rows, const Grid<dim>& grid, const std::vector<double>& lambda, GridVector& u,
+              const Distribution& distribution) {
+  if (!distribution.distributed()) return rows.add_transposed(lambda, u);
+  rows.add_transposed(lambda, u, grid.slab_offset(distribution.slab(grid)));
+}
+
+template void read_rows(const SparseRows&, const Grid<2>&, const GridVector&, const Distribution&,
+                        std::vector<double>&);
+template void read_rows(const SparseRows&, const Grid<3>&, const GridVector&, const Distribution&,
+                        std::vector<double>&);
+template void add_rows(const SparseRows&, const Grid<2>&, const std::vector<double>&, GridVector&,
+                       const Distribution&);
+template void add_rows(const SparseRows&, const Grid<3>&, const std::vector<double>&, GridVector&,
+                       const Distribution&);
+
+}  // namespace fictus

@@ -1,0 +1,71 @@
+#include "fictus/mpi/distribution.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <stdexcept>
+#include <vector>
+
+#include "fictus/mpi/next_layer.hpp"
+#include "fictus/mpi/slab_solver.hpp"
+
+namespace fictus::mpi {
+
+namespace {
+
+template <int dim>
+GridVector gather_layers(const Grid<dim>& grid, const GridVector& local, const Communicator& comm, bool everywhere) {
+  const int P = comm.size();
+  const Slab mine = default_slab(grid.layers(), comm.rank(), P);
+  if (local.size() != grid.slab_size(mine)) throw std::invalid_argument("gather: vector size mismatch");
+  // Counted in layers (a layer of 2048³ has 4.2 million entries): the counts fit an int.
+  MPI_Datatype layer;
+  MPI_Type_contiguous(int(grid.layer_size()), MPI_DOUBLE, &layer);
+  MPI_Type_commit(&layer);
+  std::vector<int> counts(static_cast<std::size_t>(P)), firsts(static_cast<std::size_t>(P));
+  for (int r = 0; r < P; ++r) {
+    const Slab s = default_slab(grid.layers(), r, P);
+    counts[std::size_t(r)] = s.count, firsts[std::size_t(r)] = s.first;
+  }
+  GridVector whole(everywhere || comm.rank() == 0 ? grid.n_unknowns() : 0, 0.0);
+  if (everywhere)
+    MPI_Allgatherv(local.data(), mine.count, layer, whole.data(), counts.data(), firsts.data(), layer, comm.get());
+  else
+    MPI_Gatherv(local.data(), mine.count, layer, whole.data(), counts.data(), firsts.data(), layer, 0, comm.get());
+  MPI_Type_free(&layer);
+  return whole;
+}
+
+}  // namespace
+
+Slab SlabDistribution::slab(int layers) const { return default_slab(layers, comm_.rank(), comm_.size()); }
+
+void SlabDistribution::broadcast(double* values, std::size_t n) const {
+  for (std::size_t done = 0; done < n;) {
+    const int chunk = int(std::min<std::size_t>(n - done, INT_MAX));
+    MPI_Bcast(values + done, chunk, MPI_DOUBLE, 0, comm_.get());
+    done += std::size_t(chunk);
+  }
+}
+
+std::unique_ptr<FastSolver<2>> SlabDistribution::fast_solver(const Grid<2>& grid, double c,
+                                                             const Execution& execution) const {
+  return std::make_unique<SlabSolver<2>>(grid, c, comm_, execution);
+}
+std::unique_ptr<FastSolver<3>> SlabDistribution::fast_solver(const Grid<3>& grid, double c,
+                                                             const Execution& execution) const {
+  return std::make_unique<SlabSolver<3>>(grid, c, comm_, execution);
+}
+GridVector SlabDistribution::with_next_layer(const Grid<2>& grid, const GridVector& local) const {
+  return mpi::with_next_layer(grid, slab(grid), local, comm_);
+}
+GridVector SlabDistribution::with_next_layer(const Grid<3>& grid, const GridVector& local) const {
+  return mpi::with_next_layer(grid, slab(grid), local, comm_);
+}
+GridVector SlabDistribution::gather(const Grid<2>& grid, const GridVector& local, bool everywhere) const {
+  return gather_layers(grid, local, comm_, everywhere);
+}
+GridVector SlabDistribution::gather(const Grid<3>& grid, const GridVector& local, bool everywhere) const {
+  return gather_layers(grid, local, comm_, everywhere);
+}
+
+}  // namespace fictus::mpi
