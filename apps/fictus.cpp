@@ -4,13 +4,13 @@
 
 #include <sys/wait.h>
 #include <unistd.h>
-#include <cerrno>
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
-#include <exception>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <filesystem>
 #include <functional>
 #include <iostream>
@@ -374,6 +374,11 @@ int run_solve_in(const std::string& text, const SolveCommand& command) {
   }
   fictus::FictitiousDomainSolver<dim> solver(spec.problem, spec.options);
   if (long_run) solver.set_progress(progress_lines());
+#ifdef FICTUS_WITH_MPI
+  // The tests' way to make one rank fail alone while the others are in the solve's collectives.
+  if (const char* rank = std::getenv("FICTUS_TEST_FAIL_ON_RANK"); rank && distribution.distributed())
+    if (std::atoi(rank) == distribution.rank()) throw std::runtime_error("a failure of this rank alone (the tests')");
+#endif
   fictus::BasicSolution<dim> s = solver.solve(spec.problem, spec.options, true, false);
   s.peak_memory_bytes = fictus::peak_memory_bytes();
   if (distribution.distributed()) {  // each rank's peak; the field on rank 0 for the files
@@ -387,7 +392,7 @@ int run_solve_in(const std::string& text, const SolveCommand& command) {
   }
   for (const std::string& w : s.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
   if (!s.newton.converged) throw NewtonFailure(fictus::describe_newton_failure(s));  // the same on every rank
-  on_rank_0(distribution, [&] {  // rank 0 speaks and writes for all
+  on_rank_0(distribution, [&] {                                                      // rank 0 speaks and writes for all
     if (!command.quiet) print_summary(s);
     if (spec.output.dir.empty()) return;
     const std::vector<fictus::cli::OutputFile> files = output_files(spec, s, input);
@@ -620,7 +625,7 @@ int main(int argc, char** argv) {
   const std::set<std::string> commands = {"solve", "plot", "reproduce", "sweep", "options"};
   if (argc > 1 && argv[1][0] != '-' && !commands.count(argv[1]))
     return fail(std::string(argv[1]) + ": not a command (solve, plot, reproduce, sweep, options; see fictus --help)",
-                  exit_bad_input);
+                exit_bad_input);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

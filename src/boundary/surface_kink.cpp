@@ -727,8 +727,7 @@ Eigen::SparseMatrix<double> balance_correction(const SparseRows& B_Gamma, const 
 
 FluxBalance flux_balance(const SurfaceKink& kink, const SparseRows& B_Gamma, const SparseRows& C_gamma,
                          const SparseRows& loads, const Eigen::SparseMatrix<double>& D_C,
-                         const GridVector& load_of_omega, const FastSolver<3>& fast,
-                         const Distribution& distribution) {
+                         const GridVector& load_of_omega, const FastSolver<3>& fast, const Distribution& distribution) {
   const int m = B_Gamma.n_rows();
   if (fast.singular()) throw std::invalid_argument("flux_balance: A is singular (a periodic box with c = 0)");
   if (C_gamma.n_rows() != m || loads.n_rows() != m || D_C.rows() != m || D_C.cols() != m ||

@@ -4,8 +4,8 @@
 #include <stdexcept>
 #include <utility>
 
-#include "fictus/grid/execution.hpp"
 #include "fictus/grid/dst_solver.hpp"
+#include "fictus/grid/execution.hpp"
 
 namespace fictus {
 
@@ -67,9 +67,7 @@ template void read_rows(const SparseRows&, const Grid<2>&, const GridVector&, co
                         std::vector<double>&);
 template void read_rows(const SparseRows&, const Grid<3>&, const GridVector&, const Distribution&,
                         std::vector<double>&);
-template void add_rows(const SparseRows&, const Grid<2>&, const std::vector<double>&, GridVector&,
-                       const Distribution&);
-template void add_rows(const SparseRows&, const Grid<3>&, const std::vector<double>&, GridVector&,
-                       const Distribution&);
+template void add_rows(const SparseRows&, const Grid<2>&, const std::vector<double>&, GridVector&, const Distribution&);
+template void add_rows(const SparseRows&, const Grid<3>&, const std::vector<double>&, GridVector&, const Distribution&);
 
 }  // namespace fictus

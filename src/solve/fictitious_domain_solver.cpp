@@ -703,8 +703,7 @@ template <int dim>
 DomainQuantities domain_quantities(const State<dim>& st, const BoundaryDiscretization<dim>& boundary,
                                    const GridVector& u, int quadrature, const BasicSolution<dim>* coarse,
                                    const GridVector& coarse_u, const typename Fields<dim>::Vectorized& exact,
-                                   double& difference2,
-                                   std::array<double, 2>& exact_integrals) {
+                                   double& difference2, std::array<double, 2>& exact_integrals) {
   const typename Fields<dim>::Vectorized f = st.f_vectorized ? st.f_vectorized : vectorize(st.f);
   constexpr int K = 9;  // |ω|, ∫û, ∫û², ∫|∇û|², ∫f, ∫fû, ∫(û − û_{N/2})², ∫u, ∫fu (u: the exact solution)
   std::vector<std::array<double, K>> sums(std::size_t(st.execution.threads()), std::array<double, K>{});
@@ -818,7 +817,9 @@ void quantities_step(const State<dim>& st, const BoundaryDiscretization<dim>& bo
   const GridVector coarse_whole =
       from && distribution.distributed() ? distribution.gather(from->grid, from->u) : GridVector();
   sol.domain = domain_quantities<dim>(st, boundary, sol.u, quantity_quadrature, from,
-                                      distribution.distributed() ? coarse_whole : from ? from->u : coarse_whole,
+                                      distribution.distributed() ? coarse_whole
+                                      : from                     ? from->u
+                                                                 : coarse_whole,
                                       exact_u, difference2, exact);
   if (sol.errors) {
     ErrorNorms& e = *sol.errors;

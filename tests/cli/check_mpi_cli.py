@@ -1,6 +1,7 @@
-"""fictus under mpirun: on one rank a solve runs as without mpirun; on more ranks the run stops with the
-error line once and a non-zero exit, and no rank is left waiting (a time limit); started by a launcher
-that is not its MPI's, it refuses.
+"""fictus under mpirun: on one rank a solve runs as without mpirun; on two and three ranks it solves
+distributed, rank 0 printing and writing for all; bad input on every rank or on one rank's layers stops
+the run with the error line once and a non-zero exit, a rank failing alone stops all, and no rank is
+left waiting (a time limit); started by a launcher that is not its MPI's, it refuses.
 
 usage: check_mpi_cli.py FICTUS OUT_DIR MPIEXEC [MPIEXEC_FLAG ...] NUMPROC_FLAG
 """
@@ -21,22 +22,68 @@ def run(ranks, *args):
 
 
 shutil.rmtree(out, ignore_errors=True)
-two = run(2, "solve", "--N", "64", "--out", os.path.join(out, "two"))
-errors = [line for line in (two.stdout + two.stderr).splitlines() if line.startswith("fictus: error:")]
-assert two.returncode != 0, "two ranks: exit code 0"
-assert len(errors) == 1, f"two ranks: {len(errors)} error lines, want 1:\n{two.stdout}{two.stderr}"
-assert "MPI ranks" in errors[0], errors[0]
-assert not os.path.exists(os.path.join(out, "two")), "two ranks: wrote output"
+
+
+def error_lines(result):
+    return [line for line in (result.stdout + result.stderr).splitlines() if line.startswith("fictus: error:")]
+
+
+def serial_results(name, *args):
+    done = subprocess.run([fictus, "solve", *args, "--quiet", "--files", "results.json", "--out",
+                           os.path.join(out, name)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    with open(os.path.join(out, name, "results.json")) as f:
+        return json.load(f)
+
+
+# Two and three ranks solve together: rank 0 prints one summary and writes the files; the answers are
+# the serial ones (the ctest mpi.solve_* compares every quantity).
+expected = serial_results("serial", "--N", "64")
+for ranks in (2, 3):
+    folder = os.path.join(out, f"ranks{ranks}")
+    together = run(ranks, "solve", "--N", "64", "--out", folder)
+    assert together.returncode == 0, f"{ranks} ranks: exit {together.returncode}:\n{together.stdout}{together.stderr}"
+    assert together.stdout.count("Newton:") == 1, f"{ranks} ranks: not one summary:\n{together.stdout}"
+    with open(os.path.join(folder, "results.json")) as f:
+        results = json.load(f)
+    assert results["ranks"]["count"] == ranks and len(results["ranks"]["peak_memory_bytes"]) == ranks, results["ranks"]
+    for key in ("force", "measure", "lambda_integral"):
+        x, y = results["contact"][key], expected["contact"][key]
+        assert abs(x - y) <= 1e-11 * abs(y), f"{ranks} ranks: contact.{key} {x} against {y} serially"
+    assert results["contact"]["points"] == expected["contact"]["points"], f"{ranks} ranks: another contact set"
+    assert os.path.getsize(os.path.join(folder, "solution.vti")) > 0
+
+# Bad input found by every rank, and bad data found by one rank only (f is NaN in the top layers, which
+# the last rank holds): one error line (rank 0's), a non-zero exit, no files, no rank left waiting.
+for name, args, expect in (("bad_flag", ["--N", "7"], "domain.N"),
+                           ("nan_in_a_slab", ["--N", "64", "--parameter", "top=0.95"], "data.f")):
+    problem = os.path.join(out, "nan.toml")
+    with open(problem, "w") as f:
+        f.write('[parameters]\ntop = 2.0\n[geometry]\nshape = "circle"\ncenter = [0.5, 0.5]\nradius = 0.3\n'
+                '[data]\nf = "y > top ? sqrt(-1) : 1"\ng = "-1"\n')
+    failed = run(2, "solve", problem, *args, "--out", os.path.join(out, name))
+    errors = error_lines(failed)
+    assert failed.returncode != 0, f"{name}: exit code 0"
+    assert len(errors) == 1 and expect in errors[0], f"{name}: want one error line on {expect}:\n{failed.stderr}"
+    assert not os.path.exists(os.path.join(out, name)), f"{name}: wrote output"
+
+# A rank that fails alone (the test's hook: the others are already in the solve's collectives) stops
+# every rank within seconds, with a non-zero exit.
+alone_rank = subprocess.run(launcher + [numproc, "2", fictus, "solve", "--N", "64", "--out", os.path.join(out, "alone_rank")],
+                            env=dict(env, FICTUS_TEST_FAIL_ON_RANK="1"), capture_output=True, text=True, timeout=120)
+assert alone_rank.returncode != 0, "a rank failing alone: exit code 0"
+assert "failed alone" in alone_rank.stderr, alone_rank.stderr
+assert not os.path.exists(os.path.join(out, "alone_rank")), "a rank failing alone: wrote output"
+
+# Only solve runs distributed.
+sweep = run(2, "sweep", "--g-scale", "1,2", "--out", os.path.join(out, "sweep"))
+assert sweep.returncode != 0 and len(error_lines(sweep)) == 1, sweep.stderr
+assert "only fictus solve" in error_lines(sweep)[0], error_lines(sweep)[0]
 
 one = run(1, "solve", "--N", "64", "--quiet", "--files", "results.json", "--out", os.path.join(out, "one"))
 assert one.returncode == 0, f"one rank: exit {one.returncode}:\n{one.stdout}{one.stderr}"
 with open(os.path.join(out, "one", "results.json")) as f:
     results = json.load(f)
-serial = subprocess.run([fictus, "solve", "--N", "64", "--quiet", "--files", "results.json", "--out",
-                         os.path.join(out, "serial")], capture_output=True, text=True, timeout=120)
-assert serial.returncode == 0, serial.stderr
-with open(os.path.join(out, "serial", "results.json")) as f:
-    expected = json.load(f)
 for key in ("force", "measure", "lambda_integral"):
     x, y = results["contact"][key], expected["contact"][key]
     assert abs(x - y) <= 1e-12 * abs(y), f"one rank: contact.{key} {x} against {y} without mpirun"
@@ -47,4 +94,5 @@ alone = subprocess.run([fictus, "solve", "--N", "64", "--out", os.path.join(out,
                        env=dict(env, SLURM_STEP_NUM_TASKS="3"), capture_output=True, text=True, timeout=120)
 assert alone.returncode != 0 and "MPI sees this process alone" in alone.stderr, alone.stderr
 assert not os.path.exists(os.path.join(out, "alone")), "alone: wrote output"
-print("mpirun: one rank solves as without it; two ranks stop with one error line")
+print("mpirun: one rank solves as without it; two and three ranks solve together as one; errors on any rank stop "
+      "every rank with one error line")

@@ -201,7 +201,7 @@ struct BasicSolution : SolutionBoundary<dim> {
   std::optional<ErrorNorms> errors;
   std::optional<PointErrors> point_errors;
   Timings timings;
-  std::size_t peak_memory_bytes = 0;  // of the process so far (VmHWM; set by the caller, 0 if unknown)
+  std::size_t peak_memory_bytes = 0;                // of the process so far (VmHWM; set by the caller, 0 if unknown)
   std::vector<std::size_t> rank_peak_memory_bytes;  // under mpirun: each rank's (rank 0's is the above)
 };
 
