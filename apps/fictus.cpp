@@ -27,6 +27,7 @@
 
 #include "fictus/mpi/communicator.hpp"
 #include "fictus/mpi/distribution.hpp"
+#include "fictus/mpi/slab_solver.hpp"
 #endif
 #include "fictus/io/problem_file.hpp"
 #include "fictus/io/process.hpp"
@@ -216,9 +217,13 @@ void print_summary(const fictus::BasicSolution<dim>& s) {
 
 /// With any VTK file among `files`, solution.vtm naming them all (one file opens the run in ParaView).
 void add_multiblock(std::vector<fictus::cli::OutputFile>& files) {
-  static const std::vector<std::pair<std::string, std::string>> blocks = {
-      {"solution.vti", "field"}, {"curves.vtp", "gamma"},         {"offset_curve.vtp", "Gamma"},
-      {"surface.vtp", "gamma"},  {"offset_surface.vtp", "Gamma"}, {"contact_boundary.vtp", "contact boundary"}};
+  static const std::vector<std::pair<std::string, std::string>> blocks = {{"solution.vti", "field"},
+                                                                          {"solution.pvti", "field"},
+                                                                          {"curves.vtp", "gamma"},
+                                                                          {"offset_curve.vtp", "Gamma"},
+                                                                          {"surface.vtp", "gamma"},
+                                                                          {"offset_surface.vtp", "Gamma"},
+                                                                          {"contact_boundary.vtp", "contact boundary"}};
   std::vector<std::pair<std::string, std::string>> named;  // (block, file)
   for (const auto& [file, block] : blocks)
     if (std::any_of(files.begin(), files.end(), [&](const auto& f) { return f.name == file; }))
@@ -282,9 +287,11 @@ fictus::ParameterValues parameter_values(const std::vector<std::string>& given) 
 
 /// The files of a run: results.json, points.csv, the VTK files (and Γ's in the smooth variant), and
 /// solution.vtm naming the VTK files.
+/// `field_files`: what replaces solution.vti (a run on several ranks: solution.pvti and its pieces).
 template <int dim>
 std::vector<fictus::cli::OutputFile> output_files(const fictus::BasicProblemSpec<dim>& spec,
-                                                  const fictus::BasicSolution<dim>& s, const json& input) {
+                                                  const fictus::BasicSolution<dim>& s, const json& input,
+                                                  const std::vector<fictus::cli::OutputFile>& field_files = {}) {
   const char* boundary_file = dim == 2 ? "curves.vtp" : "surface.vtp";
   std::vector<fictus::cli::OutputFile> files;
   for (const std::string& name : spec.output.files) {
@@ -294,6 +301,8 @@ std::vector<fictus::cli::OutputFile> output_files(const fictus::BasicProblemSpec
                        }});
     else if (name == "points.csv")
       files.push_back({name, [&](std::ostream& out) { out << fictus::cli::points_csv(s); }});
+    else if (name == "solution.vti" && !field_files.empty())
+      files.insert(files.end(), field_files.begin(), field_files.end());
     else if (name == "solution.vti")
       files.push_back({name, [&](std::ostream& out) { fictus::cli::write_vti(out, spec.problem, s); }});
     if (name != boundary_file) continue;
@@ -338,6 +347,89 @@ fictus::BasicProblemSpec<dim> solve_spec(std::string text, const SolveCommand& c
   }
   return spec;
 }
+
+#ifdef FICTUS_WITH_MPI
+/// The field of a run on several ranks, as ParaView's parallel image: solution.pvti naming one piece per
+/// rank that holds layers, solution_<rank>.vti, the node planes of its layers and the next one. Rank 0
+/// writes them all (in the output set, so that nothing is half-written): each rank sends it its layers
+/// and the next one, and rank 0 takes them one piece at a time, so it never holds the whole field.
+template <int dim>
+class FieldPieces {
+ public:
+  /// Collective (the next layers); then each rank but 0 sends its piece.
+  FieldPieces(const fictus::Distribution& distribution, const fictus::Grid<dim>& grid, const fictus::GridVector& u)
+      : grid_(grid),
+        rank_(distribution.rank()),
+        size_(distribution.size()),
+        held_(distribution.with_next_layer(grid, u)),
+        taken_(std::size_t(size_), false) {
+    MPI_Type_contiguous(int(grid.layer_size()), MPI_DOUBLE, &layer_);
+    MPI_Type_commit(&layer_);
+    if (rank_ != 0 && slab(rank_).count > 0)
+      MPI_Isend(held_.data(), slab(rank_).count + 1, layer_, 0, tag, MPI_COMM_WORLD, &send_);
+  }
+  /// Rank 0 takes every piece not taken yet, and the others' sends end, whatever happened in between
+  /// (a failed write included): no message is left over.
+  ~FieldPieces() {
+    if (rank_ == 0)
+      for (int r = 1; r < size_; ++r) values(r);
+    else if (send_ != MPI_REQUEST_NULL)
+      MPI_Wait(&send_, MPI_STATUS_IGNORE);
+    MPI_Type_free(&layer_);
+  }
+  FieldPieces(const FieldPieces&) = delete;
+  FieldPieces& operator=(const FieldPieces&) = delete;
+
+  /// Rank 0: solution.pvti and the pieces, for output_files.
+  std::vector<fictus::cli::OutputFile> files(const fictus::BasicProblem<dim>& problem,
+                                             const fictus::BasicSolution<dim>& s) {
+    std::vector<std::pair<std::array<int, 2>, std::string>> pieces;
+    std::vector<fictus::cli::OutputFile> files;
+    for (int r = 0; r < size_; ++r) {
+      if (slab(r).count == 0) continue;
+      const std::string name = "solution_" + std::to_string(r) + ".vti";
+      pieces.push_back({planes(r), name});
+      files.push_back({name, [this, r, &problem, &s](std::ostream& out) {
+                         const fictus::cli::FieldPiece piece{planes(r)[0], planes(r)[1], slab(r), &values(r)};
+                         fictus::cli::write_vti(out, problem, s, &piece);
+                       }});
+    }
+    files.insert(files.begin(), {"solution.pvti", [pieces, &problem, &s](std::ostream& out) {
+                                   fictus::cli::write_pvti(out, problem, s, pieces);
+                                 }});
+    return files;
+  }
+
+ private:
+  static constexpr int tag = 7;
+  fictus::Slab slab(int r) const { return fictus::mpi::default_slab(grid_.layers(), r, size_); }
+  /// The node planes of rank r's piece: its layers' and the next one (a Dirichlet box's first piece also
+  /// the wall's plane 0).
+  std::array<int, 2> planes(int r) const {
+    const fictus::Slab s = slab(r);
+    if (grid_.periodic()) return {s.first, s.first + s.count};
+    return {s.first == 0 ? 0 : s.first + 1, s.first + s.count + 1};
+  }
+  /// Rank 0: rank r's layers and the next one (received at the first call; the last piece received is
+  /// kept).
+  const fictus::GridVector& values(int r) {
+    if (r == 0) return held_;
+    if (!taken_[std::size_t(r)] && slab(r).count > 0) {
+      received_.resize(grid_.slab_size(slab(r)) + grid_.layer_size());
+      MPI_Recv(received_.data(), slab(r).count + 1, layer_, r, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      taken_[std::size_t(r)] = true;
+    }
+    return received_;
+  }
+
+  fictus::Grid<dim> grid_;
+  int rank_, size_;
+  fictus::GridVector held_, received_;
+  std::vector<bool> taken_;
+  MPI_Datatype layer_;
+  MPI_Request send_ = MPI_REQUEST_NULL;
+};
+#endif
 
 /// Runs `work` (a check of the file system, the printing and the files) on rank 0 only, and throws on
 /// every rank when it threw there.
@@ -387,15 +479,23 @@ int run_solve_in(const std::string& text, const SolveCommand& command) {
     distribution.sum(peaks);
     for (double p : peaks) s.rank_peak_memory_bytes.push_back(std::size_t(p));
     s.peak_memory_bytes = s.rank_peak_memory_bytes[0];
-    const bool field_file = std::count(spec.output.files.begin(), spec.output.files.end(), "solution.vti") > 0;
-    s.u = field_file && !spec.output.dir.empty() ? distribution.gather(s.grid, s.u, false) : fictus::GridVector();
   }
+#ifdef FICTUS_WITH_MPI
+  std::optional<FieldPieces<dim>> pieces;  // the field in pieces, one per rank
+  if (distribution.distributed() && !spec.output.dir.empty() &&
+      std::count(spec.output.files.begin(), spec.output.files.end(), "solution.vti") > 0)
+    pieces.emplace(distribution, s.grid, s.u);
+#endif
   for (const std::string& w : s.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
   if (!s.newton.converged) throw NewtonFailure(fictus::describe_newton_failure(s));  // the same on every rank
   on_rank_0(distribution, [&] {                                                      // rank 0 speaks and writes for all
     if (!command.quiet) print_summary(s);
     if (spec.output.dir.empty()) return;
-    const std::vector<fictus::cli::OutputFile> files = output_files(spec, s, input);
+    std::vector<fictus::cli::OutputFile> field_files;
+#ifdef FICTUS_WITH_MPI
+    if (pieces) field_files = pieces->files(spec.problem, s);
+#endif
+    const std::vector<fictus::cli::OutputFile> files = output_files(spec, s, input, field_files);
     fictus::cli::write_output_set(spec.output.dir, files);
     if (command.quiet) return;
     std::uintmax_t bytes = 0;

@@ -102,6 +102,30 @@ def read_vti(path):
     return (*axes, arrays)
 
 
+def read_field(folder):
+    """The field of a run: solution.vti, or (a run on several MPI ranks) solution.pvti's pieces put
+    together. The axes and the point arrays, shaped [j, i] or [k, j, i]."""
+    single = os.path.join(folder, "solution.vti")
+    if os.path.exists(single):
+        return read_vti(single)
+    with open(os.path.join(folder, "solution.pvti")) as handle:
+        text = handle.read()
+    extent = [int(v) for v in re.search(r'WholeExtent="([^"]+)"', text).group(1).split()]
+    origin = [float(v) for v in re.search(r'Origin="([^"]+)"', text).group(1).split()]
+    spacing = [float(v) for v in re.search(r'Spacing="([^"]+)"', text).group(1).split()]
+    three = extent[5] > 0
+    shape = (extent[5] + 1, extent[3] + 1, extent[1] + 1) if three else (extent[3] + 1, extent[1] + 1)
+    arrays = {}
+    for piece, source in re.findall(r'<Piece Extent="([^"]+)" Source="([^"]+)"', text):
+        first, last = [int(v) for v in piece.split()][(4 if three else 2):(6 if three else 4)]
+        _, found = read_xml_arrays(os.path.join(folder, source))
+        for (_, name), values in found.items():
+            whole = arrays.setdefault(name, np.zeros(shape, dtype=values.dtype))
+            whole[first:last + 1] = values.reshape((last - first + 1,) + shape[1:])
+    axes = [origin[d] + spacing[d] * np.arange(extent[2 * d + 1] + 1) for d in range(3 if three else 2)]
+    return (*axes, arrays)
+
+
 def read_vtp(path):
     """fictus's surface.vtp or offset_surface.vtp: points, triangles (point indices), cell arrays."""
     _, found = read_xml_arrays(path)
@@ -125,7 +149,7 @@ def closed(v):
 # 2-D
 
 def plot_solution(folder):
-    x, y, arrays = read_vti(os.path.join(folder, "solution.vti"))
+    x, y, arrays = read_field(folder)
     p = read_csv(os.path.join(folder, "points.csv"))
     u = np.where(arrays["inside"] > 0, arrays["u"], np.nan)
     fig, ax = plt.subplots(figsize=(7, 6))
@@ -268,7 +292,7 @@ def plot_convergence(folder):
 # 3-D
 
 def plot_slices(folder):
-    x, y, z, arrays = read_vti(os.path.join(folder, "solution.vti"))
+    x, y, z, arrays = read_field(folder)
     inside = arrays["inside"] > 0
     u = np.where(inside, arrays["u"], np.nan)  # indexed [k, j, i]
     k, j, i = (int(round(float(np.mean(np.nonzero(inside)[a])))) for a in range(3))
@@ -395,7 +419,7 @@ def main(folder, with_lambda=False):
         made.append("sweep.png")
     if results_of(folder).get("dim", 2) == 3:
         inputs = "solution.vti or surface.vtp"
-        if exists("solution.vti"):
+        if exists("solution.vti") or exists("solution.pvti"):
             plot_slices(folder)
             made.append("slices.png")
         if exists("surface.vtp"):
@@ -403,7 +427,7 @@ def main(folder, with_lambda=False):
             made.append("surface.png")
     else:
         inputs = "solution.vti, points.csv, table<k>.csv or sweep.json"
-        if exists("solution.vti") and exists("points.csv"):
+        if (exists("solution.vti") or exists("solution.pvti")) and exists("points.csv"):
             plot_solution(folder)
             made.append("solution.png")
         if exists("points.csv"):

@@ -164,17 +164,42 @@ struct DataArrays {
   }
 };
 
-/// ImageData of the nodes of extent [0, n_d] with the point data `data`.
+/// The extent "0 n0 0 n1 0 n2", or with `planes` the planes [first, last] along `axis`.
+std::string extent_of(std::array<int, 3> n, int axis = 0, std::array<int, 2> planes = {-1, -1}) {
+  std::string text;
+  for (int d = 0; d < 3; ++d) {
+    const bool cut = d == axis && planes[0] >= 0;
+    text += (d ? " " : "") + std::to_string(cut ? planes[0] : 0) + " " + std::to_string(cut ? planes[1] : n[d]);
+  }
+  return text;
+}
+
+/// ImageData of the nodes of extent [0, n_d] with the point data `data`; a piece (planes [first, last]
+/// along `axis`) when planes are given.
 void write_image(std::ostream& out, std::array<int, 3> n, Point3 origin, Point3 spacing, const DataArrays& data,
-                 int threads) {
+                 int threads, int axis = 0, std::array<int, 2> planes = {-1, -1}) {
   std::ostringstream xml;
   xml.precision(17);
-  const std::string extent = "0 " + std::to_string(n[0]) + " 0 " + std::to_string(n[1]) + " 0 " + std::to_string(n[2]);
-  xml << header("ImageData") << "  <ImageData WholeExtent=\"" << extent << "\" Origin=\"" << origin.x << ' ' << origin.y
-      << ' ' << origin.z << "\" Spacing=\"" << spacing.x << ' ' << spacing.y << ' ' << spacing.z
-      << "\">\n    <Piece Extent=\"" << extent << "\">\n      <PointData Scalars=\"u\">\n"
+  xml << header("ImageData") << "  <ImageData WholeExtent=\"" << extent_of(n) << "\" Origin=\"" << origin.x << ' '
+      << origin.y << ' ' << origin.z << "\" Spacing=\"" << spacing.x << ' ' << spacing.y << ' ' << spacing.z
+      << "\">\n    <Piece Extent=\"" << extent_of(n, axis, planes) << "\">\n      <PointData Scalars=\"u\">\n"
       << data.xml << "      </PointData>\n    </Piece>\n  </ImageData>\n";
   write_appended(out, xml.str(), data.arrays, threads);
+}
+
+/// The node planes [first, last] of the slowest axis that `piece` covers (all of them without one).
+template <int dim>
+std::array<int, 2> planes_of(const Grid<dim>& grid, const FieldPiece* piece) {
+  return piece ? std::array<int, 2>{piece->first, piece->last} : std::array<int, 2>{0, grid.n(dim - 1)};
+}
+
+/// û at node i: the solution's whole field, or the piece's values (its slab and the next layer).
+template <int dim>
+double field_at(const Grid<dim>& grid, const GridVector& whole, const FieldPiece* piece,
+                const typename Grid<dim>::Index& i) {
+  if (!grid.has_unknown(i)) return 0.0;
+  if (piece) return (*piece->values)[grid.slab_index(i, piece->slab)];
+  return whole.empty() ? 0.0 : whole[grid.index(i)];
 }
 
 /// One kind of cells of a PolyData: "Verts", "Lines" or "Polys"; the points of cell k, by index, are
@@ -210,15 +235,18 @@ void write_poly(std::ostream& out, const std::vector<double>& points, const std:
 
 }  // namespace
 
-void write_vti(std::ostream& out, const Problem& problem, const Solution& s) {
+void write_vti(std::ostream& out, const Problem& problem, const Solution& s, const FieldPiece* piece) {
   const Grid2& grid = s.grid;
   const int nx = grid.nx(), ny = grid.ny();
-  const std::size_t n = std::size_t(nx + 1) * std::size_t(ny + 1);
+  const std::array<int, 2> planes = planes_of(grid, piece);
+  const std::size_t n = std::size_t(nx + 1) * std::size_t(planes[1] - planes[0] + 1);
   const CurveGridIntersection geometry(*problem.gamma, grid);
-  const auto node = [nx](std::size_t k) { return std::pair<int, int>{int(k % (nx + 1)), int(k / (nx + 1))}; };
+  const auto node = [nx, &planes](std::size_t k) {
+    return std::pair<int, int>{int(k % (nx + 1)), planes[0] + int(k / (nx + 1))};
+  };
   const auto u = [&](std::size_t k) {
     const auto [i, j] = node(k);
-    return grid.has_unknown(i, j) && !s.u.empty() ? s.u[grid.index(i, j)] : 0.0;
+    return field_at(grid, s.u, piece, {i, j});
   };
   const auto exact = [&](std::size_t k) {
     const auto [i, j] = node(k);
@@ -230,7 +258,7 @@ void write_vti(std::ostream& out, const Problem& problem, const Solution& s) {
              const auto [i, j] = node(k);
              return std::uint8_t(geometry.node_inside(i, j));
            }));
-  if (problem.exact && !s.u.empty()) {
+  if (problem.exact && (piece || !s.u.empty())) {
     data.add("Float64", "u_exact", computed<double>(n, exact));
     data.add("Float64", "error", computed<double>(n, [&](std::size_t k) {
                const auto [i, j] = node(k);
@@ -238,7 +266,7 @@ void write_vti(std::ostream& out, const Problem& problem, const Solution& s) {
              }));
   }
   write_image(out, {nx, ny, 0}, Point3{grid.box().lower.x, grid.box().lower.y, 0.0}, {grid.h(), grid.h(), 1.0}, data,
-              s.options.threads);
+              s.options.threads, 1, piece ? planes : std::array<int, 2>{-1, -1});
 }
 
 namespace {
@@ -290,21 +318,20 @@ void write_offset_curve_vtp(std::ostream& out, const Solution& s) {
   write_closed_line(out, points, data, s.options.threads);
 }
 
-void write_vti(std::ostream& out, const SurfaceProblem& problem, const SurfaceSolution& s) {
+void write_vti(std::ostream& out, const SurfaceProblem& problem, const SurfaceSolution& s, const FieldPiece* piece) {
   const Grid3& grid = s.grid;
   const int nx = grid.nx(), ny = grid.ny(), nz = grid.nz();
-  const std::size_t n = std::size_t(nx + 1) * std::size_t(ny + 1) * std::size_t(nz + 1);
-  const auto node = [nx, ny](std::size_t k) {
-    return Grid3::Index{int(k % (nx + 1)), int(k / (nx + 1) % (ny + 1)), int(k / (std::size_t(nx + 1) * (ny + 1)))};
+  const std::array<int, 2> planes = planes_of(grid, piece);
+  const std::size_t n = std::size_t(nx + 1) * std::size_t(ny + 1) * std::size_t(planes[1] - planes[0] + 1);
+  const auto node = [nx, ny, &planes](std::size_t k) {
+    return Grid3::Index{int(k % (nx + 1)), int(k / (nx + 1) % (ny + 1)),
+                        planes[0] + int(k / (std::size_t(nx + 1) * (ny + 1)))};
   };
   const auto x = [&](const Grid3::Index& i) { return Point3{grid.x(i[0]), grid.y(i[1]), grid.z(i[2])}; };
   std::vector<std::uint8_t> inside(n);  // a byte a node: the level function once per node
 #pragma omp parallel for num_threads(s.options.threads) schedule(static)
   for (std::int64_t k = 0; k < std::int64_t(n); ++k) inside[std::size_t(k)] = problem.gamma->level(x(node(k))) < 0;
-  const auto u = [&](std::size_t k) {
-    const Grid3::Index i = node(k);
-    return grid.has_unknown(i) ? s.u[grid.index(i)] : 0.0;
-  };
+  const auto u = [&](std::size_t k) { return field_at(grid, s.u, piece, node(k)); };
   const auto exact = [&](std::size_t k) {
     const Point3 p = x(node(k));
     return inside[k] ? problem.exact(p.x, p.y, p.z) : 0.0;
@@ -316,8 +343,38 @@ void write_vti(std::ostream& out, const SurfaceProblem& problem, const SurfaceSo
     data.add("Float64", "u_exact", computed<double>(n, exact));
     data.add("Float64", "error", computed<double>(n, [&](std::size_t k) { return inside[k] ? u(k) - exact(k) : 0.0; }));
   }
-  write_image(out, {nx, ny, nz}, grid.box().lower, {grid.h(), grid.h(), grid.h()}, data, s.options.threads);
+  write_image(out, {nx, ny, nz}, grid.box().lower, {grid.h(), grid.h(), grid.h()}, data, s.options.threads, 2,
+              piece ? planes : std::array<int, 2>{-1, -1});
 }
+
+template <int dim>
+void write_pvti(std::ostream& out, const BasicProblem<dim>& problem, const BasicSolution<dim>& s,
+                const std::vector<std::pair<std::array<int, 2>, std::string>>& pieces) {
+  const Grid<dim>& grid = s.grid;
+  const std::array<int, 3> n{grid.nx(), grid.n(1), dim == 3 ? grid.n(dim - 1) : 0};
+  const Point3 origin{grid.box().lower[0], grid.box().lower[1], dim == 3 ? grid.box().lower[dim - 1] : 0.0};
+  std::ostringstream xml;
+  xml.precision(17);
+  xml << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PImageData\" version=\"1.0\" byte_order=\"LittleEndian\" "
+         "header_type=\"UInt64\">\n  <PImageData WholeExtent=\""
+      << extent_of(n) << "\" GhostLevel=\"0\" Origin=\"" << origin.x << ' ' << origin.y << ' ' << origin.z
+      << "\" Spacing=\"" << grid.h() << ' ' << grid.h() << ' ' << (dim == 3 ? grid.h() : 1.0)
+      << "\">\n    <PPointData Scalars=\"u\">\n      <PDataArray type=\"Float64\" Name=\"u\"/>\n"
+         "      <PDataArray type=\"UInt8\" Name=\"inside\"/>\n";
+  if (problem.exact)
+    xml << "      <PDataArray type=\"Float64\" Name=\"u_exact\"/>\n      <PDataArray type=\"Float64\" "
+           "Name=\"error\"/>\n";
+  xml << "    </PPointData>\n";
+  for (const auto& [planes, file] : pieces)
+    xml << "    <Piece Extent=\"" << extent_of(n, dim - 1, planes) << "\" Source=\"" << file << "\"/>\n";
+  xml << "  </PImageData>\n</VTKFile>\n";
+  out << xml.str();
+}
+
+template void write_pvti(std::ostream&, const BasicProblem<2>&, const BasicSolution<2>&,
+                         const std::vector<std::pair<std::array<int, 2>, std::string>>&);
+template void write_pvti(std::ostream&, const BasicProblem<3>&, const BasicSolution<3>&,
+                         const std::vector<std::pair<std::array<int, 2>, std::string>>&);
 
 namespace {
 

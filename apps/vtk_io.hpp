@@ -13,6 +13,7 @@
 //                        points (the contact set resolved inside the points' parts, docs/math.md), and
 //                        in 3-D the lines joining consecutive ones;
 //   solution.vtm         a multiblock file naming the others: opens a whole run in ParaView.
+#include <array>
 #include <ostream>
 #include <string>
 #include <utility>
@@ -25,9 +26,18 @@
 
 namespace fictus::cli {
 
+/// A piece of the field, for a run on several MPI ranks: the node planes [first, last] of the slowest
+/// axis (y in 2-D, z in 3-D), û from `values`, which holds `slab`'s layers and the next one
+/// (Grid::slab_index). Neighbouring pieces share their last and first plane, as VTK's pieces do.
+struct FieldPiece {
+  int first = 0, last = 0;
+  Slab slab;
+  const GridVector* values = nullptr;
+};
+
 /// û at all (nx+1)(ny+1) nodes (x fastest; 0 on a Dirichlet boundary), "inside" (1 in ω), and,
-/// with an exact solution, "u_exact" and "error" (û − u, 0 outside ω).
-void write_vti(std::ostream& out, const Problem& problem, const Solution& solution);
+/// with an exact solution, "u_exact" and "error" (û − u, 0 outside ω). With `piece`: that piece's nodes.
+void write_vti(std::ostream& out, const Problem& problem, const Solution& solution, const FieldPiece* piece = nullptr);
 /// γ through the collocation points with point data s, g, u, dudn, gap (u − g), contact, normal, the
 /// independent check's dudn_check when there is one, and lambda in the non-smooth variant.
 void write_curve_vtp(std::ostream& out, const Solution& solution);
@@ -35,8 +45,14 @@ void write_curve_vtp(std::ostream& out, const Solution& solution);
 void write_offset_curve_vtp(std::ostream& out, const Solution& solution);
 
 /// 3-D: û at all (N+1)³ nodes, "inside" (1 in ω) and, with an exact solution, "u_exact" and "error"
-/// (0 outside ω).
-void write_vti(std::ostream& out, const SurfaceProblem& problem, const SurfaceSolution& solution);
+/// (0 outside ω). With `piece`: that piece's nodes.
+void write_vti(std::ostream& out, const SurfaceProblem& problem, const SurfaceSolution& solution,
+               const FieldPiece* piece = nullptr);
+/// The parallel file (PImageData) naming the pieces' files, each with its node planes [first, last]
+/// along the slowest axis: solution.pvti of a run on several ranks.
+template <int dim>
+void write_pvti(std::ostream& out, const BasicProblem<dim>& problem, const BasicSolution<dim>& solution,
+                const std::vector<std::pair<std::array<int, 2>, std::string>>& pieces);
 /// 3-D: γ's triangles (points shared), cell data patch, normal (the patch's outward normal), g, u,
 /// dudn, gap, contact (and lambda in the non-smooth variant), point data the area-weighted means of
 /// the same over the triangles at a point.

@@ -5,6 +5,7 @@ left waiting (a time limit); started by a launcher that is not its MPI's, it ref
 
 usage: check_mpi_cli.py FICTUS OUT_DIR MPIEXEC [MPIEXEC_FLAG ...] NUMPROC_FLAG
 """
+import importlib.util
 import json
 import os
 import shutil
@@ -36,9 +37,17 @@ def serial_results(name, *args):
         return json.load(f)
 
 
-# Two and three ranks solve together: rank 0 prints one summary and writes the files; the answers are
-# the serial ones (the ctest mpi.solve_* compares every quantity).
+# Two and three ranks solve together: rank 0 prints one summary and writes the files, the field as
+# solution.pvti with a piece per rank; the answers are the serial ones (the ctest mpi.solve_* compares
+# every quantity).
 expected = serial_results("serial", "--N", "64")
+subprocess.run([fictus, "solve", "--N", "64", "--quiet", "--out", os.path.join(out, "serial_field")], check=True,
+               capture_output=True, timeout=120)
+plot_script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "apps", "plot.py")
+loader = importlib.util.spec_from_file_location("plot", plot_script)
+plot = importlib.util.module_from_spec(loader)
+loader.loader.exec_module(plot)
+serial_field = plot.read_field(os.path.join(out, "serial_field"))[-1]["u"]
 for ranks in (2, 3):
     folder = os.path.join(out, f"ranks{ranks}")
     together = run(ranks, "solve", "--N", "64", "--out", folder)
@@ -51,7 +60,13 @@ for ranks in (2, 3):
         x, y = results["contact"][key], expected["contact"][key]
         assert abs(x - y) <= 1e-11 * abs(y), f"{ranks} ranks: contact.{key} {x} against {y} serially"
     assert results["contact"]["points"] == expected["contact"]["points"], f"{ranks} ranks: another contact set"
-    assert os.path.getsize(os.path.join(folder, "solution.vti")) > 0
+    assert not os.path.exists(os.path.join(folder, "solution.vti")), f"{ranks} ranks: solution.vti beside the pieces"
+    pieces = [name for name in os.listdir(folder) if name.startswith("solution_") and name.endswith(".vti")]
+    assert len(pieces) == ranks, f"{ranks} ranks: pieces {pieces}"
+    field = plot.read_field(folder)[-1]["u"]
+    assert field.shape == serial_field.shape, (field.shape, serial_field.shape)
+    difference = abs(field - serial_field).max() / abs(serial_field).max()
+    assert difference < 1e-11, f"{ranks} ranks: the pieces' field differs from the serial one by {difference}"
 
 # Bad input found by every rank, and bad data found by one rank only (f is NaN in the top layers, which
 # the last rank holds): one error line (rank 0's), a non-zero exit, no files, no rank left waiting.

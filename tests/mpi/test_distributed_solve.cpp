@@ -36,7 +36,8 @@ std::string plain_problem(int dim) {
   return std::string("[domain]\ndim = ") + std::to_string(dim) + "\n[geometry]\nshape = \"" +
          (dim == 2 ? "circle" : "sphere") + "\"\ncenter = " + center +
          "\nradius = 0.3\n[data]\nf = \"-6 * max(0, x - 0.5) + 0.5 * y\"\n"
-         "g = \"max(0, x - 0.5)^3 - 0.1 * max(0, 0.5 - x)" + (dim == 3 ? " - 0.05 * z" : "") + "\"\n";
+         "g = \"max(0, x - 0.5)^3 - 0.1 * max(0, 0.5 - x)" +
+         (dim == 3 ? " - 0.05 * z" : "") + "\"\n";
 }
 
 struct Case {
