@@ -12,6 +12,9 @@ import shutil
 import subprocess
 import sys
 
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkIOXML import vtkXMLPImageDataReader
+
 fictus, out = sys.argv[1], sys.argv[2]
 launcher, numproc = sys.argv[3:-1], sys.argv[-1]
 env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
@@ -67,6 +70,12 @@ for ranks in (2, 3):
     assert field.shape == serial_field.shape, (field.shape, serial_field.shape)
     difference = abs(field - serial_field).max() / abs(serial_field).max()
     assert difference < 1e-11, f"{ranks} ranks: the pieces' field differs from the serial one by {difference}"
+    # ParaView's reader of parallel images takes the pieces as one field.
+    reader = vtkXMLPImageDataReader()
+    reader.SetFileName(os.path.join(folder, "solution.pvti"))
+    reader.Update()
+    read = vtk_to_numpy(reader.GetOutput().GetPointData().GetArray("u")).reshape(serial_field.shape)
+    assert abs(read - field).max() == 0, f"{ranks} ranks: VTK reads another field from solution.pvti"
 
 # Bad input found by every rank, and bad data found by one rank only (f is NaN in the top layers, which
 # the last rank holds): one error line (rank 0's), a non-zero exit, no files, no rank left waiting.
