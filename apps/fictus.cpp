@@ -431,21 +431,6 @@ class FieldPieces {
 };
 #endif
 
-/// Runs `work` (a check of the file system, the printing and the files) on rank 0 only, and throws on
-/// every rank when it threw there.
-void on_rank_0(const fictus::Distribution& distribution, const std::function<void()>& check) {
-  if (!distribution.distributed()) return check();
-  std::exception_ptr failure;
-  if (distribution.rank() == 0) try {
-      check();
-    } catch (...) {
-      failure = std::current_exception();
-    }
-  if (distribution.all(!failure)) return;
-  if (failure) std::rethrow_exception(failure);
-  throw fictus::cli::OutputError("output.dir: refused on rank 0");
-}
-
 /// `fictus solve` in either dimension: the problem, the estimate before any work, the solve with
 /// progress lines on long runs, the summary and the output files.
 template <int dim>
@@ -455,8 +440,8 @@ int run_solve_in(const std::string& text, const SolveCommand& command) {
   const json input = json::parse(spec.input_json);
   const fictus::Distribution& distribution = *fictus::process_distribution();
   if (!spec.output.dir.empty())
-    on_rank_0(distribution, [&] { fictus::cli::check_output_folder(spec.output.dir, spec.output.files); });
-  fictus::check_memory(spec.problem, spec.options);
+    fictus::cli::on_rank_0(distribution, [&] { fictus::cli::check_output_folder(spec.output.dir, spec.output.files); });
+  fictus::cli::on_rank_0(distribution, [&] { fictus::check_memory(spec.problem, spec.options); });  // rank 0's node
   const double seconds = fictus::estimated_seconds(spec.problem, spec.options);
   const bool long_run = seconds >= 2 && !command.quiet;
   if (long_run) {  // long runs say what is coming before the work starts
@@ -488,7 +473,7 @@ int run_solve_in(const std::string& text, const SolveCommand& command) {
 #endif
   for (const std::string& w : s.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
   if (!s.newton.converged) throw NewtonFailure(fictus::describe_newton_failure(s));  // the same on every rank
-  on_rank_0(distribution, [&] {                                                      // rank 0 speaks and writes for all
+  fictus::cli::on_rank_0(distribution, [&] {                                         // rank 0 speaks and writes for all
     if (!command.quiet) print_summary(s);
     if (spec.output.dir.empty()) return;
     std::vector<fictus::cli::OutputFile> field_files;
@@ -605,8 +590,9 @@ int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out,
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // a line at a time, also into a file or a pipe
 #ifdef FICTUS_WITH_MPI
-  // Under mpirun (or srun): MPI for the life of the process. On more than one rank, `fictus solve` runs
-  // distributed (the process's Distribution is the ranks' slabs); rank 0 prints and writes.
+  // Under mpirun (or srun): MPI for the life of the process. On more than one rank, `fictus solve` and
+  // `fictus sweep` run distributed (the process's Distribution is the ranks' slabs); rank 0 prints and
+  // writes.
   std::optional<fictus::mpi::Environment> mpi;
   if (fictus::mpi::launched()) {
     try {
@@ -634,8 +620,9 @@ int main(int argc, char** argv) {
       }
       fictus::set_process_distribution(std::make_shared<fictus::mpi::SlabDistribution>(world));
       const std::string command = argc > 1 ? argv[1] : "";
-      if (command == "plot" || command == "reproduce" || command == "sweep")
-        return fail("started on " + std::to_string(ranks.size) + " MPI ranks: only fictus solve runs distributed (" +
+      if (command == "plot" || command == "reproduce")
+        return fail("started on " + std::to_string(ranks.size) +
+                        " MPI ranks: only fictus solve and sweep run distributed (" +
                         (command.empty() ? std::string("no command") : command.substr(0, 40)) +
                         " runs on one rank: without mpirun, or mpirun -np 1)",
                     exit_bad_input);

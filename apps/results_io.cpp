@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <fstream>
 #include <limits>
 #include <optional>
@@ -303,6 +304,19 @@ fs::path existing_ancestor(const fs::path& dir) {
 std::string reason(const std::error_code& error) { return error ? error.message() : std::string("unknown error"); }
 
 }  // namespace
+
+void on_rank_0(const Distribution& distribution, const std::function<void()>& work) {
+  if (!distribution.distributed()) return work();
+  std::exception_ptr failure;
+  if (distribution.rank() == 0) try {
+      work();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  if (distribution.all(!failure)) return;
+  if (failure) std::rethrow_exception(failure);
+  throw std::runtime_error("rank 0 stopped the run (its error line says why)");
+}
 
 void check_output_folder(const fs::path& dir, const std::vector<std::string>& names) {
   for (std::size_t k = 0; k < names.size(); ++k)

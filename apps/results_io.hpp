@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "fictus/grid/distribution.hpp"
 #include "fictus/io/problem_file.hpp"
 #include "fictus/solve/convergence_table.hpp"
 #include "fictus/solve/fictitious_domain_solver.hpp"
@@ -51,6 +52,11 @@ struct OutputFile {
 /// parent), and std::invalid_argument "output.files: … is named twice" for a repeated name. Called
 /// before any work, so that a long solve does not end in a folder error.
 void check_output_folder(const std::filesystem::path& dir, const std::vector<std::string>& names);
+
+/// A run on several MPI ranks: runs `work` (a check of the file system, the printing, the files) on rank
+/// 0 only, and throws on every rank when it threw there (rank 0's exception; the others' says so).
+/// Collective. Serially: runs `work`.
+void on_rank_0(const Distribution& distribution, const std::function<void()>& work);
 
 /// Writes the files as one set: all into a temporary folder inside `dir` (one file system, also when
 /// `dir` is a mount point), then each earlier file set aside and the new one renamed into place; on

@@ -206,11 +206,13 @@ int run_sweep_in(const std::string& text, const SweepArguments& args, const Opti
   if (flags.given("error_estimate") && base.options.error_estimate)
     throw std::invalid_argument("solver.error_estimate: not computed in a sweep (solve one member for its estimate)");
   for (const std::string& w : base.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
-  if (!args.out.empty()) check_output_folder(args.out, {"sweep.csv", "sweep.json"});
+  // Under mpirun on several ranks every member is solved on the ranks' slabs; rank 0 checks and writes.
+  const Distribution& distribution = *process_distribution();
+  if (!args.out.empty()) on_rank_0(distribution, [&] { check_output_folder(args.out, {"sweep.csv", "sweep.json"}); });
   SolverOptions options = base.options;
   if constexpr (dim == 2) options.condition_number = false;  // not a column of the sweep
   options.error_estimate = false;  // nor is the estimate: a member's N/2 solve would not reuse the blocks
-  check_memory(base.problem, options);
+  on_rank_0(distribution, [&] { check_memory(base.problem, options); });
   const auto setup_start = std::chrono::steady_clock::now();
   FictitiousDomainSolver<dim> solver(base.problem, options);
   // The base problem first: its own errors (a smooth variant on a polygon, Γ leaving the box) are
@@ -262,9 +264,11 @@ int run_sweep_in(const std::string& text, const SweepArguments& args, const Opti
                      {"rows", rows}};
     if (family.kind == "rotate" && dim == 3) j["sweep"]["axis"] = std::string(1, char('x' + axis_of(args.axis)));
     j["problem"]["name"] = base.problem.name;
-    write_output_set(args.out, {{"sweep.csv", [&](std::ostream& out) { out << csv.str(); }},
-                                {"sweep.json", [&](std::ostream& out) { out << j.dump(2) << '\n'; }}});
-    std::printf("wrote sweep.csv and sweep.json to %s/\n", args.out.c_str());
+    on_rank_0(distribution, [&] {
+      write_output_set(args.out, {{"sweep.csv", [&](std::ostream& out) { out << csv.str(); }},
+                                  {"sweep.json", [&](std::ostream& out) { out << j.dump(2) << '\n'; }}});
+      std::printf("wrote sweep.csv and sweep.json to %s/\n", args.out.c_str());
+    });
   }
   if (first_failure) fail_sweep(family, first_failure->first, first_failure->second, failures);
   return 0;

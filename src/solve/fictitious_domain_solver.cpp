@@ -945,10 +945,10 @@ std::pair<double, double> nodes_and_multipliers(const BasicProblem<dim>& problem
   return {nodes, m};
 }
 
-/// Whether a green solve of `problem` would keep its Schur blocks compressed.
+/// Whether a green solve of `problem` would keep its Schur blocks compressed (never on several ranks).
 template <int dim>
 bool compressed(const BasicProblem<dim>& problem, const SolverOptions& options, double m) {
-  return options.inner == InnerSolver::green &&
+  return options.inner == InnerSolver::green && !process_distribution()->distributed() &&
          compressed_schur(options.schur_storage, dim, m, problem.boundary == Boundary::periodic && problem.c == 0);
 }
 
@@ -963,7 +963,11 @@ std::size_t estimated_peak_bytes(const BasicProblem<dim>& problem, const SolverO
   const double schur = compressed(problem, options, m)
                            ? std::min(16 * m * m, 2600 * std::pow(m, 1.27)) + 3 * 8 * 256 * m
                            : (dim == 2 ? 4 : 3) * 8 * m * m;
-  const double bytes = (dim == 2 ? 3 : 4) * 8 * nodes + schur + 32.0 * (1 << 20);
+  // On P ranks (one rank's peak): the Green's table on every rank, the other arrays split, with
+  // FFTW-MPI's transposes half of a rank's array again.
+  const double P = process_distribution()->size(), arrays = dim == 2 ? 3 : 4;
+  const double grid = P > 1 ? 8 * nodes * (1 + 1.5 * (arrays - 1) / P) : arrays * 8 * nodes;
+  const double bytes = grid + schur + 32.0 * (1 << 20);
   return bytes > 1.8e19 ? std::size_t(1.8e19) : std::size_t(bytes);
 }
 

@@ -99,10 +99,26 @@ assert alone_rank.returncode != 0, "a rank failing alone: exit code 0"
 assert "failed alone" in alone_rank.stderr, alone_rank.stderr
 assert not os.path.exists(os.path.join(out, "alone_rank")), "a rank failing alone: wrote output"
 
-# Only solve runs distributed.
-sweep = run(2, "sweep", "--g-scale", "1,2", "--out", os.path.join(out, "sweep"))
-assert sweep.returncode != 0 and len(error_lines(sweep)) == 1, sweep.stderr
-assert "only fictus solve" in error_lines(sweep)[0], error_lines(sweep)[0]
+# A sweep runs distributed as well: every member on the ranks' slabs, rank 0 writing sweep.csv.
+sweeps = {}
+for ranks in (0, 2):
+    folder = os.path.join(out, f"sweep{ranks}")
+    command = [fictus, "sweep", "--g-scale", "0.5,1,2", "--N", "64", "--out", folder]
+    done = run(ranks, *command[1:]) if ranks else subprocess.run(command, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, f"sweep on {ranks} ranks: exit {done.returncode}:\n{done.stderr}"
+    with open(os.path.join(folder, "sweep.json")) as f:
+        sweeps[ranks] = json.load(f)["rows"]
+assert len(sweeps[0]) == len(sweeps[2]) == 3
+for serial_row, row in zip(sweeps[0], sweeps[2]):
+    assert row["contact_points"] == serial_row["contact_points"], "sweep on 2 ranks: another contact set"
+    for key in ("contact_force", "contact_measure", "lambda_integral"):
+        x, y = row[key], serial_row[key]
+        assert abs(x - y) <= 1e-11 * abs(y), f"sweep on 2 ranks: {key} {x} against {y} serially"
+
+# reproduce and plot run on one rank.
+reproduce = run(2, "reproduce", "--levels", "6-6")
+assert reproduce.returncode != 0 and len(error_lines(reproduce)) == 1, reproduce.stderr
+assert "only fictus solve and sweep" in error_lines(reproduce)[0], error_lines(reproduce)[0]
 
 one = run(1, "solve", "--N", "64", "--quiet", "--files", "results.json", "--out", os.path.join(out, "one"))
 assert one.returncode == 0, f"one rank: exit {one.returncode}:\n{one.stdout}{one.stderr}"

@@ -1,0 +1,83 @@
+"""Whole solves under mpirun against the serial solve, on this machine: time, each rank's peak memory
+and the agreement of λ and the force, from results.json and points.csv of `fictus solve`.
+
+  python3 bench/mpi_whole_solve.py [build] > bench/results/<date>-mpi-whole-solve.md
+
+Cases: 2-D h = 1/4096 (the manufactured circle) and the 3-D sphere of bench/sphere_contact.toml at
+N = 128 and 192; serially with 2 threads (and the dense Schur complement that a run on several ranks
+keeps), on 2 ranks × 1 thread, and on 4 ranks × 1 thread (oversubscribed on 2 cores: its times are not
+the machine's, its memory per rank is).
+"""
+import csv
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+
+build = sys.argv[1] if len(sys.argv) > 1 else "build"
+fictus = os.path.join(build, "apps", "fictus")
+here = os.path.dirname(os.path.abspath(__file__))
+root = os.path.dirname(here)
+env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+work = tempfile.mkdtemp(prefix="fictus-mpi-bench-")
+
+CASES = [
+    ("2-D circle, h = 1/4096", os.path.join(root, "examples", "manufactured_circle.toml"), ["--N", "4096"]),
+    ("3-D sphere, N = 128", os.path.join(here, "sphere_contact.toml"), ["--N", "128"]),
+    ("3-D sphere, N = 192", os.path.join(here, "sphere_contact.toml"), ["--N", "192"]),
+]
+RUNS = [  # (name, ranks, threads, extra flags)
+    ("serial", 0, 2, []),
+    ("serial, dense S", 0, 2, ["--schur_storage", "dense"]),
+    ("2 ranks", 2, 1, []),
+    ("4 ranks (oversubscribed)", 4, 1, []),
+]
+
+
+def run(problem, flags, ranks, threads, folder):
+    command = [fictus, "solve", problem, *flags, "--threads", str(threads), "--quiet", "--files",
+               "results.json,points.csv", "--out", folder]
+    if ranks:
+        command = ["mpiexec", "--oversubscribe", "--bind-to", "none", "-n", str(ranks)] + command
+    subprocess.run(command, env=env, check=True, capture_output=True, timeout=3600)
+    with open(os.path.join(folder, "results.json")) as f:
+        results = json.load(f)
+    with open(os.path.join(folder, "points.csv")) as f:
+        lam = [float(r["lambda"]) for r in csv.DictReader(f)]
+    return results, lam
+
+
+def commit():
+    try:
+        return subprocess.run(["git", "-C", root, "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                              check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+mpi = subprocess.run(["mpiexec", "--version"], capture_output=True, text=True).stdout.splitlines()[0]
+print("# Whole solves on several MPI ranks against the serial solve\n")
+print(f"- Machine: {platform.node()}, {os.cpu_count()} CPUs; {mpi}; commit {commit()}; Release build.")
+print("- Each run: `fictus solve FILE --N N --threads T`, under `mpiexec --oversubscribe --bind-to none -n P` for P")
+print("  ranks. Time: results.json's total; memory: each rank's peak (VmHWM), the largest and the sum.")
+print("- λ and the force against the first serial run: max |Δλ| / max |λ|, and |ΔF| / |F|.\n")
+print("| case | run | m | Schur | Newton steps | time [s] | peak of a rank [MiB] | peaks summed [MiB] "
+      "| Δλ | ΔF |")
+print("|---|---|---|---|---|---|---|---|---|---|")
+for case, problem, flags in CASES:
+    reference = None
+    for name, ranks, threads, extra in RUNS:
+        folder = os.path.join(work, f"{len(case)}-{name.split()[0]}-{ranks}-{len(extra)}")
+        results, lam = run(problem, flags + extra, ranks, threads, folder)
+        peaks = results.get("ranks", {}).get("peak_memory_bytes", [results["peak_memory_bytes"]])
+        force = results["contact"]["force"]
+        if reference is None:
+            reference = (lam, force)
+        dl = max(abs(a - b) for a, b in zip(lam, reference[0])) / max(abs(a) for a in reference[0])
+        df = abs(force - reference[1]) / abs(reference[1])
+        storage = ((results.get("inner") or {}).get("schur_storage") or {}).get("kind", "")
+        print(f"| {case} | {name}, {max(ranks, 1)} × {threads} | {results['multipliers']} | {storage} "
+              f"| {results['newton']['iterations']} | {results['timings']['total']:.2f} "
+              f"| {max(peaks) / 2**20:.0f} | {sum(peaks) / 2**20:.0f} | {dl:.1e} | {df:.1e} |", flush=True)
