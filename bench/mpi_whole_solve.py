@@ -1,10 +1,12 @@
 """Whole solves under mpirun against the serial solve, on this machine: time, each rank's peak memory
 and the agreement of λ and the force, from results.json and points.csv of `fictus solve`.
 
-  python3 bench/mpi_whole_solve.py [build] > bench/results/<date>-mpi-whole-solve.md
+  python3 bench/mpi_whole_solve.py [build] [case ...] > bench/results/<date>-mpi-whole-solve.md
+
+(cases by their N: 4096, 128, 192, 384; all but 384 when none is given)
 
 Cases: 2-D h = 1/4096 (the manufactured circle) and the 3-D sphere of bench/sphere_contact.toml at
-N = 128 and 192; serially with 2 threads (and the dense Schur complement that a run on several ranks
+N = 128, 192 and 384 (where a grid array is 429 MiB); serially with 2 threads (and the dense Schur complement that a run on several ranks
 keeps), on 2 ranks × 1 thread, and on 4 ranks × 1 thread (oversubscribed on 2 cores: its times are not
 the machine's, its memory per rank is).
 """
@@ -27,7 +29,10 @@ CASES = [
     ("2-D circle, h = 1/4096", os.path.join(root, "examples", "manufactured_circle.toml"), ["--N", "4096"]),
     ("3-D sphere, N = 128", os.path.join(here, "sphere_contact.toml"), ["--N", "128"]),
     ("3-D sphere, N = 192", os.path.join(here, "sphere_contact.toml"), ["--N", "192"]),
+    ("3-D sphere, N = 384", os.path.join(here, "sphere_contact.toml"), ["--N", "384"]),
 ]
+chosen = sys.argv[2:] or ["4096", "128", "192"]
+CASES = [c for c in CASES if c[2][1] in chosen]
 RUNS = [  # (name, ranks, threads, extra flags)
     ("serial", 0, 2, []),
     ("serial, dense S", 0, 2, ["--schur_storage", "dense"]),
