@@ -363,10 +363,11 @@ class FieldPieces {
         size_(distribution.size()),
         held_(distribution.with_next_layer(grid, u)),
         taken_(std::size_t(size_), false) {
+    MPI_Comm_dup(MPI_COMM_WORLD, &comm_);  // the pieces' messages on a communicator of their own
     MPI_Type_contiguous(int(grid.layer_size()), MPI_DOUBLE, &layer_);
     MPI_Type_commit(&layer_);
     if (rank_ != 0 && slab(rank_).count > 0)
-      MPI_Isend(held_.data(), slab(rank_).count + 1, layer_, 0, tag, MPI_COMM_WORLD, &send_);
+      MPI_Isend(held_.data(), slab(rank_).count + 1, layer_, 0, tag, comm_, &send_);
   }
   /// Rank 0 takes every piece not taken yet, and the others' sends end, whatever happened in between
   /// (a failed write included): no message is left over.
@@ -376,6 +377,7 @@ class FieldPieces {
     else if (send_ != MPI_REQUEST_NULL)
       MPI_Wait(&send_, MPI_STATUS_IGNORE);
     MPI_Type_free(&layer_);
+    MPI_Comm_free(&comm_);
   }
   FieldPieces(const FieldPieces&) = delete;
   FieldPieces& operator=(const FieldPieces&) = delete;
@@ -416,7 +418,7 @@ class FieldPieces {
     if (r == 0) return held_;
     if (!taken_[std::size_t(r)] && slab(r).count > 0) {
       received_.resize(grid_.slab_size(slab(r)) + grid_.layer_size());
-      MPI_Recv(received_.data(), slab(r).count + 1, layer_, r, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      MPI_Recv(received_.data(), slab(r).count + 1, layer_, r, tag, comm_, MPI_STATUS_IGNORE);
       taken_[std::size_t(r)] = true;
     }
     return received_;
@@ -426,6 +428,7 @@ class FieldPieces {
   int rank_, size_;
   fictus::GridVector held_, received_;
   std::vector<bool> taken_;
+  MPI_Comm comm_;
   MPI_Datatype layer_;
   MPI_Request send_ = MPI_REQUEST_NULL;
 };
@@ -435,10 +438,11 @@ class FieldPieces {
 /// progress lines on long runs, the summary and the output files.
 template <int dim>
 int run_solve_in(const std::string& text, const SolveCommand& command) {
-  const fictus::BasicProblemSpec<dim> spec = solve_spec<dim>(text, command);
+  fictus::BasicProblemSpec<dim> spec = solve_spec<dim>(text, command);
   for (const std::string& w : spec.warnings) std::fprintf(stderr, "fictus: warning: %s\n", w.c_str());
   const json input = json::parse(spec.input_json);
   const fictus::Distribution& distribution = *fictus::process_distribution();
+  fictus::cli::agree_on_threads(distribution, spec.options);
   if (!spec.output.dir.empty())
     fictus::cli::on_rank_0(distribution, [&] { fictus::cli::check_output_folder(spec.output.dir, spec.output.files); });
   fictus::cli::on_rank_0(distribution, [&] { fictus::check_memory(spec.problem, spec.options); });  // rank 0's node

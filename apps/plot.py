@@ -105,10 +105,17 @@ def read_vti(path):
 def read_field(folder):
     """The field of a run: solution.vti, or (a run on several MPI ranks) solution.pvti's pieces put
     together. The axes and the point arrays, shaped [j, i] or [k, j, i]."""
-    single = os.path.join(folder, "solution.vti")
-    if os.path.exists(single):
-        return read_vti(single)
-    with open(os.path.join(folder, "solution.pvti")) as handle:
+    name = "solution.vti"
+    multiblock = os.path.join(folder, "solution.vtm")
+    if os.path.exists(multiblock):  # the run's own field, not an earlier run's file beside it
+        with open(multiblock) as handle:
+            named = re.search(r'name="field" file="([^"]+)"', handle.read())
+        name = named.group(1) if named else name
+    elif not os.path.exists(os.path.join(folder, name)):
+        name = "solution.pvti"
+    if name.endswith(".vti"):
+        return read_vti(os.path.join(folder, name))
+    with open(os.path.join(folder, name)) as handle:
         text = handle.read()
     extent = [int(v) for v in re.search(r'WholeExtent="([^"]+)"', text).group(1).split()]
     origin = [float(v) for v in re.search(r'Origin="([^"]+)"', text).group(1).split()]

@@ -318,6 +318,11 @@ void on_rank_0(const Distribution& distribution, const std::function<void()>& wo
   throw std::runtime_error("rank 0 stopped the run (its error line says why)");
 }
 
+void agree_on_threads(const Distribution& distribution, SolverOptions& options) {
+  if (!distribution.distributed()) return;
+  options.threads = int(-distribution.max(-double(Execution(options.threads).threads())));
+}
+
 void check_output_folder(const fs::path& dir, const std::vector<std::string>& names) {
   for (std::size_t k = 0; k < names.size(); ++k)
     if (std::find(names.begin(), names.begin() + k, names[k]) != names.begin() + k)

@@ -57,6 +57,10 @@ void check_output_folder(const std::filesystem::path& dir, const std::vector<std
 /// 0 only, and throws on every rank when it threw there (rank 0's exception; the others' says so).
 /// Collective. Serially: runs `work`.
 void on_rank_0(const Distribution& distribution, const std::function<void()>& work);
+/// A run on several MPI ranks: every rank takes the smallest of the ranks' thread counts. The ranks run
+/// the same Newton steps, which must agree bit for bit, and the dense LU's blocking follows the thread
+/// count. Collective. Serially: nothing.
+void agree_on_threads(const Distribution& distribution, SolverOptions& options);
 
 /// Writes the files as one set: all into a temporary folder inside `dir` (one file system, also when
 /// `dir` is a mount point), then each earlier file set aside and the new one renamed into place; on

@@ -210,6 +210,7 @@ int run_sweep_in(const std::string& text, const SweepArguments& args, const Opti
   const Distribution& distribution = *process_distribution();
   if (!args.out.empty()) on_rank_0(distribution, [&] { check_output_folder(args.out, {"sweep.csv", "sweep.json"}); });
   SolverOptions options = base.options;
+  agree_on_threads(distribution, options);
   if constexpr (dim == 2) options.condition_number = false;  // not a column of the sweep
   options.error_estimate = false;  // nor is the estimate: a member's N/2 solve would not reuse the blocks
   on_rank_0(distribution, [&] { check_memory(base.problem, options); });

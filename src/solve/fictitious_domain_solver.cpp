@@ -410,6 +410,9 @@ std::optional<BasicSolution<dim>> coarse_solve(const State<dim>& st, const Basic
     throw;
   } catch (const std::runtime_error& e) {  // e.g. an empty patch
     if (stop_asked) throw Interrupted();
+    // Distributed, a failure here may be one rank's alone while the others wait in the coarse solve's
+    // collectives: it ends the run (the CLI stops every rank) rather than leave them waiting.
+    if (st.execution.distribution().distributed()) throw;
     skipped = std::string("the solve on the grid of N/2 failed: ") + e.what();
   } catch (const std::invalid_argument& e) {  // a grid too coarse for the boundary or the box
     if (stop_asked) throw Interrupted();
@@ -625,9 +628,17 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
   if (!setup.storage_warning.empty()) sol.warnings.push_back(setup.storage_warning);
   for (const NewtonStep& step : sol.newton.history) sol.inner_iterations += step.inner_iterations;
   if (options.condition_number && dim == 2) sol.condition_number = setup.schur->condition_number(sol.newton.active);
-  // Distributed: every rank ran the same steps on the same numbers; rank 0's λ and α are the answer.
-  st.execution.distribution().broadcast(sol.newton.lambda.data(), std::size_t(sol.newton.lambda.size()));
-  st.execution.distribution().broadcast(&sol.newton.alpha, 1);
+  // Distributed: every rank ran the same steps on the same numbers; rank 0's λ, α, active set and outcome
+  // are the answer, so that no later decision can differ between ranks.
+  const Distribution& distribution = st.execution.distribution();
+  if (distribution.distributed()) {
+    distribution.broadcast(sol.newton.lambda.data(), std::size_t(sol.newton.lambda.size()));
+    std::vector<double> outcome{sol.newton.alpha, double(sol.newton.converged), double(sol.newton.iterations)};
+    outcome.insert(outcome.end(), sol.newton.active.begin(), sol.newton.active.end());
+    distribution.broadcast(outcome.data(), outcome.size());
+    sol.newton.alpha = outcome[0], sol.newton.converged = outcome[1] != 0, sol.newton.iterations = int(outcome[2]);
+    for (std::size_t i = 0; i < sol.newton.active.size(); ++i) sol.newton.active[i] = outcome[3 + i] != 0;
+  }
   sol.lambda.assign(sol.newton.lambda.data(), sol.newton.lambda.data() + sol.newton.lambda.size());
   sol.lambda_total = row_sums(setup.boundary->B_Gamma()).dot(sol.newton.lambda);
   sol.alpha = sol.newton.alpha;
@@ -661,10 +672,10 @@ void field(const State<dim>& st, const BoundarySetup<dim>& setup, BasicSolution<
 
 /// Step 7: the Signorini conditions at the points, and again with an independent ∂u/∂n.
 template <int dim>
-void signorini_checks(const BoundaryDiscretization<dim>& boundary, BasicSolution<dim>& sol) {
+void signorini_checks(const BoundaryDiscretization<dim>& boundary, bool with_field, BasicSolution<dim>& sol) {
   const int m = boundary.n_points();
   sol.signorini = detail::signorini_check(sol.trace, sol.normal_derivative, sol.g, sol.conditions.kind);
-  if (sol.u.empty()) return;
+  if (!with_field) return;  // (not sol.u.empty(): a rank of a distributed run may hold no layer)
   IndependentCheck check;
   std::optional<std::vector<double>> d = boundary.independent_normal_derivative(sol.u, check.rule);
   if (!d) return;
@@ -882,7 +893,7 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
     sol.normal_derivative.assign(sol.newton.normal_derivative.data(),
                                  sol.newton.normal_derivative.data() + sol.newton.normal_derivative.size());
   }
-  signorini_checks<dim>(boundary, sol);  // 7
+  signorini_checks<dim>(boundary, compute_field, sol);  // 7
   resolve_contact<dim>(sol);
   if (compute_field) clock.mark("check");
   if ((data.exact || data.exact_vectorized) && compute_field) {  // 8

@@ -77,6 +77,19 @@ for ranks in (2, 3):
     read = vtk_to_numpy(reader.GetOutput().GetPointData().GetArray("u")).reshape(serial_field.shape)
     assert abs(read - field).max() == 0, f"{ranks} ranks: VTK reads another field from solution.pvti"
 
+# Twelve ranks on 63 layers (blocks of 6): the last rank holds no layer, and every collective step must
+# still meet it there (the readings, the integrals over ω, the pieces of the field).
+many = run(12, "solve", "--N", "64", "--quiet", "--files", "results.json,solution.vti", "--out", os.path.join(out, "many"))
+assert many.returncode == 0, f"12 ranks: exit {many.returncode}:\n{many.stdout}{many.stderr}"
+with open(os.path.join(out, "many", "results.json")) as f:
+    results = json.load(f)
+assert results["ranks"]["count"] == 12
+for key in ("force", "measure", "lambda_integral"):
+    x, y = results["contact"][key], expected["contact"][key]
+    assert abs(x - y) <= 1e-11 * abs(y), f"12 ranks: contact.{key} {x} against {y} serially"
+field = plot.read_field(os.path.join(out, "many"))[-1]["u"]
+assert abs(field - serial_field).max() <= 1e-11 * abs(serial_field).max(), "12 ranks: another field"
+
 # Bad input found by every rank, and bad data found by one rank only (f is NaN in the top layers, which
 # the last rank holds): one error line (rank 0's), a non-zero exit, no files, no rank left waiting.
 for name, args, expect in (("bad_flag", ["--N", "7"], "domain.N"),
