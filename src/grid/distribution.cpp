@@ -45,6 +45,12 @@ std::unique_ptr<FastSolver<3>> Distribution::fast_solver(const Grid<3>& grid, do
 }
 GridVector Distribution::with_next_layer(const Grid<2>&, const GridVector&) const { serial_only("with_next_layer"); }
 GridVector Distribution::with_next_layer(const Grid<3>&, const GridVector&) const { serial_only("with_next_layer"); }
+Slab Distribution::transform_planes(const std::vector<int>& shape, std::size_t& local_size) const {
+  local_size = 1;
+  for (int n : shape) local_size *= std::size_t(n);
+  return Slab{0, shape.empty() ? 0 : shape[0]};
+}
+void Distribution::dct1(const std::vector<int>&, double*, int) const { serial_only("dct1"); }
 GridVector Distribution::gather(const Grid<2>&, const GridVector& local, bool) const { return local; }
 GridVector Distribution::gather(const Grid<3>&, const GridVector& local, bool) const { return local; }
 

@@ -4,6 +4,7 @@
 #include <climits>
 
 #include "fftw_plan.hpp"
+#include "fictus/grid/distribution.hpp"
 #include "fictus/grid/q1_symbol.hpp"
 
 namespace fictus {
@@ -18,20 +19,34 @@ GreenTable<dim>::GreenTable(const Grid<dim>& grid, double c, const Execution& ex
     size_[d] = std::size_t(period_[d] / 2 + 1);
     entries *= size_[d];
   }
-  table_.assign(entries, 0.0);
+  std::vector<int> shape;  // slowest axis first
+  for (int d = dim - 1; d >= 0; --d) shape.push_back(int(size_[d]));
+  // This rank's planes of the slowest axis (all of them serially), then a plane of zeros that every
+  // plane held elsewhere reads.
+  const Distribution& distribution = execution.distribution();
+  partial_ = distribution.distributed();
+  std::size_t local = entries;
+  const Slab held = partial_ ? distribution.transform_planes(shape, local) : Slab{0, shape[0]};
+  const std::size_t plane = entries / size_[dim - 1];
+  plane_.resize(size_[dim - 1]);
+  for (int z = 0; z < shape[0]; ++z)
+    plane_[std::size_t(z)] = (held.holds(z) ? std::size_t(z - held.first) : std::size_t(held.count)) * plane;
+  table_.assign(partial_ ? std::max(local, std::size_t(held.count + 1) * plane) : entries, 0.0);
   // Table entry p holds 1/λ of mode p. Dirichlet: p_d = 1..n_d−1 (spectrum index p_d − 1), zero at
   // p_d ∈ {0, n_d}; periodic: p_d = 0..n_d/2 (spectrum index p_d), the zero mode dropped when λ = 0.
   double denominator = periodic_ ? 1.0 : double(1 << dim);
   for (int d = 0; d < dim; ++d) denominator *= grid.n(d);
   const double scale = 1.0 / denominator;
-  const int shift = periodic_ ? 0 : 1, rows = int(entries / size_[0]), row_length = int(size_[0]);
+  const int shift = periodic_ ? 0 : 1, row_length = int(size_[0]);
+  const int rows_per_plane = int(plane / size_[0]), first_row = held.first * rows_per_plane,
+            rows = held.count * rows_per_plane;
   const double* k0 = symbol.axis(0).stiffness.data();
   const double* m0 = symbol.axis(0).mass.data();
 #pragma omp parallel for num_threads(execution.threads()) schedule(static)
   for (int r = 0; r < rows; ++r) {
     std::array<int, dim> slow{};
     bool inside = true;
-    for (int d = 1, rest = r; d < dim; ++d) {
+    for (int d = 1, rest = first_row + r; d < dim; ++d) {
       slow[d] = rest % int(size_[d]) - shift, rest /= int(size_[d]);
       inside = inside && slow[d] >= 0 && slow[d] < symbol.axis(d).size();
     }
@@ -45,8 +60,12 @@ GreenTable<dim>::GreenTable(const Grid<dim>& grid, double c, const Execution& ex
       row[p] = lambda > 0 ? scale / lambda : 0.0;
     }
   }
-  std::vector<int> shape;  // slowest axis first
-  for (int d = dim - 1; d >= 0; --d) shape.push_back(int(size_[d]));
+  if (partial_) {
+    distribution.dct1(shape, table_.data(), execution.threads());
+    const auto zeros = table_.begin() + std::ptrdiff_t(std::size_t(held.count) * plane);  // the transform's scratch
+    std::fill(zeros, zeros + std::ptrdiff_t(plane), 0.0);
+    return;
+  }
   detail::R2rPlan plan(shape, detail::R2rKind::dct1, execution.threads());
   plan.execute(table_.data());
 }
@@ -76,8 +95,8 @@ void GreenTable<dim>::G(const std::array<std::vector<int>, dim>& a, const std::a
     const auto &ad = a[std::size_t(d)], &bd = b[std::size_t(d)];
     for (int y : bd)
       for (int x : ad) {
-        minus[std::size_t(d)].push_back(std::size_t(near_fold(x - y, period_[d])) * stride);
-        if (!periodic_) plus[std::size_t(d)].push_back(std::size_t(near_fold(x + y, period_[d])) * stride);
+        minus[std::size_t(d)].push_back(offset(d, near_fold(x - y, period_[d]), stride));
+        if (!periodic_) plus[std::size_t(d)].push_back(offset(d, near_fold(x + y, period_[d]), stride));
       }
     stride *= size_[d];
   }
@@ -158,9 +177,8 @@ void GreenTable<dim>::G(const Index* a, std::size_t n_a, const Index* b, const d
     for (int d = 0; d < dim; ++d)
       for (int j = 0; j < width[d]; ++j) {
         const int y = low[d] + j;
-        offsets[minus_at[d] + std::size_t(j)] = std::size_t(near_fold(a[u][d] - y, period_[d])) * stride[d];
-        if (!periodic_)
-          offsets[plus_at[d] + std::size_t(j)] = std::size_t(near_fold(a[u][d] + y, period_[d])) * stride[d];
+        offsets[minus_at[d] + std::size_t(j)] = offset(d, near_fold(a[u][d] - y, period_[d]), stride[d]);
+        if (!periodic_) offsets[plus_at[d] + std::size_t(j)] = offset(d, near_fold(a[u][d] + y, period_[d]), stride[d]);
       }
     const std::size_t *xm = offsets.data() + minus_at[0], *xp = offsets.data() + plus_at[0];
     const std::size_t *ym = offsets.data() + minus_at[1], *yp = offsets.data() + plus_at[1];

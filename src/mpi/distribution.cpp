@@ -1,10 +1,13 @@
 #include "fictus/mpi/distribution.hpp"
 
+#include <fftw3-mpi.h>
+
 #include <algorithm>
 #include <climits>
 #include <stdexcept>
 #include <vector>
 
+#include "../grid/fftw_plan.hpp"
 #include "fictus/mpi/next_layer.hpp"
 #include "fictus/mpi/slab_solver.hpp"
 
@@ -38,6 +41,36 @@ GridVector gather_layers(const Grid<dim>& grid, const GridVector& local, const C
 }  // namespace
 
 Slab SlabDistribution::slab(int layers) const { return default_slab(layers, comm_.rank(), comm_.size()); }
+
+Slab SlabDistribution::transform_planes(const std::vector<int>& shape, std::size_t& local_size) const {
+  const std::vector<ptrdiff_t> n(shape.begin(), shape.end());
+  ptrdiff_t count = 0, first = 0;
+  const ptrdiff_t allocation =
+      fftw_mpi_local_size_many(int(n.size()), n.data(), 1, FFTW_MPI_DEFAULT_BLOCK, comm_.get(), &count, &first);
+  local_size = std::size_t(std::max<ptrdiff_t>(allocation, 1));
+  return count > 0 ? Slab{int(first), int(count)} : Slab{shape[0], 0};
+}
+
+void SlabDistribution::dct1(const std::vector<int>& shape, double* local, int threads) const {
+  const std::vector<ptrdiff_t> n(shape.begin(), shape.end());
+  const std::vector<fftw_r2r_kind> kinds(shape.size(), FFTW_REDFT00);
+  fftw_plan plan = nullptr;
+  {
+    std::lock_guard lock(detail::planner_mutex());
+    detail::init_threads_once();
+    fftw_plan_with_nthreads(threads < 1 ? 1 : threads);
+    plan = fftw_mpi_plan_many_r2r(int(n.size()), n.data(), 1, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, local,
+                                  local, comm_.get(), kinds.data(), FFTW_ESTIMATE);
+  }
+  if (comm_.max(plan == nullptr ? 1.0 : 0.0) != 0.0) {  // all ranks throw, or none
+    std::lock_guard lock(detail::planner_mutex());
+    if (plan) fftw_destroy_plan(plan);
+    throw std::runtime_error("FFTW-MPI: could not plan the Green's table's transform");
+  }
+  fftw_execute(plan);
+  std::lock_guard lock(detail::planner_mutex());
+  fftw_destroy_plan(plan);
+}
 
 void SlabDistribution::broadcast(double* values, std::size_t n) const {
   for (std::size_t done = 0; done < n;) {

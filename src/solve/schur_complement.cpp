@@ -201,6 +201,8 @@ ExplicitSchur::ExplicitSchur(const GreenTable<dim>& green, const SparseRows& B_g
                              const SparseRows& loads, const Execution& execution, const DirectTerms& direct,
                              const FarField& far_field, FarFieldReport* report) {
   std::vector<Eigen::MatrixXd> blocks = green_blocks(green, {&B_gamma, &C_gamma}, loads, execution, far_field, report);
+  if (green.partial())  // a distributed run: each rank's table planes gave its part of every entry
+    for (Eigen::MatrixXd& block : blocks) execution.distribution().sum(block.data(), std::size_t(block.size()));
   S_B_ = std::move(blocks[0]);
   S_C_ = std::move(blocks[1]);
   if (!direct.empty()) {

@@ -11,7 +11,9 @@
 #include "fictus/boundary/curve.hpp"
 #include "fictus/boundary/curve_grid_intersection.hpp"
 #include "fictus/boundary/surface.hpp"
+#include "fictus/grid/green_table.hpp"
 #include "fictus/grid/load_vector.hpp"
+#include "fictus/mpi/distribution.hpp"
 #include "fictus/mpi/next_layer.hpp"
 #include "fictus/mpi/slab_solver.hpp"
 #include "fictus/solve/error_norms.hpp"
@@ -249,6 +251,53 @@ TEST(SlabSteps, IntegralsOverOmegaMatchOneProcess) {
       fictus::for_each_omega_sample(v, grid3, ellipsoid, 3, execution, visit, s);
     });
   }
+}
+
+/// The Green's table on the ranks' planes: each rank's G (0 wherever the planes are another rank's),
+/// summed over the ranks, against the whole table of one process, at node pairs all over the grid, by
+/// the scalar and the batch lookups.
+template <int dim>
+void check_green_table(const fictus::Box<dim>& box, int n0, Boundary boundary, double c) {
+  const Communicator comm;
+  const fictus::Grid<dim> grid(box, n0, boundary);
+  const fictus::GreenTable<dim> whole(grid, c, fictus::Execution(2));
+  fictus::set_process_distribution(std::make_shared<fictus::mpi::SlabDistribution>(comm));
+  const fictus::GreenTable<dim> part(grid, c, fictus::Execution(1));
+  fictus::set_process_distribution(nullptr);
+  EXPECT_EQ(part.partial(), comm.size() > 1);
+  using Index = typename fictus::Grid<dim>::Index;
+  std::vector<Index> a, b;
+  std::vector<double> weights;
+  for (int k = 0; k < 40; ++k) {
+    Index p, q;
+    for (int d = 0; d < dim; ++d) {
+      const int lo = boundary == Boundary::dirichlet ? 1 : 0,
+                span = grid.n(d) - (boundary == Boundary::dirichlet ? 1 : 0);
+      p[d] = lo + (k * 7 + 3 * d) % (span - lo), q[d] = lo + (k * 13 + 5 * d + 2) % (span - lo);
+    }
+    a.push_back(p), b.push_back(q), weights.push_back(1.0 + 0.1 * k);
+  }
+  std::vector<double> scalar(a.size()), batch(a.size()), exact(a.size()), exact_batch(a.size());
+  for (std::size_t k = 0; k < a.size(); ++k) scalar[k] = part.G(a[k], b[k]), exact[k] = whole.G(a[k], b[k]);
+  part.G(a.data(), a.size(), b.data(), weights.data(), b.size(), batch.data());
+  whole.G(a.data(), a.size(), b.data(), weights.data(), b.size(), exact_batch.data());
+  comm.sum(scalar.data(), scalar.size());
+  comm.sum(batch.data(), batch.size());
+  double difference = 0, size = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    difference = std::max({difference, std::abs(scalar[k] - exact[k]), std::abs(batch[k] - exact_batch[k])});
+    size = std::max({size, std::abs(exact[k]), std::abs(exact_batch[k])});
+  }
+  const std::string name = std::to_string(dim) + "-D " + fictus::to_string(boundary) +
+                           ", c = " + std::to_string(c).substr(0, 3) + ": the Green's table on planes, summed";
+  expect_agreement(comm.max(difference) / size, name, comm);
+}
+
+TEST(SlabGreenTable, PartsAddUpToTheWholeTable) {
+  check_green_table<2>(fictus::Box<2>{{0.0, 0.0}, {1.0, 1.0}}, 32, Boundary::dirichlet, 1.0);
+  check_green_table<2>(fictus::Box<2>{{0.0, 0.0}, {1.0, 1.25}}, 32, Boundary::periodic, 0.0);
+  check_green_table<3>(fictus::Box<3>{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}}, 16, Boundary::dirichlet, 1.0);
+  check_green_table<3>(fictus::Box<3>{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.25}}, 16, Boundary::periodic, 1.0);
 }
 
 TEST(SlabSolver, DefaultSlabsCoverTheLayersInOrder) {

@@ -56,6 +56,14 @@ class Distribution {
   /// zeros where there is none. What the samplers over ω take with a slab. Serial: never asked.
   virtual GridVector with_next_layer(const Grid<2>& grid, const GridVector& local) const;
   virtual GridVector with_next_layer(const Grid<3>& grid, const GridVector& local) const;
+  /// A DCT-I (REDFT00 along every axis) of an array of `shape` (slowest axis first) split in planes
+  /// along its slowest axis (the Green's table's): this rank's planes, and (`local_size`) the doubles its
+  /// local array must hold for the transform. Serial: every plane.
+  virtual Slab transform_planes(const std::vector<int>& shape, std::size_t& local_size) const;
+  /// The transform, in place on this rank's planes (`local`, transform_planes' size). Collective.
+  /// Serial: never asked (GreenTable transforms its whole table itself).
+  virtual void dct1(const std::vector<int>& shape, double* local, int threads) const;
+
   /// The whole grid vector from each rank's layers: on every rank, or (`everywhere` false) on rank 0
   /// only (the others get an empty vector).
   virtual GridVector gather(const Grid<2>& grid, const GridVector& local, bool everywhere = true) const;

@@ -10,6 +10,10 @@
 //   even and n-periodic; the table holds Π_d [0, n_d/2], one REDFT00 of size Π(n_d/2 + 1).
 //   With c = 0 the zero mode is dropped: G is the pseudo-inverse A⁺.
 // λ(p) comes from Q1Symbol. Built once per grid, boundary and c; lookups are const and thread-safe.
+// Distributed (the execution's Distribution), a rank holds only its planes of the table along the
+// slowest axis (FFTW-MPI's blocks, made by one distributed DCT-I), and every lookup elsewhere reads 0:
+// each rank's sums over lookups (the Schur entries) are its part, and the ranks' parts add up to the
+// serial sums.
 #include <array>
 #include <cstddef>
 #include <vector>
@@ -63,6 +67,8 @@ class GreenTable {
   /// (b_k, w_k), k < n_b: the near blocks' sums in the Schur assembly, the same sums as G's.
   void G(const Index* a, std::size_t n_a, const Index* b, const double* w, std::size_t n_b, double* out) const;
   std::size_t memory_bytes() const { return table_.size() * sizeof(double); }
+  /// Whether this rank holds only some planes (a distributed run): its lookups give its part of a sum.
+  bool partial() const { return partial_; }
 
  private:
   /// Dirichlet: period 2n, table [0, n]; periodic: period n, table [0, n/2]. `period` is the period.
@@ -76,16 +82,22 @@ class GreenTable {
     s = s < 0 ? -s : s;
     return s > period / 2 ? period - s : s;
   }
+  /// Where table offset s of axis d begins (stride: the axis's, serially); the slowest axis through plane_.
+  std::size_t offset(int d, int s, std::size_t stride) const {
+    return d == dim - 1 ? plane_[std::size_t(s)] : std::size_t(s) * stride;
+  }
   double at(const Index& s) const {
     std::size_t k = 0;
-    for (int d = dim - 1; d >= 0; --d) k = k * size_[d] + std::size_t(s[d]);
-    return table_[k];
+    for (int d = dim - 2; d >= 0; --d) k = k * size_[d] + std::size_t(s[d]);
+    return table_[plane_[std::size_t(s[dim - 1])] + k];
   }
   Grid<dim> grid_;
   double c_;
   bool periodic_;
   std::array<int, dim> period_;        // of T along each axis
   std::array<std::size_t, dim> size_;  // table entries along each axis: period/2 + 1
+  bool partial_ = false;
+  std::vector<std::size_t> plane_;  // where plane z of the slowest axis begins in table_ (a zero plane if not held)
   AlignedVector<double> table_;
 };
 

@@ -24,6 +24,8 @@ class SlabDistribution final : public Distribution {
   std::unique_ptr<FastSolver<3>> fast_solver(const Grid<3>& grid, double c, const Execution& execution) const override;
   GridVector with_next_layer(const Grid<2>& grid, const GridVector& local) const override;
   GridVector with_next_layer(const Grid<3>& grid, const GridVector& local) const override;
+  Slab transform_planes(const std::vector<int>& shape, std::size_t& local_size) const override;
+  void dct1(const std::vector<int>& shape, double* local, int threads) const override;
   GridVector gather(const Grid<2>& grid, const GridVector& local, bool everywhere = true) const override;
   GridVector gather(const Grid<3>& grid, const GridVector& local, bool everywhere = true) const override;
 
