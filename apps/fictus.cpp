@@ -372,10 +372,12 @@ class FieldPieces {
   /// Rank 0 takes every piece not taken yet, and the others' sends end, whatever happened in between
   /// (a failed write included): no message is left over.
   ~FieldPieces() {
-    if (rank_ == 0)
-      for (int r = 1; r < size_; ++r) values(r);
-    else if (send_ != MPI_REQUEST_NULL)
+    if (rank_ == 0) {
+      for (int r = 1; r < size_; ++r)
+        if (!taken_[std::size_t(r)]) values(r);
+    } else if (send_ != MPI_REQUEST_NULL) {
       MPI_Wait(&send_, MPI_STATUS_IGNORE);
+    }
     MPI_Type_free(&layer_);
     MPI_Comm_free(&comm_);
   }
@@ -412,14 +414,17 @@ class FieldPieces {
     if (grid_.periodic()) return {s.first, s.first + s.count};
     return {s.first == 0 ? 0 : s.first + 1, s.first + s.count + 1};
   }
-  /// Rank 0: rank r's layers and the next one (received at the first call; the last piece received is
-  /// kept).
+  /// Rank 0: rank r's layers and the next one, received at the first call (one piece is kept: the last
+  /// one received).
   const fictus::GridVector& values(int r) {
     if (r == 0) return held_;
     if (!taken_[std::size_t(r)] && slab(r).count > 0) {
       received_.resize(grid_.slab_size(slab(r)) + grid_.layer_size());
       MPI_Recv(received_.data(), slab(r).count + 1, layer_, r, tag, comm_, MPI_STATUS_IGNORE);
       taken_[std::size_t(r)] = true;
+      last_ = r;
+    } else if (slab(r).count > 0 && last_ != r) {
+      throw std::logic_error("FieldPieces: a piece asked for again after another one");
     }
     return received_;
   }
@@ -428,6 +433,7 @@ class FieldPieces {
   int rank_, size_;
   fictus::GridVector held_, received_;
   std::vector<bool> taken_;
+  int last_ = -1;  // the rank whose piece received_ holds
   MPI_Comm comm_;
   MPI_Datatype layer_;
   MPI_Request send_ = MPI_REQUEST_NULL;

@@ -266,8 +266,9 @@ void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
     clock.mark("green_table");
   }
   const int m = b.n_points();
-  // Distributed, the blocks are dense: each rank makes them from its own copy of the table and takes rank
-  // 0's, so that Newton runs the same on every rank (compressed blocks are not shared yet).
+  // Distributed, the blocks are dense: each rank makes its part of every entry from its planes of the
+  // table, the parts are summed, and every rank takes rank 0's sum, so that Newton runs the same on every
+  // rank (compressed blocks are not linear in the entries: not distributed yet).
   const bool compressible = compressed_schur(options.schur_storage, dim, m, st.fast->singular());
   const bool hierarchical = compressible && !distribution.distributed();
   if (options.schur_storage == SchurStorageKind::hierarchical && !hierarchical)
