@@ -632,8 +632,7 @@ int main(int argc, char** argv) {
       const std::string command = argc > 1 ? argv[1] : "";
       if (command == "plot" || command == "reproduce")
         return fail("started on " + std::to_string(ranks.size) +
-                        " MPI ranks: only fictus solve and sweep run distributed (" +
-                        (command.empty() ? std::string("no command") : command.substr(0, 40)) +
+                        " MPI ranks: only fictus solve and sweep run distributed (" + command +
                         " runs on one rank: without mpirun, or mpirun -np 1)",
                     exit_bad_input);
     }

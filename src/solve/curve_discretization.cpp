@@ -268,12 +268,7 @@ std::vector<double> CurveDiscretization::obstacle(const Data& data) const {
 
 void CurveDiscretization::for_each_omega_sample(const GridVector& u, int quadrature,
                                                 const OmegaSampleVisitor<2>& visit) const {
-  const Distribution& distribution = execution_.distribution();
-  if (!distribution.distributed())
-    return fictus::for_each_omega_sample(u, *gamma_geometry_, quadrature, execution_, visit);
-  const Grid2& grid = gamma_geometry_->grid();
-  fictus::for_each_omega_sample(distribution.with_next_layer(grid, u), *gamma_geometry_, quadrature, execution_, visit,
-                                distribution.slab(grid));
+  fictus::for_each_omega_sample(u, *gamma_geometry_, quadrature, execution_, visit);
 }
 
 ErrorNorms CurveDiscretization::errors(const GridVector& u, const std::vector<double>&, const Data& data,

@@ -76,6 +76,10 @@ ErrorNorms compute_errors(const GridVector& u_h, const CurveGridIntersection& ga
 void for_each_omega_sample(const GridVector& u_h, const CurveGridIntersection& gamma, int q, const Execution& execution,
                            const OmegaSampleVisitor<2>& visit, std::optional<Slab> slab) {
   const Grid2& grid = gamma.grid();
+  const Distribution& distribution = execution.distribution();
+  if (!slab && distribution.distributed())  // this rank's layers: add the next one
+    return for_each_omega_sample(distribution.with_next_layer(grid, u_h), gamma, q, execution, visit,
+                                 distribution.slab(grid));
   const Slab s = slab.value_or(grid.every_layer());
 #pragma omp parallel num_threads(execution.threads())
   {
@@ -260,6 +264,10 @@ ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surfac
 
 void for_each_omega_sample(const GridVector& u_h, const Grid3& grid, const Surface& gamma, int q,
                            const Execution& execution, const OmegaSampleVisitor<3>& visit, std::optional<Slab> slab) {
+  const Distribution& distribution = execution.distribution();
+  if (!slab && distribution.distributed())  // this rank's layers: add the next one
+    return for_each_omega_sample(distribution.with_next_layer(grid, u_h), grid, gamma, q, execution, visit,
+                                 distribution.slab(grid));
   const Slab s = slab.value_or(grid.every_layer());
   std::vector<OmegaSamples<3>> rows(std::size_t(execution.threads()));
   for_each_omega_row(grid, gamma, q, execution, s, [&](int thread, const std::vector<OmegaPoint>& points) {
@@ -316,13 +324,8 @@ ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surfac
                           const std::vector<double>& trace, const VectorizedField3& exact,
                           const GradientField3& exact_gradient, int q, const Execution& execution) {
   const double e = 1e-6 * grid.box().width(0);
-  const Distribution& distribution = execution.distribution();  // as in 2-D
-  const GridVector held = distribution.distributed() ? distribution.with_next_layer(grid, u_h) : GridVector();
-  const GridVector& u_held = distribution.distributed() ? held : u_h;
   const std::array<double, 4> omega = omega_error_sums<3>(
-      [&](const OmegaSampleVisitor<3>& visit) {
-        for_each_omega_sample(u_held, grid, gamma, q, execution, visit, distribution.slab(grid));
-      },
+      [&](const OmegaSampleVisitor<3>& visit) { for_each_omega_sample(u_h, grid, gamma, q, execution, visit); },
       [&](const std::array<std::vector<double>, 3>& x, std::vector<double>& u, std::array<std::vector<double>, 3>& du) {
         evaluate_at(exact, x, u);
         gradient_at(exact, exact_gradient, e, x, du);

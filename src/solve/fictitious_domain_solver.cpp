@@ -826,13 +826,11 @@ void quantities_step(const State<dim>& st, const BoundaryDiscretization<dim>& bo
   // Distributed, each rank samples the whole coarse field at the points of its cells (an eighth of a grid
   // vector in 3-D, a quarter in 2-D).
   const Distribution& distribution = st.execution.distribution();
-  const GridVector coarse_whole =
+  const GridVector gathered =
       from && distribution.distributed() ? distribution.gather(from->grid, from->u) : GridVector();
-  sol.domain = domain_quantities<dim>(st, boundary, sol.u, quantity_quadrature, from,
-                                      distribution.distributed() ? coarse_whole
-                                      : from                     ? from->u
-                                                                 : coarse_whole,
-                                      exact_u, difference2, exact);
+  const GridVector& coarse_u = from && !distribution.distributed() ? from->u : gathered;
+  sol.domain =
+      domain_quantities<dim>(st, boundary, sol.u, quantity_quadrature, from, coarse_u, exact_u, difference2, exact);
   if (sol.errors) {
     ErrorNorms& e = *sol.errors;
     const double energy =

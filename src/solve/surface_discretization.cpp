@@ -265,11 +265,7 @@ std::optional<std::vector<double>> SurfaceDiscretization::independent_normal_der
 
 void SurfaceDiscretization::for_each_omega_sample(const GridVector& u, int quadrature,
                                                   const OmegaSampleVisitor<3>& visit) const {
-  const Distribution& distribution = execution_.distribution();
-  if (!distribution.distributed())
-    return fictus::for_each_omega_sample(u, grid_, *gamma_, quadrature, execution_, visit);
-  fictus::for_each_omega_sample(distribution.with_next_layer(grid_, u), grid_, *gamma_, quadrature, execution_, visit,
-                                distribution.slab(grid_));
+  fictus::for_each_omega_sample(u, grid_, *gamma_, quadrature, execution_, visit);
 }
 
 ErrorNorms SurfaceDiscretization::errors(const GridVector& u, const std::vector<double>& trace, const Data& data,

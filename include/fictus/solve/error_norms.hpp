@@ -80,7 +80,8 @@ template <int dim>
 using OmegaSampleVisitor = std::function<void(int thread, const OmegaSamples<dim>& row)>;
 /// With `slab`: only the cells of the slab's layers (Grid::cell_layer), u_h holding the slab's layers and
 /// the next one (Grid::slab_index): a rank's part of the integrals, which a distributed run adds over
-/// its ranks.
+/// its ranks. Without one in a distributed run (the execution's distribution), u_h is this rank's
+/// layers, and the next layer is fetched (collective).
 void for_each_omega_sample(const GridVector& u_h, const CurveGridIntersection& gamma, int q, const Execution& execution,
                            const OmegaSampleVisitor<2>& visit, std::optional<Slab> slab = std::nullopt);
 void for_each_omega_sample(const GridVector& u_h, const Grid3& grid, const Surface& gamma, int q,
