@@ -266,15 +266,13 @@ void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
     clock.mark("green_table");
   }
   const int m = b.n_points();
-  // Distributed, the blocks are dense: each rank makes its part of every entry from its planes of the
-  // table, the parts are summed, and every rank takes rank 0's sum, so that Newton runs the same on every
-  // rank (compressed blocks are not linear in the entries: not distributed yet).
-  const bool compressible = compressed_schur(options.schur_storage, dim, m, st.fast->singular());
-  const bool hierarchical = compressible && !distribution.distributed();
+  // Distributed, each rank makes its part of every entry from its planes of the table and the parts are
+  // summed (the compressed blocks' cores before their compression); every rank takes rank 0's sums, so
+  // that Newton runs the same on every rank.
+  const bool hierarchical = compressed_schur(options.schur_storage, dim, m, st.fast->singular());
   if (options.schur_storage == SchurStorageKind::hierarchical && !hierarchical)
     setup.storage_warning =
-        compressible ? "solver.schur_storage: a run on several MPI ranks keeps the Schur complement dense"
-                     : "solver.schur_storage: a periodic box with c = 0 (A singular) keeps the Schur complement dense";
+        "solver.schur_storage: a periodic box with c = 0 (A singular) keeps the Schur complement dense";
   if (hierarchical) {
     GmresOptions inner = gmres;
     inner.relative_tolerance = hierarchical_gmres_tolerance;
@@ -955,10 +953,10 @@ std::pair<double, double> nodes_and_multipliers(const BasicProblem<dim>& problem
   return {nodes, m};
 }
 
-/// Whether a green solve of `problem` would keep its Schur blocks compressed (never on several ranks).
+/// Whether a green solve of `problem` would keep its Schur blocks compressed.
 template <int dim>
 bool compressed(const BasicProblem<dim>& problem, const SolverOptions& options, double m) {
-  return options.inner == InnerSolver::green && !process_distribution()->distributed() &&
+  return options.inner == InnerSolver::green &&
          compressed_schur(options.schur_storage, dim, m, problem.boundary == Boundary::periodic && problem.c == 0);
 }
 

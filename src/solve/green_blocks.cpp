@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "fictus/grid/distribution.hpp"
 #include "fictus/solve/schur_complement.hpp"
 
 namespace fictus {
@@ -342,7 +343,16 @@ struct BlockAssembly {
   void partition();
   void cluster_data();
   void fill(std::vector<Eigen::MatrixXd>& out);
-  void far_block(const Block& b, Eigen::MatrixXd& core, Eigen::MatrixXd& half, Eigen::MatrixXd& block,
+  /// The workspace of one thread.
+  struct Scratch {
+    std::vector<double> column;
+    Eigen::MatrixXd core, half, block;
+  };
+  /// work(k, scratch) for k < n on the threads; an exception or an interruption stops them all.
+  template <class Work>
+  void each(std::size_t n, const Work& work);
+  void far_core(const Block& b, Eigen::MatrixXd& core) const;
+  void far_block(const Block& b, const Eigen::MatrixXd& core, Eigen::MatrixXd& half, Eigen::MatrixXd& block,
                  std::vector<Eigen::MatrixXd>& out) const;
   void near_block(const Block& b, const std::vector<Index<dim>>& q_nodes, const std::vector<double>& q_values,
                   std::vector<double>& column, std::vector<Eigen::MatrixXd>& out) const;
@@ -498,14 +508,20 @@ void BlockAssembly<dim>::cluster_data() {
   execution.throw_if_interrupted();
 }
 
-/// A far block: U_x (G between the interpolation nodes) V_yᵀ.
+/// A far block's core: G between the interpolation nodes of its clusters (with a partial table, this
+/// rank's part of it).
 template <int dim>
-void BlockAssembly<dim>::far_block(const Block& b, Eigen::MatrixXd& core, Eigen::MatrixXd& half, Eigen::MatrixXd& block,
-                                   std::vector<Eigen::MatrixXd>& out) const {
-  const auto &cx = X->clusters[std::size_t(b.x)], &cy = Y->clusters[std::size_t(b.y)];
+void BlockAssembly<dim>::far_core(const Block& b, Eigen::MatrixXd& core) const {
   const Interpolation<dim>&Lx = *x_interp[std::size_t(b.x)], &Ly = *y_interp[std::size_t(b.y)];
   core.resize(Lx.size(), Ly.size());
   green.G(Lx.nodes, Ly.nodes, core.data(), std::size_t(Lx.size()));
+}
+
+/// A far block from its core: U_x core V_yᵀ.
+template <int dim>
+void BlockAssembly<dim>::far_block(const Block& b, const Eigen::MatrixXd& core, Eigen::MatrixXd& half,
+                                   Eigen::MatrixXd& block, std::vector<Eigen::MatrixXd>& out) const {
+  const auto &cx = X->clusters[std::size_t(b.x)], &cy = Y->clusters[std::size_t(b.y)];
   CompressedBlocks::Block* kept = b.low_rank ? &compressed->blocks[std::size_t(b.store)] : nullptr;
   if (kept) {  // low rank where that is smaller than the dense block, from the block's rows and columns
     const Eigen::MatrixXd& Vy = V[std::size_t(b.y)];
@@ -567,27 +583,41 @@ void BlockAssembly<dim>::near_block(const Block& b, const std::vector<Index<dim>
   }
 }
 
-/// Every block, dearest first, on the threads.
+/// Each matrix ← its sum over the ranks, with rank 0's bits on every rank (what is made from it next is
+/// then the same on every rank), in messages of about `summed_chunk` doubles. Serial: unchanged.
+constexpr std::size_t summed_chunk = std::size_t(1) << 22;
+void sum_over_ranks(const Distribution& distribution, const std::vector<Eigen::MatrixXd*>& mats) {
+  if (!distribution.distributed()) return;
+  std::vector<double> buffer;
+  for (std::size_t first = 0, last = 0; first < mats.size(); first = last) {
+    std::size_t n = 0;
+    for (last = first; last < mats.size() && (last == first || n + std::size_t(mats[last]->size()) <= summed_chunk);)
+      n += std::size_t(mats[last++]->size());
+    buffer.resize(n);
+    double* at = buffer.data();
+    for (std::size_t k = first; k < last; ++k) at = std::copy_n(mats[k]->data(), mats[k]->size(), at);
+    distribution.sum(buffer.data(), n);
+    distribution.broadcast(buffer.data(), n);
+    at = buffer.data();
+    for (std::size_t k = first; k < last; ++k) {
+      std::copy_n(at, mats[k]->size(), mats[k]->data());
+      at += mats[k]->size();
+    }
+  }
+}
+
 template <int dim>
-void BlockAssembly<dim>::fill(std::vector<Eigen::MatrixXd>& out) {
-  std::vector<Index<dim>> q_nodes;  // Q's entries' nodes and values, for the near blocks' sums
-  std::vector<double> q_values;
-  q_nodes.reserve(Q.entries.size());
-  q_values.reserve(Q.entries.size());
-  for (const SparseRows::Entry& e : Q.entries) q_nodes.push_back(node_of<dim>(e)), q_values.push_back(e.value);
+template <class Work>
+void BlockAssembly<dim>::each(std::size_t n, const Work& work) {
   std::atomic<bool> stop = false;  // an interruption seen by thread 0 (the caller's) ends every thread's work
 #pragma omp parallel num_threads(execution.threads())
   {
-    std::vector<double> column;
-    Eigen::MatrixXd core, half, block;
+    Scratch scratch;
 #pragma omp for schedule(dynamic, 1)
-    for (std::size_t k = 0; k < blocks.size(); ++k) try {
+    for (std::size_t k = 0; k < n; ++k) try {
         if (omp_get_thread_num() == 0 && execution.interrupt_requested()) stop = true;
         if (stop) continue;
-        if (blocks[k].far)
-          far_block(blocks[k], core, half, block, out);
-        else
-          near_block(blocks[k], q_nodes, q_values, column, out);
+        work(k, scratch);
       } catch (...) {
         keep();
         stop = true;
@@ -595,6 +625,56 @@ void BlockAssembly<dim>::fill(std::vector<Eigen::MatrixXd>& out) {
   }
   if (failure) std::rethrow_exception(failure);
   if (stop) throw Interrupted();
+}
+
+/// Every block, dearest first, on the threads. The entries are linear in the table's values, so with a
+/// partial table (a distributed run) each rank makes its part of every entry and the parts are added:
+/// the dense blocks' by ExplicitSchur, the kept dense ones here. A low-rank block is not linear in its
+/// entries: its core (G between the interpolation nodes) is summed first, in batches of about
+/// `summed_chunk` doubles, and every rank compresses the same sum. Serially the sums are no-ops and each
+/// block comes out as it would in one pass.
+template <int dim>
+void BlockAssembly<dim>::fill(std::vector<Eigen::MatrixXd>& out) {
+  std::vector<Index<dim>> q_nodes;  // Q's entries' nodes and values, for the near blocks' sums
+  std::vector<double> q_values;
+  q_nodes.reserve(Q.entries.size());
+  q_values.reserve(Q.entries.size());
+  for (const SparseRows::Entry& e : Q.entries) q_nodes.push_back(node_of<dim>(e)), q_values.push_back(e.value);
+  std::vector<std::size_t> linear, low_rank;
+  for (std::size_t k = 0; k < blocks.size(); ++k) (blocks[k].low_rank ? low_rank : linear).push_back(k);
+  each(linear.size(), [&](std::size_t k, Scratch& s) {
+    const Block& b = blocks[linear[k]];
+    if (b.far) {
+      far_core(b, s.core);
+      far_block(b, s.core, s.half, s.block, out);
+    } else {
+      near_block(b, q_nodes, q_values, s.column, out);
+    }
+  });
+  const Distribution& distribution = execution.distribution();
+  if (compressed) {
+    std::vector<Eigen::MatrixXd*> kept_dense;
+    for (std::size_t k = 0; k < stores.size(); ++k)
+      if (!stores[k].far)
+        for (Eigen::MatrixXd& d : compressed->blocks[k].dense) kept_dense.push_back(&d);
+    sum_over_ranks(distribution, kept_dense);
+  }
+  std::vector<Eigen::MatrixXd> cores;
+  std::vector<Eigen::MatrixXd*> summed;
+  for (std::size_t first = 0, last = 0; first < low_rank.size(); first = last) {
+    std::size_t n = 0;  // a batch: the next blocks whose cores take about summed_chunk doubles
+    for (last = first; last < low_rank.size() && (last == first || n <= summed_chunk); ++last) {
+      const Block& b = blocks[low_rank[last]];
+      n += std::size_t(x_interp[std::size_t(b.x)]->size()) * std::size_t(y_interp[std::size_t(b.y)]->size());
+    }
+    cores.resize(last - first);
+    each(cores.size(), [&](std::size_t k, Scratch&) { far_core(blocks[low_rank[first + k]], cores[k]); });
+    summed.clear();
+    for (Eigen::MatrixXd& core : cores) summed.push_back(&core);
+    sum_over_ranks(distribution, summed);
+    each(cores.size(),
+         [&](std::size_t k, Scratch& s) { far_block(blocks[low_rank[first + k]], cores[k], s.half, s.block, out); });
+  }
 }
 
 template <int dim>
@@ -701,16 +781,31 @@ void CompressedBlocks::multiply(const Eigen::VectorXd& x, std::vector<Eigen::Vec
   const auto skip = [&](int s, const Cluster& cx) {
     return set_of_row && wanted[std::size_t(s)][std::size_t(cx.end)] == wanted[std::size_t(s)][std::size_t(cx.begin)];
   };
-  // Each thread adds into its own copy (tree order), summed after.
-  std::vector<Eigen::MatrixXd> partial(std::size_t(std::max(1, threads)));
+  // Each thread adds a fixed run of the blocks (of about equal work) into its own copy (tree order),
+  // summed after in thread order: the bits depend on the thread count only, so that ranks with the same
+  // count compute the same product (a distributed run's Newton steps must agree).
+  const int n_threads = std::max(1, threads);
+  std::vector<Eigen::MatrixXd> partial(static_cast<std::size_t>(n_threads));
   const int n_b = int(blocks.size());
-#pragma omp parallel num_threads(threads)
+  std::vector<double> work(std::size_t(n_b) + 1, 0.0);  // work[k]: the first k blocks' stored numbers
+  for (int k = 0; k < n_b; ++k) {
+    const Block& b = blocks[std::size_t(k)];
+    double n = 0;
+    for (const auto* parts : {&b.dense, &b.left, &b.right})
+      for (const Eigen::MatrixXd& d : *parts) n += double(d.size());
+    work[std::size_t(k) + 1] = work[std::size_t(k)] + n;
+  }
+#pragma omp parallel num_threads(n_threads)
   {
-    Eigen::MatrixXd& mine = partial[std::size_t(omp_get_thread_num())];
+    const int t = omp_get_thread_num(), team = omp_get_num_threads();
+    Eigen::MatrixXd& mine = partial[std::size_t(t)];
     mine = Eigen::MatrixXd::Zero(n_rows, n_sets);
     Eigen::VectorXd w;
-#pragma omp for schedule(dynamic, 64)
-    for (int k = 0; k < n_b; ++k) {
+    const auto run_start = [&](int r) {
+      return int(std::lower_bound(work.begin(), work.end(), work.back() * r / team) - work.begin());
+    };
+    const int first = t == 0 ? 0 : run_start(t), last = t + 1 == team ? n_b : run_start(t + 1);
+    for (int k = first; k < last; ++k) {
       const Block& b = blocks[std::size_t(k)];
       const Cluster &cx = row_clusters[std::size_t(b.x)], &cy = col_clusters[std::size_t(b.y)];
       const auto xy = xt.segment(cy.begin, cy.end - cy.begin);

@@ -178,9 +178,6 @@ HierarchicalSchur::HierarchicalSchur(const GreenTable<dim>& green, const SparseR
                                      const SparseRows& loads, const Execution& execution, const DirectTerms& direct,
                                      const HierarchicalOptions& options, const GmresOptions& gmres)
     : impl_(std::make_unique<Impl>()) {
-  // Its blocks are compressed from the entries (cross approximation): a rank's part of each entry
-  // would be compressed on its own, not summed.
-  if (green.partial()) throw std::logic_error("HierarchicalSchur: the Green's table of a distributed run is partial");
   const auto start = std::chrono::steady_clock::now();
   Impl& s = *impl_;
   s.m = B_gamma.n_rows();

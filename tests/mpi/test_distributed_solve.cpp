@@ -47,12 +47,14 @@ struct Case {
   fictus::Boundary boundary;
   double c = -1;  // < 0: the file's
   fictus::InnerSolver inner = fictus::InnerSolver::green;
+  fictus::SchurStorageKind storage = fictus::SchurStorageKind::automatic;
 };
 
 std::string name_of(int dim, const Case& c) {
   return std::to_string(dim) + "-D N = " + std::to_string(c.N) + ", " + fictus::to_string(c.variant) + ", " +
          fictus::to_string(c.boundary) + (c.c >= 0 ? ", c = " + std::to_string(c.c).substr(0, 3) : "") +
-         (c.inner == fictus::InnerSolver::krylov ? ", krylov" : "");
+         (c.inner == fictus::InnerSolver::krylov ? ", krylov" : "") +
+         (c.storage == fictus::SchurStorageKind::hierarchical ? ", compressed Schur" : "");
 }
 
 template <class Vector>
@@ -92,6 +94,7 @@ void check(const Case& c) {
   if (c.c >= 0) spec.problem.c = c.c;
   spec.options.variant = c.variant;
   spec.options.inner = c.inner;
+  spec.options.schur_storage = c.storage;
   spec.options.threads = 1;
   spec.options.error_estimate = true;
 
@@ -153,10 +156,12 @@ TEST(DistributedSolve, TwoDimensionsAgreeWithTheSerialSolve) {
   const std::string circle = example("manufactured_circle.toml"), plain = plain_problem(2);
   using B = fictus::Boundary;
   using V = fictus::Variant;
+  const auto compressed = fictus::SchurStorageKind::hierarchical;
   for (const Case& c : {Case{circle, 128, V::smooth, B::dirichlet}, Case{circle, 128, V::nonsmooth, B::dirichlet},
                         Case{circle, 128, V::smooth, B::periodic}, Case{circle, 128, V::nonsmooth, B::periodic},
                         Case{plain, 128, V::smooth, B::periodic, 0.0}, Case{plain, 128, V::nonsmooth, B::periodic, 0.0},
-                        Case{circle, 128, V::smooth, B::dirichlet, -1, fictus::InnerSolver::krylov}})
+                        Case{circle, 128, V::smooth, B::dirichlet, -1, fictus::InnerSolver::krylov},
+                        Case{circle, 128, V::nonsmooth, B::periodic, -1, fictus::InnerSolver::green, compressed}})
     check<2>(c);
 }
 
@@ -164,10 +169,12 @@ TEST(DistributedSolve, ThreeDimensionsAgreeWithTheSerialSolve) {
   const std::string sphere = example("manufactured_sphere.toml"), plain = plain_problem(3);
   using B = fictus::Boundary;
   using V = fictus::Variant;
+  const auto compressed = fictus::SchurStorageKind::hierarchical;
   for (const Case& c : {Case{sphere, 32, V::smooth, B::dirichlet}, Case{sphere, 32, V::nonsmooth, B::dirichlet},
                         Case{sphere, 32, V::nonsmooth, B::periodic}, Case{plain, 32, V::smooth, B::periodic, 0.0},
                         Case{plain, 32, V::nonsmooth, B::periodic, 0.0},
-                        Case{sphere, 32, V::nonsmooth, B::dirichlet, -1, fictus::InnerSolver::krylov}})
+                        Case{sphere, 32, V::nonsmooth, B::dirichlet, -1, fictus::InnerSolver::krylov},
+                        Case{sphere, 32, V::smooth, B::dirichlet, -1, fictus::InnerSolver::green, compressed}})
     check<3>(c);
 }
 

@@ -17,7 +17,11 @@
 #include "fictus/mpi/next_layer.hpp"
 #include "fictus/mpi/slab_solver.hpp"
 #include "fictus/solve/error_norms.hpp"
+#include "fictus/solve/hierarchical_schur.hpp"
+#include "fictus/solve/schur_complement.hpp"
+#include "fictus/solve/surface_discretization.hpp"
 #include "scattered_rows.hpp"
+#include "sphere_rows.hpp"
 
 namespace {
 
@@ -298,6 +302,50 @@ TEST(SlabGreenTable, PartsAddUpToTheWholeTable) {
   check_green_table<2>(fictus::Box<2>{{0.0, 0.0}, {1.0, 1.25}}, 32, Boundary::periodic, 0.0);
   check_green_table<3>(fictus::Box<3>{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}}, 16, Boundary::dirichlet, 1.0);
   check_green_table<3>(fictus::Box<3>{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.25}}, 16, Boundary::periodic, 1.0);
+}
+
+/// The compressed Schur blocks (the hierarchical solver's partition with leaves of 8: low-rank pairs at
+/// this m) from the ranks' planes of the table, each far pair's core summed over the ranks before its
+/// compression, against the blocks of the whole table: the products agree to round-off, and every rank
+/// holds the same bits (its Newton steps must be the others').
+TEST(SlabGreenTable, CompressedBlocksFromThePartsAreThoseOfTheWholeTable) {
+  const Communicator comm;
+  for (const auto& [boundary, c] : {std::pair{Boundary::dirichlet, 1.0}, std::pair{Boundary::periodic, 1.0}}) {
+    const fictus::test_support::SphereRows rows(boundary, 0.3, 48, 2.0, 1.5);
+    fictus::FarField storage = fictus::hierarchical_far_field;
+    storage.leaf = 8;
+    const fictus::GreenTable<3> whole(rows.grid, c, fictus::Execution(1));
+    const fictus::CompressedBlocks serial = fictus::compressed_green_blocks(
+        whole, {&rows.B, &rows.C}, rows.Q, fictus::Execution(2), fictus::default_far_field_3d, storage);
+    const auto distribution = std::make_shared<fictus::mpi::SlabDistribution>(comm);
+    fictus::set_process_distribution(distribution);
+    const fictus::Execution execution(2);
+    const fictus::GreenTable<3> part(rows.grid, c, execution);
+    const fictus::CompressedBlocks parts = fictus::compressed_green_blocks(part, {&rows.B, &rows.C}, rows.Q, execution,
+                                                                           fictus::default_far_field_3d, storage);
+    fictus::set_process_distribution(nullptr);
+    const std::string name = std::string("3-D ") + fictus::to_string(boundary) + ": compressed blocks from planes";
+    ASSERT_EQ(parts.blocks.size(), serial.blocks.size()) << name;
+    int low_rank = 0;
+    for (const fictus::CompressedBlocks::Block& b : parts.blocks) low_rank += b.dense.empty() ? 1 : 0;
+    if (boundary == Boundary::dirichlet)  // periodic: the images keep the far pairs dense at this m
+      EXPECT_GT(low_rank, 10) << name;
+    if (comm.rank() == 0)
+      std::printf("    %d of %zu blocks of low rank, m = %d\n", low_rank, parts.blocks.size(), rows.B.n_rows());
+    const int m = rows.B.n_rows();
+    const Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(m, -1.0, 2.0).array().sin();
+    std::vector<Eigen::VectorXd> want, got;
+    serial.multiply(x, want, 2);
+    parts.multiply(x, got, 2);
+    double difference = 0;
+    for (std::size_t s = 0; s < 2; ++s) difference = std::max(difference, (got[s] - want[s]).norm() / want[s].norm());
+    expect_agreement(comm.max(difference), name + ", products", comm);
+    std::vector<double> mine(got[0].data(), got[0].data() + m), first;
+    mine.insert(mine.end(), got[1].data(), got[1].data() + m);
+    first = mine;
+    distribution->broadcast(first.data(), first.size());
+    EXPECT_EQ(comm.max(mine == first ? 0.0 : 1.0), 0.0) << name << ": the ranks' products differ";
+  }
 }
 
 TEST(SlabSolver, DefaultSlabsCoverTheLayersInOrder) {

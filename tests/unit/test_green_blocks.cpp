@@ -15,6 +15,7 @@
 #include "fictus/solve/hierarchical_schur.hpp"
 #include "fictus/solve/schur_complement.hpp"
 #include "fictus/solve/surface_discretization.hpp"
+#include "sphere_rows.hpp"
 
 namespace {
 
@@ -30,26 +31,10 @@ void PrintTo(const Case& k, std::ostream* out) {
        << ", r = " << k.radius;
 }
 
-/// The smooth variant's rows on a sphere: B_γ, C_γ at the points, patch integrals on Γ at δ.
-struct SphereRows {
-  fictus::Grid3 grid;
-  fictus::SparseRows B, C, Q;
+/// The rows of the case's sphere.
+struct SphereRows : fictus::test_support::SphereRows {
   SphereRows(const Case& k, int N, double patch_cells, double delta_cells)
-      : grid(fictus::Box3{{0, 0, 0}, {1, 1, 1}}, N, k.boundary) {
-    const double h = grid.h();
-    const fictus::Ellipsoid sphere({0.5, 0.5, 0.5}, {k.radius, k.radius, k.radius});
-    const int m = int(sphere.area() / (patch_cells * h * patch_cells * h));
-    const fictus::PatchedSurface s = sphere.patches(m, h);
-    std::vector<fictus::Triangle3> Gamma = s.triangles;
-    for (fictus::Triangle3& t : Gamma)
-      for (fictus::Point3* p : {&t.a, &t.b, &t.c}) {
-        const fictus::Point3 d = *p - fictus::Point3{0.5, 0.5, 0.5};
-        *p = *p + (delta_cells * h / fictus::norm(d)) * d;
-      }
-    B = fictus::point_value_rows(grid, s.point);
-    C = fictus::normal_derivative_rows_centered(grid, s.point, s.normal);
-    Q = fictus::patch_integral_rows(grid, fictus::patch_integrals(grid, Gamma, s.patch_of, m), m);
-  }
+      : fictus::test_support::SphereRows(k.boundary, k.radius, N, patch_cells, delta_cells) {}
 };
 
 double relative_max_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
