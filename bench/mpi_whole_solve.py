@@ -3,7 +3,8 @@ and the agreement of λ and the force, from results.json and points.csv of `fict
 
   python3 bench/mpi_whole_solve.py [build] [case ...] > bench/results/<date>-mpi-whole-solve.md
 
-(cases by their N: 4096, 128, 192, 384; all but 384 when none is given)
+(cases by their N: 4096, 128, 192, 384; 384c and 512c for the compressed Schur complement; 4096, 128
+and 192 when none is given)
 
 Cases: 2-D h = 1/4096 (the manufactured circle) and the 3-D sphere of bench/sphere_contact.toml at
 N = 128, 192 and 384 (where a grid array is 429 MiB); serially with 2 threads (and the dense Schur complement that a run on several ranks
@@ -31,14 +32,25 @@ CASES = [
     ("3-D sphere, N = 192", os.path.join(here, "sphere_contact.toml"), ["--N", "192"]),
     ("3-D sphere, N = 384", os.path.join(here, "sphere_contact.toml"), ["--N", "384"]),
 ]
-chosen = sys.argv[2:] or ["4096", "128", "192"]
-CASES = [c for c in CASES if c[2][1] in chosen]
 RUNS = [  # (name, ranks, threads, extra flags)
     ("serial", 0, 2, []),
     ("serial, dense S", 0, 2, ["--schur_storage", "dense"]),
     ("2 ranks", 2, 1, []),
     ("4 ranks (oversubscribed)", 4, 1, []),
 ]
+# The compressed Schur complement (chosen from m = 5000 on; asked for here at smaller m) on the ranks,
+# against the serial compressed solve and the dense blocks on the same ranks.
+COMPRESSED = ["--schur_storage", "hierarchical"]
+COMPRESSED_RUNS = [
+    ("serial, compressed S", 0, 2, COMPRESSED),
+    ("2 ranks, compressed S", 2, 1, COMPRESSED),
+    ("2 ranks, dense S", 2, 1, ["--schur_storage", "dense"]),
+    ("4 ranks, compressed S (oversubscribed)", 4, 1, COMPRESSED),
+]
+for N in ("384", "512"):
+    CASES.append((f"3-D sphere, N = {N}, compressed", os.path.join(here, "sphere_contact.toml"), ["--N", N], "c"))
+chosen = sys.argv[2:] or ["4096", "128", "192"]
+CASES = [c for c in CASES if c[2][1] + (c[3] if len(c) > 3 else "") in chosen]
 
 
 def run(problem, flags, ranks, threads, folder):
@@ -71,10 +83,10 @@ print("- λ and the force against the first serial run: max |Δλ| / max |λ|, a
 print("| case | run | m | Schur | Newton steps | time [s] | peak of a rank [MiB] | peaks summed [MiB] "
       "| Δλ | ΔF |")
 print("|---|---|---|---|---|---|---|---|---|---|")
-for case, problem, flags in CASES:
+for n_case, (case, problem, flags, *compressed) in enumerate(CASES):
     reference = None
-    for name, ranks, threads, extra in RUNS:
-        folder = os.path.join(work, f"{len(case)}-{name.split()[0]}-{ranks}-{len(extra)}")
+    for n_run, (name, ranks, threads, extra) in enumerate(COMPRESSED_RUNS if compressed else RUNS):
+        folder = os.path.join(work, f"{n_case}-{n_run}")
         results, lam = run(problem, flags + extra, ranks, threads, folder)
         peaks = results.get("ranks", {}).get("peak_memory_bytes", [results["peak_memory_bytes"]])
         force = results["contact"]["force"]
