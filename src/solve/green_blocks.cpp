@@ -351,6 +351,8 @@ struct BlockAssembly {
   /// work(k, scratch) for k < n on the threads; an exception or an interruption stops them all.
   template <class Work>
   void each(std::size_t n, const Work& work);
+  template <class Piece>
+  void fill_kept(const Piece& piece);
   void far_core(const Block& b, Eigen::MatrixXd& core) const;
   void far_block(const Block& b, const Eigen::MatrixXd& core, Eigen::MatrixXd& half, Eigen::MatrixXd& block,
                  std::vector<Eigen::MatrixXd>& out) const;
@@ -583,28 +585,7 @@ void BlockAssembly<dim>::near_block(const Block& b, const std::vector<Index<dim>
   }
 }
 
-/// Each matrix ← its sum over the ranks, with rank 0's bits on every rank (what is made from it next is
-/// then the same on every rank), in messages of about `summed_chunk` doubles. Serial: unchanged.
-constexpr std::size_t summed_chunk = std::size_t(1) << 22;
-void sum_over_ranks(const Distribution& distribution, const std::vector<Eigen::MatrixXd*>& mats) {
-  if (!distribution.distributed()) return;
-  std::vector<double> buffer;
-  for (std::size_t first = 0, last = 0; first < mats.size(); first = last) {
-    std::size_t n = 0;
-    for (last = first; last < mats.size() && (last == first || n + std::size_t(mats[last]->size()) <= summed_chunk);)
-      n += std::size_t(mats[last++]->size());
-    buffer.resize(n);
-    double* at = buffer.data();
-    for (std::size_t k = first; k < last; ++k) at = std::copy_n(mats[k]->data(), mats[k]->size(), at);
-    distribution.sum(buffer.data(), n);
-    distribution.broadcast(buffer.data(), n);
-    at = buffer.data();
-    for (std::size_t k = first; k < last; ++k) {
-      std::copy_n(at, mats[k]->size(), mats[k]->data());
-      at += mats[k]->size();
-    }
-  }
-}
+constexpr std::size_t summed_chunk = std::size_t(1) << 22;  // doubles (32 MiB) in one sum over the ranks
 
 template <int dim>
 template <class Work>
@@ -627,12 +608,9 @@ void BlockAssembly<dim>::each(std::size_t n, const Work& work) {
   if (stop) throw Interrupted();
 }
 
-/// Every block, dearest first, on the threads. The entries are linear in the table's values, so with a
-/// partial table (a distributed run) each rank makes its part of every entry and the parts are added:
-/// the dense blocks' by ExplicitSchur, the kept dense ones here. A low-rank block is not linear in its
-/// entries: its core (G between the interpolation nodes) is summed first, in batches of about
-/// `summed_chunk` doubles, and every rank compresses the same sum. Serially the sums are no-ops and each
-/// block comes out as it would in one pass.
+/// Every block, dearest first, on the threads. The entries are linear in the table's values: with a
+/// partial table (a distributed run) each rank makes its part of every entry, and the dense blocks'
+/// parts are added by ExplicitSchur; the kept ones by fill_kept.
 template <int dim>
 void BlockAssembly<dim>::fill(std::vector<Eigen::MatrixXd>& out) {
   std::vector<Index<dim>> q_nodes;  // Q's entries' nodes and values, for the near blocks' sums
@@ -640,40 +618,91 @@ void BlockAssembly<dim>::fill(std::vector<Eigen::MatrixXd>& out) {
   q_nodes.reserve(Q.entries.size());
   q_values.reserve(Q.entries.size());
   for (const SparseRows::Entry& e : Q.entries) q_nodes.push_back(node_of<dim>(e)), q_values.push_back(e.value);
-  std::vector<std::size_t> linear, low_rank;
-  for (std::size_t k = 0; k < blocks.size(); ++k) (blocks[k].low_rank ? low_rank : linear).push_back(k);
-  each(linear.size(), [&](std::size_t k, Scratch& s) {
-    const Block& b = blocks[linear[k]];
-    if (b.far) {
-      far_core(b, s.core);
-      far_block(b, s.core, s.half, s.block, out);
-    } else {
-      near_block(b, q_nodes, q_values, s.column, out);
-    }
-  });
+  const auto piece = [&](const Block& b, Scratch& s) {
+    if (!b.far) return near_block(b, q_nodes, q_values, s.column, out);
+    far_core(b, s.core);
+    far_block(b, s.core, s.half, s.block, out);
+  };
+  if (!compressed) return each(blocks.size(), [&](std::size_t k, Scratch& s) { piece(blocks[k], s); });
+  fill_kept(piece);
+}
+
+/// The kept blocks, in batches of them whose numbers (near: the entries; far: the core, G between the
+/// interpolation nodes) take about summed_chunk doubles. A batch's near entries and far cores are made
+/// (with a partial table: this rank's part), summed over the ranks, and each block is kept by one rank,
+/// chosen for equal work, which compresses it if it is far (cross approximation is not linear in the
+/// entries: it takes the sum). Serially every block is kept and comes out as in one pass.
+template <int dim>
+template <class Piece>
+void BlockAssembly<dim>::fill_kept(const Piece& piece) {
   const Distribution& distribution = execution.distribution();
-  if (compressed) {
-    std::vector<Eigen::MatrixXd*> kept_dense;
-    for (std::size_t k = 0; k < stores.size(); ++k)
-      if (!stores[k].far)
-        for (Eigen::MatrixXd& d : compressed->blocks[k].dense) kept_dense.push_back(&d);
-    sum_over_ranks(distribution, kept_dense);
+  const std::size_t n = stores.size();
+  std::vector<std::vector<std::size_t>> pieces(n);  // of each kept block, dearest first
+  for (std::size_t k = 0; k < blocks.size(); ++k) pieces[std::size_t(blocks[k].store)].push_back(k);
+  const auto rows = [&](std::size_t k) { return std::size_t(cluster_items(*X, stores[k].x).size()); };
+  const auto cols = [&](std::size_t k) { return std::size_t(cluster_items(*Y, stores[k].y).size()); };
+  const auto core_size = [&](std::size_t k) {
+    return std::size_t(x_interp[std::size_t(stores[k].x)]->size()) *
+           std::size_t(y_interp[std::size_t(stores[k].y)]->size());
+  };
+  // The owners: the blocks by their work (near: the entries; far: the cross approximation's rows and
+  // columns through the core), dearest first, each to the rank with the least so far.
+  std::vector<int> owner(n, 0);
+  if (distribution.distributed()) {
+    std::vector<double> work(n), load(std::size_t(distribution.size()), 0.0);
+    for (std::size_t k = 0; k < n; ++k)
+      work[k] = stores[k].far ? double(rows(k) + cols(k)) * double(x_interp[std::size_t(stores[k].x)]->size() +
+                                                                   y_interp[std::size_t(stores[k].y)]->size())
+                              : double(rows(k) * cols(k));
+    std::vector<std::size_t> order(n);
+    std::iota(order.begin(), order.end(), std::size_t(0));
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return work[a] > work[b]; });
+    for (std::size_t k : order) {
+      const auto least = std::size_t(std::min_element(load.begin(), load.end()) - load.begin());
+      owner[k] = int(least);
+      load[least] += work[k];
+    }
   }
+  const std::size_t n_sets = row_sets.size();
   std::vector<Eigen::MatrixXd> cores;
   std::vector<Eigen::MatrixXd*> summed;
-  for (std::size_t first = 0, last = 0; first < low_rank.size(); first = last) {
-    std::size_t n = 0;  // a batch: the next blocks whose cores take about summed_chunk doubles
-    for (last = first; last < low_rank.size() && (last == first || n <= summed_chunk); ++last) {
-      const Block& b = blocks[low_rank[last]];
-      n += std::size_t(x_interp[std::size_t(b.x)]->size()) * std::size_t(y_interp[std::size_t(b.y)]->size());
+  std::vector<std::size_t> made, kept_far;
+  for (std::size_t first = 0, last = 0; first < n; first = last) {
+    std::size_t numbers = 0;
+    for (last = first; last < n && (last == first || numbers <= summed_chunk); ++last)
+      numbers += stores[last].far ? core_size(last) : n_sets * rows(last) * cols(last);
+    cores.assign(last - first, Eigen::MatrixXd());
+    made.clear(), summed.clear(), kept_far.clear();
+    for (std::size_t k = first; k < last; ++k) {
+      CompressedBlocks::Block& kept = compressed->blocks[k];
+      if (stores[k].far) {
+        summed.push_back(&cores[k - first]);
+        if (owner[k] == distribution.rank()) kept_far.push_back(k);
+      } else {
+        kept.dense.assign(n_sets, Eigen::MatrixXd(Eigen::Index(rows(k)), Eigen::Index(cols(k))));
+        for (Eigen::MatrixXd& d : kept.dense) summed.push_back(&d);
+      }
+      made.insert(made.end(), pieces[k].begin(), pieces[k].end());
     }
-    cores.resize(last - first);
-    each(cores.size(), [&](std::size_t k, Scratch&) { far_core(blocks[low_rank[first + k]], cores[k]); });
-    summed.clear();
-    for (Eigen::MatrixXd& core : cores) summed.push_back(&core);
+    each(made.size(), [&](std::size_t a, Scratch& s) {
+      const Block& b = blocks[made[a]];
+      if (b.low_rank)
+        far_core(b, cores[std::size_t(b.store) - first]);
+      else
+        piece(b, s);
+    });
     sum_over_ranks(distribution, summed);
-    each(cores.size(),
-         [&](std::size_t k, Scratch& s) { far_block(blocks[low_rank[first + k]], cores[k], s.half, s.block, out); });
+    each(kept_far.size(), [&](std::size_t a, Scratch& s) {
+      const std::size_t k = kept_far[a];
+      std::vector<Eigen::MatrixXd> unused;
+      far_block(blocks[pieces[k].front()], cores[k - first], s.half, s.block, unused);
+    });
+    for (std::size_t k = first; k < last; ++k)
+      if (owner[k] != distribution.rank()) {
+        compressed->blocks[k].held = false;
+        compressed->blocks[k].dense.clear();
+        compressed->blocks[k].dense.shrink_to_fit();
+      }
   }
 }
 
@@ -734,15 +763,9 @@ CompressedBlocks compressed_green_blocks(const GreenTable<dim>& green, const std
   assembly.partition();
   assembly.cluster_data();
   c.blocks.resize(assembly.stores.size());
-  for (std::size_t k = 0; k < assembly.stores.size(); ++k) {
-    const Store& kept = assembly.stores[k];
-    c.blocks[k].x = kept.x, c.blocks[k].y = kept.y;
-    if (!kept.far)  // filled in place by the pieces of the block
-      c.blocks[k].dense.assign(row_sets.size(), Eigen::MatrixXd(assembly.X->clusters[std::size_t(kept.x)].end -
-                                                                    assembly.X->clusters[std::size_t(kept.x)].begin,
-                                                                assembly.Y->clusters[std::size_t(kept.y)].end -
-                                                                    assembly.Y->clusters[std::size_t(kept.y)].begin));
-  }
+  for (std::size_t k = 0; k < assembly.stores.size(); ++k)
+    c.blocks[k].x = assembly.stores[k].x, c.blocks[k].y = assembly.stores[k].y;
+  if (execution.distribution().distributed()) c.distribution = execution.shared_distribution();
   std::vector<Eigen::MatrixXd> unused;
   assembly.fill(unused);
   if (report) assembly.report(*report);
@@ -756,6 +779,26 @@ CompressedBlocks compressed_green_blocks(const GreenTable<dim>& green, const std
       c.row_parent[std::size_t(assembly.X->clusters[k].left)] =
           c.row_parent[std::size_t(assembly.X->clusters[k].right)] = int(k);
   return c;
+}
+
+void sum_over_ranks(const Distribution& distribution, const std::vector<Eigen::MatrixXd*>& mats) {
+  if (!distribution.distributed()) return;
+  std::vector<double> buffer;
+  for (std::size_t first = 0, last = 0; first < mats.size(); first = last) {
+    std::size_t n = 0;
+    for (last = first; last < mats.size() && (last == first || n + std::size_t(mats[last]->size()) <= summed_chunk);)
+      n += std::size_t(mats[last++]->size());
+    buffer.resize(n);
+    double* at = buffer.data();
+    for (std::size_t k = first; k < last; ++k) at = std::copy_n(mats[k]->data(), mats[k]->size(), at);
+    distribution.sum(buffer.data(), n);
+    distribution.broadcast(buffer.data(), n);
+    at = buffer.data();
+    for (std::size_t k = first; k < last; ++k) {
+      std::copy_n(at, mats[k]->size(), mats[k]->data());
+      at += mats[k]->size();
+    }
+  }
 }
 
 double CompressedBlocks::bytes() const {
@@ -807,6 +850,7 @@ void CompressedBlocks::multiply(const Eigen::VectorXd& x, std::vector<Eigen::Vec
     const int first = t == 0 ? 0 : run_start(t), last = t + 1 == team ? n_b : run_start(t + 1);
     for (int k = first; k < last; ++k) {
       const Block& b = blocks[std::size_t(k)];
+      if (!b.held) continue;
       const Cluster &cx = row_clusters[std::size_t(b.x)], &cy = col_clusters[std::size_t(b.y)];
       const auto xy = xt.segment(cy.begin, cy.end - cy.begin);
       if (!b.dense.empty()) {
@@ -823,6 +867,7 @@ void CompressedBlocks::multiply(const Eigen::VectorXd& x, std::vector<Eigen::Vec
   }
   for (std::size_t p = 1; p < partial.size(); ++p)
     if (partial[p].size() > 0) partial[0] += partial[p];
+  if (distribution) distribution->sum(partial[0].data(), std::size_t(partial[0].size()));
   y.assign(std::size_t(n_sets), Eigen::VectorXd(n_rows));
   for (int s = 0; s < n_sets; ++s)
     for (int i = 0; i < n_rows; ++i) y[std::size_t(s)](row_item[std::size_t(i)]) = partial[0](i, s);
@@ -849,7 +894,7 @@ Eigen::MatrixXd CompressedBlocks::diagonal_block(int k, int g) const {
   for (const Block& b : blocks) {
     const Cluster &cx = row_clusters[std::size_t(b.x)], &cy = col_clusters[std::size_t(b.y)];
     const int r0 = std::max(cx.begin, cg.begin), r1 = std::min(cx.end, cg.end);
-    if (r0 >= r1) continue;
+    if (r0 >= r1 || !b.held) continue;
     cols.clear(), at.clear();
     for (int j = cy.begin; j < cy.end; ++j)
       if (const int p = place[std::size_t(col_item[std::size_t(j)])]; p >= 0)

@@ -209,24 +209,40 @@ HierarchicalSchur::HierarchicalSchur(const GreenTable<dim>& green, const SparseR
       items.assign(s.blocks.row_item.begin() + cl.begin, s.blocks.row_item.begin() + cl.end);
       s.diag_B[std::size_t(g)] = s.blocks.diagonal_block(0, groups[std::size_t(g)]);
       s.diag_C[std::size_t(g)] = s.blocks.diagonal_block(1, groups[std::size_t(g)]);
-      add_direct(s.D_B, items, s.diag_B[std::size_t(g)]);
-      add_direct(s.D_C, items, s.diag_C[std::size_t(g)]);
     } catch (...) {
 #pragma omp critical(fictus_hierarchical_failure)
       if (!failure) failure = std::current_exception();
     }
   if (failure) std::rethrow_exception(failure);
+  if (s.blocks.distribution) {  // each rank's blocks' entries: summed, every rank holds the whole groups
+    std::vector<Eigen::MatrixXd*> parts;
+    for (auto* diag : {&s.diag_B, &s.diag_C})
+      for (Eigen::MatrixXd& M : *diag) parts.push_back(&M);
+    sum_over_ranks(*s.blocks.distribution, parts);
+  }
+  for (int g = 0; g < n_groups; ++g) {
+    add_direct(s.D_B, s.groups[std::size_t(g)], s.diag_B[std::size_t(g)]);
+    add_direct(s.D_C, s.groups[std::size_t(g)], s.diag_C[std::size_t(g)]);
+  }
   SchurStorage& t = s.storage;
   t.kind = "hierarchical";
   t.bytes = s.blocks.bytes() + 12.0 * double(s.D_B.nonZeros() + s.D_C.nonZeros());
   t.dense_bytes = 2.0 * 8.0 * double(s.m) * double(s.m);
   for (const CompressedBlocks::Block& b : s.blocks.blocks) {
+    if (!b.held) continue;
     if (b.dense.empty()) {
       t.low_rank_blocks += 1;
       for (const Eigen::MatrixXd& r : b.right) t.largest_rank = std::max(t.largest_rank, int(r.cols()));
     } else {
       t.full_blocks += 1;
     }
+  }
+  if (s.blocks.distribution) {  // the blocks of all ranks
+    const Distribution& d = *s.blocks.distribution;
+    std::vector<double> totals{t.bytes, t.low_rank_blocks, t.full_blocks};
+    d.sum(totals);
+    t.bytes = totals[0], t.low_rank_blocks = totals[1], t.full_blocks = totals[2];
+    t.largest_rank = int(d.max(t.largest_rank));
   }
   for (const Eigen::MatrixXd& M : s.diag_B) t.preconditioner_bytes += 3.0 * 8.0 * double(M.size());
   t.far_fraction = report.far_pairs / (report.far_pairs + report.near_pairs);

@@ -306,8 +306,9 @@ TEST(SlabGreenTable, PartsAddUpToTheWholeTable) {
 
 /// The compressed Schur blocks (the hierarchical solver's partition with leaves of 8: low-rank pairs at
 /// this m) from the ranks' planes of the table, each far pair's core summed over the ranks before its
-/// compression, against the blocks of the whole table: the products agree to round-off, and every rank
-/// holds the same bits (its Newton steps must be the others').
+/// compression, each block kept by one rank, against the blocks of the whole table: the products (each
+/// rank's blocks', summed) agree to round-off, and every rank gets the same bits (its Newton steps must
+/// be the others').
 TEST(SlabGreenTable, CompressedBlocksFromThePartsAreThoseOfTheWholeTable) {
   const Communicator comm;
   for (const auto& [boundary, c] : {std::pair{Boundary::dirichlet, 1.0}, std::pair{Boundary::periodic, 1.0}}) {
@@ -326,8 +327,15 @@ TEST(SlabGreenTable, CompressedBlocksFromThePartsAreThoseOfTheWholeTable) {
     fictus::set_process_distribution(nullptr);
     const std::string name = std::string("3-D ") + fictus::to_string(boundary) + ": compressed blocks from planes";
     ASSERT_EQ(parts.blocks.size(), serial.blocks.size()) << name;
-    int low_rank = 0;
-    for (const fictus::CompressedBlocks::Block& b : parts.blocks) low_rank += b.dense.empty() ? 1 : 0;
+    // Each block is one rank's; together the ranks hold what the serial blocks take.
+    double counts[3] = {0, 0, parts.bytes()};  // held blocks, of them of low rank, bytes
+    for (const fictus::CompressedBlocks::Block& b : parts.blocks)
+      if (b.held) counts[0] += 1, counts[1] += b.dense.empty() ? 1 : 0;
+    comm.sum(counts, 3);
+    EXPECT_EQ(counts[0], double(parts.blocks.size())) << name;
+    EXPECT_NEAR(counts[2], serial.bytes(), 0.02 * serial.bytes()) << name;
+    if (comm.size() > 1) EXPECT_LT(parts.bytes(), 0.9 * serial.bytes()) << name;
+    const int low_rank = int(counts[1]);
     if (boundary == Boundary::dirichlet)  // periodic: the images keep the far pairs dense at this m
       EXPECT_GT(low_rank, 10) << name;
     if (comm.rank() == 0)

@@ -33,6 +33,7 @@ class Execution {
   int threads() const { return threads_; }
   /// Where the grid's vectors lie: one process, or slabs over MPI ranks (distribution.hpp).
   const Distribution& distribution() const { return *distribution_; }
+  std::shared_ptr<const Distribution> shared_distribution() const { return distribution_; }
 
   /// A check for a request to stop, polled between the steps of a solve, in Newton and GMRES
   /// iterations and in the long assembly loops, always on the thread that called solve (OpenMP's

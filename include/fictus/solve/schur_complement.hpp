@@ -10,6 +10,7 @@
 //   ExplicitSchur  ours: S_B and S_C assembled from the discrete Green's function, dense LU.
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -72,7 +73,7 @@ struct FarFieldReport {
 /// What the storage of S_B and S_C took (results.json `schur_storage`; dense: the m × m blocks).
 struct SchurStorage {
   std::string kind = "dense";  // "dense" or "hierarchical"
-  double bytes = 0;            // both blocks
+  double bytes = 0;            // both blocks (distributed: over all ranks, each holding its share)
   double dense_bytes = 0;      // both blocks dense: 2·m²·8
   double low_rank_blocks = 0, full_blocks = 0;
   int largest_rank = 0;  // of the compressed block that takes the most memory
@@ -280,24 +281,34 @@ struct CompressedBlocks {
     std::vector<Eigen::MatrixXd> dense;  // per row set (p × q), or empty: low rank
     std::vector<Eigen::MatrixXd> left;   // low rank, per row set: p × k
     std::vector<Eigen::MatrixXd> right;  // low rank, per row set: q × k
+    bool held = true;                    // false: another rank's (none of the above here)
   };
   int n_rows = 0, n_cols = 0, n_sets = 0;
   std::vector<int> row_item, col_item;  // tree order → row (column) index
   std::vector<Cluster> row_clusters, col_clusters;
   std::vector<Block> blocks;
   std::vector<int> row_parent;  // the row tree's parents (−1: root)
+  /// A distributed run: the ranks hold disjoint shares of the blocks (`held`), chosen for equal work, and
+  /// a product is the sum over the ranks of each one's blocks' product. Null: every block is here.
+  std::shared_ptr<const Distribution> distribution;
+  /// What this rank's blocks take.
   double bytes() const;
   /// y[k] = (R_k G Qᵀ) x for every row set k; with `set_of_row`, row i is wanted of set set_of_row[i]
   /// only (the Newton matrix's rows) and the blocks whose rows want none of a set skip it, so the other
-  /// entries of y are unspecified.
+  /// entries of y are unspecified. Distributed: collective, the same bits on every rank.
   void multiply(const Eigen::VectorXd& x, std::vector<Eigen::VectorXd>& y, int threads,
                 const std::vector<char>* set_of_row = nullptr) const;
   /// Groups of rows: the row clusters of at most `size` items nearest the root (items in tree order).
   std::vector<int> groups(int size) const;
   /// The block of set k over the rows × the columns of row cluster g, both in the cluster's tree order
-  /// (the row sets and Q must number the same points, as S_B, S_C).
+  /// (the row sets and Q must number the same points, as S_B, S_C). Distributed: this rank's blocks'
+  /// entries only (sum over the ranks for the whole).
   Eigen::MatrixXd diagonal_block(int k, int g) const;
 };
+
+/// Each matrix ← its sum over the ranks, with rank 0's bits on every rank (so that what is made from it
+/// next is the same everywhere), in messages of about 32 MiB. Serial: unchanged. Collective.
+void sum_over_ranks(const Distribution& distribution, const std::vector<Eigen::MatrixXd*>& matrices);
 
 /// The relative accuracy of the far blocks' recompression: two orders below the interpolation's own
 /// error (1e-3 … 1e-4), so S̃ steers Newton as well as with 1e-8 (the same steps and fast solves on the
