@@ -7,9 +7,10 @@ and the agreement of λ and the force, from results.json and points.csv of `fict
 and 192 when none is given)
 
 Cases: 2-D h = 1/4096 (the manufactured circle) and the 3-D sphere of bench/sphere_contact.toml at
-N = 128, 192 and 384 (where a grid array is 429 MiB); serially with 2 threads (and the dense Schur complement that a run on several ranks
-keeps), on 2 ranks × 1 thread, and on 4 ranks × 1 thread (oversubscribed on 2 cores: its times are not
-the machine's, its memory per rank is).
+N = 128, 192 and 384 (where a grid array is 429 MiB); serially with 2 threads (with the Schur complement
+auto chooses, and dense), on 2 ranks × 1 thread, and on 4 ranks × 1 thread (oversubscribed on 2 cores: its
+times are not the machine's, its memory per rank is). The compressed cases (384c, 512c): the compressed
+Schur complement serially, on 2 and 4 ranks, and the dense one on 2 ranks.
 """
 import csv
 import json

@@ -631,7 +631,8 @@ void BlockAssembly<dim>::fill(std::vector<Eigen::MatrixXd>& out) {
 /// interpolation nodes) take about summed_chunk doubles. A batch's near entries and far cores are made
 /// (with a partial table: this rank's part), summed over the ranks, and each block is kept by one rank,
 /// chosen for equal work, which compresses it if it is far (cross approximation is not linear in the
-/// entries: it takes the sum). Serially every block is kept and comes out as in one pass.
+/// entries: it takes the sum; only the owner uses a sum, so the ranks need not agree on its bits).
+/// Serially every block is kept and comes out as in one pass.
 template <int dim>
 template <class Piece>
 void BlockAssembly<dim>::fill_kept(const Piece& piece) {
@@ -639,8 +640,11 @@ void BlockAssembly<dim>::fill_kept(const Piece& piece) {
   const std::size_t n = stores.size();
   std::vector<std::vector<std::size_t>> pieces(n);  // of each kept block, dearest first
   for (std::size_t k = 0; k < blocks.size(); ++k) pieces[std::size_t(blocks[k].store)].push_back(k);
-  const auto rows = [&](std::size_t k) { return std::size_t(cluster_items(*X, stores[k].x).size()); };
-  const auto cols = [&](std::size_t k) { return std::size_t(cluster_items(*Y, stores[k].y).size()); };
+  const auto size = [](const auto& T, int c) {
+    return std::size_t(T.clusters[std::size_t(c)].end - T.clusters[std::size_t(c)].begin);
+  };
+  const auto rows = [&](std::size_t k) { return size(*X, stores[k].x); };
+  const auto cols = [&](std::size_t k) { return size(*Y, stores[k].y); };
   const auto core_size = [&](std::size_t k) {
     return std::size_t(x_interp[std::size_t(stores[k].x)]->size()) *
            std::size_t(y_interp[std::size_t(stores[k].y)]->size());
@@ -765,6 +769,8 @@ CompressedBlocks compressed_green_blocks(const GreenTable<dim>& green, const std
   c.blocks.resize(assembly.stores.size());
   for (std::size_t k = 0; k < assembly.stores.size(); ++k)
     c.blocks[k].x = assembly.stores[k].x, c.blocks[k].y = assembly.stores[k].y;
+  if (green.partial() != execution.distribution().distributed())
+    throw std::logic_error("compressed_green_blocks: a partial Green's table needs the distribution it was made with");
   if (execution.distribution().distributed()) c.distribution = execution.shared_distribution();
   std::vector<Eigen::MatrixXd> unused;
   assembly.fill(unused);
@@ -792,7 +798,6 @@ void sum_over_ranks(const Distribution& distribution, const std::vector<Eigen::M
     double* at = buffer.data();
     for (std::size_t k = first; k < last; ++k) at = std::copy_n(mats[k]->data(), mats[k]->size(), at);
     distribution.sum(buffer.data(), n);
-    distribution.broadcast(buffer.data(), n);
     at = buffer.data();
     for (std::size_t k = first; k < last; ++k) {
       std::copy_n(at, mats[k]->size(), mats[k]->data());

@@ -214,7 +214,9 @@ HierarchicalSchur::HierarchicalSchur(const GreenTable<dim>& green, const SparseR
       if (!failure) failure = std::current_exception();
     }
   if (failure) std::rethrow_exception(failure);
-  if (s.blocks.distribution) {  // each rank's blocks' entries: summed, every rank holds the whole groups
+  // Distributed: each rank's blocks' entries, summed; every entry is one rank's (the others add zeros), so
+  // every rank holds the same bits of the whole groups.
+  if (s.blocks.distribution) {
     std::vector<Eigen::MatrixXd*> parts;
     for (auto* diag : {&s.diag_B, &s.diag_C})
       for (Eigen::MatrixXd& M : *diag) parts.push_back(&M);
@@ -226,7 +228,7 @@ HierarchicalSchur::HierarchicalSchur(const GreenTable<dim>& green, const SparseR
   }
   SchurStorage& t = s.storage;
   t.kind = "hierarchical";
-  t.bytes = s.blocks.bytes() + 12.0 * double(s.D_B.nonZeros() + s.D_C.nonZeros());
+  t.bytes = s.blocks.bytes();
   t.dense_bytes = 2.0 * 8.0 * double(s.m) * double(s.m);
   for (const CompressedBlocks::Block& b : s.blocks.blocks) {
     if (!b.held) continue;
@@ -244,6 +246,7 @@ HierarchicalSchur::HierarchicalSchur(const GreenTable<dim>& green, const SparseR
     t.bytes = totals[0], t.low_rank_blocks = totals[1], t.full_blocks = totals[2];
     t.largest_rank = int(d.max(t.largest_rank));
   }
+  t.bytes += 12.0 * double(s.D_B.nonZeros() + s.D_C.nonZeros());  // every rank's
   for (const Eigen::MatrixXd& M : s.diag_B) t.preconditioner_bytes += 3.0 * 8.0 * double(M.size());
   t.far_fraction = report.far_pairs / (report.far_pairs + report.near_pairs);
   t.seconds_assembly = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

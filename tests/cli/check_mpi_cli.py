@@ -90,21 +90,26 @@ for key in ("force", "measure", "lambda_integral"):
 field = plot.read_field(os.path.join(out, "many"))[-1]["u"]
 assert abs(field - serial_field).max() <= 1e-11 * abs(serial_field).max(), "12 ranks: another field"
 
-# The compressed Schur complement on two ranks (3-D; asked for below the m where auto chooses it): used,
-# without a warning, and the serial answer.
+# The compressed Schur complement on 2 and 12 ranks (3-D; asked for below the m where auto chooses it;
+# on 12 ranks some hold few of its blocks): used, without a warning, and the serial answer.
 sphere = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "examples", "manufactured_sphere.toml")
 compressed_args = [sphere, "--N", "40", "--schur_storage", "hierarchical", "--error_estimate", "false"]
 expected_compressed = serial_results("serial_compressed", *compressed_args)
-compressed = run(2, "solve", *compressed_args, "--quiet", "--files", "results.json", "--out", os.path.join(out, "compressed"))
-assert compressed.returncode == 0, f"compressed: exit {compressed.returncode}:\n{compressed.stdout}{compressed.stderr}"
-with open(os.path.join(out, "compressed", "results.json")) as f:
-    results = json.load(f)
-assert results["inner"]["schur_storage"]["kind"] == "hierarchical", results["inner"]["schur_storage"]
-assert not any("schur_storage" in w for w in results["warnings"]), results["warnings"]
-for key in ("force", "measure", "lambda_integral"):
-    x, y = results["contact"][key], expected_compressed["contact"][key]
-    assert abs(x - y) <= 1e-11 * abs(y), f"compressed on 2 ranks: contact.{key} {x} against {y} serially"
-assert results["contact"]["points"] == expected_compressed["contact"]["points"], "compressed: another contact set"
+for ranks in (2, 12):
+    folder = os.path.join(out, f"compressed{ranks}")
+    compressed = run(ranks, "solve", *compressed_args, "--quiet", "--files", "results.json", "--out", folder)
+    assert compressed.returncode == 0, f"compressed, {ranks} ranks: exit {compressed.returncode}:\n{compressed.stderr}"
+    with open(os.path.join(folder, "results.json")) as f:
+        results = json.load(f)
+    storage, serial_storage = results["inner"]["schur_storage"], expected_compressed["inner"]["schur_storage"]
+    assert storage["kind"] == "hierarchical", storage
+    assert storage["low_rank_blocks"] + storage["full_blocks"] == \
+        serial_storage["low_rank_blocks"] + serial_storage["full_blocks"], (storage, serial_storage)
+    assert not any("schur_storage" in w for w in results["warnings"]), results["warnings"]
+    for key in ("force", "measure", "lambda_integral"):
+        x, y = results["contact"][key], expected_compressed["contact"][key]
+        assert abs(x - y) <= 1e-11 * abs(y), f"compressed on {ranks} ranks: contact.{key} {x} against {y} serially"
+    assert results["contact"]["points"] == expected_compressed["contact"]["points"], f"compressed, {ranks}: contact set"
 
 # Bad input found by every rank, and bad data found by one rank only (f is NaN in the top layers, which
 # the last rank holds): one error line (rank 0's), a non-zero exit, no files, no rank left waiting.

@@ -107,6 +107,13 @@ void check(const Case& c) {
   const std::string name = name_of(dim, c) + ": ";
   ASSERT_TRUE(serial.newton.converged) << name << serial.newton.failure;
   ASSERT_TRUE(slabs.newton.converged) << name << slabs.newton.failure;
+  if (c.storage == fictus::SchurStorageKind::hierarchical) {  // kept compressed, the ranks' blocks the serial ones
+    ASSERT_TRUE(serial.schur_storage && slabs.schur_storage) << name;
+    const fictus::SchurStorage &a = *serial.schur_storage, &b = *slabs.schur_storage;
+    EXPECT_EQ(b.kind, "hierarchical") << name;
+    EXPECT_EQ(a.low_rank_blocks + a.full_blocks, b.low_rank_blocks + b.full_blocks) << name;
+    EXPECT_NEAR(a.bytes, b.bytes, 0.02 * a.bytes) << name;
+  }
   // The sums over the ranks run in another order than the serial ones, and the slab transforms are
   // FFTW-MPI's: the answers agree to round-off, amplified by the Newton matrix's condition (1e4 here).
   constexpr double tolerance = 1e-11;

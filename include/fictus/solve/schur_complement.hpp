@@ -306,8 +306,7 @@ struct CompressedBlocks {
   Eigen::MatrixXd diagonal_block(int k, int g) const;
 };
 
-/// Each matrix ← its sum over the ranks, with rank 0's bits on every rank (so that what is made from it
-/// next is the same everywhere), in messages of about 32 MiB. Serial: unchanged. Collective.
+/// Each matrix ← its sum over the ranks, in messages of about 32 MiB. Serial: unchanged. Collective.
 void sum_over_ranks(const Distribution& distribution, const std::vector<Eigen::MatrixXd*>& matrices);
 
 /// The relative accuracy of the far blocks' recompression: two orders below the interpolation's own
