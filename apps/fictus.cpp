@@ -537,7 +537,12 @@ int run_plot(const std::string& folder, bool with_lambda) {
 int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out, const std::string& table,
                   const std::string& levels_text) {
   const auto [first, last] = parse_levels(levels_text);
-  if (!out.empty()) fictus::cli::check_output_folder(out, {"table1.json", "table1.csv", "table2.json", "table2.csv"});
+  // Under mpirun each level is a distributed solve; rank 0 checks, prints and writes for all.
+  const fictus::Distribution& distribution = *fictus::process_distribution();
+  if (!out.empty())
+    fictus::cli::on_rank_0(distribution, [&] {
+      fictus::cli::check_output_folder(out, {"table1.json", "table1.csv", "table2.json", "table2.csv"});
+    });
   std::vector<fictus::Variant> variants;
   if (table == "1" || table == "both") variants.push_back(fictus::Variant::nonsmooth);
   if (table == "2" || table == "both") variants.push_back(fictus::Variant::smooth);
@@ -555,7 +560,8 @@ int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out,
       fictus::SolverOptions options = fictus::paper_options(N, variant);  // the paper's m and δ
       options.error_estimate = false;  // the tables time the paper's method; --error_estimate true adds it
       flags.apply(problem, options);
-      fictus::check_memory(problem, options);
+      fictus::cli::agree_on_threads(distribution, options);
+      fictus::cli::on_rank_0(distribution, [&] { fictus::check_memory(problem, options); });  // rank 0's node
       fictus::Solution s = fictus::solve(problem, options);
       s.peak_memory_bytes = fictus::peak_memory_bytes();
       if (!s.newton.converged) {
@@ -589,7 +595,7 @@ int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out,
   if (!out.empty()) {
     std::vector<fictus::cli::OutputFile> set;
     for (const auto& [name, text] : files) set.push_back({name, [&text](std::ostream& o) { o << text; }});
-    fictus::cli::write_output_set(out, set);
+    fictus::cli::on_rank_0(distribution, [&] { fictus::cli::write_output_set(out, set); });
     std::printf("wrote %zu files to %s/\n", files.size(), out.c_str());
   }
   return status;
@@ -630,10 +636,10 @@ int main(int argc, char** argv) {
       }
       fictus::set_process_distribution(std::make_shared<fictus::mpi::SlabDistribution>(world));
       const std::string command = argc > 1 ? argv[1] : "";
-      if (command == "plot" || command == "reproduce")
+      if (command == "plot")
         return fail("started on " + std::to_string(ranks.size) +
-                        " MPI ranks: only fictus solve and sweep run distributed (" + command +
-                        " runs on one rank: without mpirun, or mpirun -np 1)",
+                        " MPI ranks: fictus plot runs on one rank (without mpirun, or mpirun -np 1); solve, sweep "
+                        "and reproduce run distributed",
                     exit_bad_input);
     }
   }

@@ -149,10 +149,23 @@ for serial_row, row in zip(sweeps[0], sweeps[2]):
         x, y = row[key], serial_row[key]
         assert abs(x - y) <= 1e-11 * abs(y), f"sweep on 2 ranks: {key} {x} against {y} serially"
 
-# reproduce and plot run on one rank.
-reproduce = run(2, "reproduce", "--levels", "6-6")
-assert reproduce.returncode != 0 and len(error_lines(reproduce)) == 1, reproduce.stderr
-assert "only fictus solve and sweep" in error_lines(reproduce)[0], error_lines(reproduce)[0]
+# reproduce runs its levels distributed (rank 0 writing the tables); plot runs on one rank.
+tables = {}
+for ranks in (0, 2):
+    folder = os.path.join(out, f"reproduce{ranks}")
+    command = [fictus, "reproduce", "--levels", "6-7", "--table", "1", "--out", folder]
+    done = run(ranks, *command[1:]) if ranks else subprocess.run(command, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, f"reproduce on {ranks} ranks: exit {done.returncode}:\n{done.stdout}{done.stderr}"
+    assert done.stdout.count("Table 1") == 1, f"reproduce on {ranks} ranks: not one table:\n{done.stdout}"
+    with open(os.path.join(folder, "table1.json")) as f:
+        tables[ranks] = json.load(f)["levels"]
+for serial_level, level in zip(tables[0], tables[2]):
+    for key in ("l2_omega", "h1_omega", "l2_gamma"):
+        x, y = level["errors"][key], serial_level["errors"][key]
+        assert abs(x - y) <= 1e-11 * abs(y), f"reproduce on 2 ranks: errors.{key} {x} against {y} serially"
+plot_refused = run(2, "plot", os.path.join(out, "reproduce0"))
+assert plot_refused.returncode != 0 and len(error_lines(plot_refused)) == 1, plot_refused.stderr
+assert "fictus plot runs on one rank" in error_lines(plot_refused)[0], error_lines(plot_refused)[0]
 
 one = run(1, "solve", "--N", "64", "--quiet", "--files", "results.json", "--out", os.path.join(out, "one"))
 assert one.returncode == 0, f"one rank: exit {one.returncode}:\n{one.stdout}{one.stderr}"
