@@ -38,7 +38,64 @@ GridVector gather_layers(const Grid<dim>& grid, const GridVector& local, const C
   return whole;
 }
 
+/// Each rank's wanted layers (wrapped) from their holders: every rank learns every rank's wish, sends the
+/// layers it holds of each in the wished order, and the receiver puts each sender's layers in place.
+template <int dim>
+GridVector fetch_layers(const Grid<dim>& grid, const GridVector& local, Slab wanted, const Communicator& comm) {
+  const int P = comm.size(), L = grid.layers();
+  const Slab mine = default_slab(L, comm.rank(), P);
+  if (local.size() != grid.slab_size(mine)) throw std::invalid_argument("layers: vector size mismatch");
+  if (wanted.count < 0 || wanted.count > L || wanted.first < 0)
+    throw std::invalid_argument("layers: a range of at most the grid's layers, from layer >= 0");
+  std::vector<int> wishes(2 * static_cast<std::size_t>(P));
+  const int wish[2] = {wanted.first, wanted.count};
+  MPI_Allgather(wish, 2, MPI_INT, wishes.data(), 2, MPI_INT, comm.get());
+  std::vector<int> holder(static_cast<std::size_t>(L));
+  for (int r = 0; r < P; ++r) {
+    const Slab s = default_slab(L, r, P);
+    for (int l = s.first; l < s.first + s.count; ++l) holder[std::size_t(l)] = r;
+  }
+  const std::size_t size = grid.layer_size();
+  std::vector<int> send_counts(static_cast<std::size_t>(P), 0), recv_counts(static_cast<std::size_t>(P), 0);
+  std::vector<double> send;
+  for (int r = 0; r < P; ++r)  // in r's order, the layers this rank holds
+    for (int t = 0; t < wishes[2 * std::size_t(r) + 1]; ++t)
+      if (const int l = (wishes[2 * std::size_t(r)] + t) % L; mine.holds(l)) {
+        send.insert(send.end(), local.begin() + std::ptrdiff_t(std::size_t(l - mine.first) * size),
+                    local.begin() + std::ptrdiff_t(std::size_t(l - mine.first + 1) * size));
+        ++send_counts[std::size_t(r)];
+      }
+  for (int t = 0; t < wanted.count; ++t) ++recv_counts[std::size_t(holder[std::size_t((wanted.first + t) % L)])];
+  std::vector<int> send_firsts(static_cast<std::size_t>(P), 0), recv_firsts(static_cast<std::size_t>(P), 0);
+  for (int r = 1; r < P; ++r) {
+    send_firsts[std::size_t(r)] = send_firsts[std::size_t(r) - 1] + send_counts[std::size_t(r) - 1];
+    recv_firsts[std::size_t(r)] = recv_firsts[std::size_t(r) - 1] + recv_counts[std::size_t(r) - 1];
+  }
+  MPI_Datatype layer;  // counted in layers: the counts fit an int
+  MPI_Type_contiguous(int(size), MPI_DOUBLE, &layer);
+  MPI_Type_commit(&layer);
+  GridVector received(std::size_t(wanted.count) * size);
+  MPI_Alltoallv(send.data(), send_counts.data(), send_firsts.data(), layer, received.data(), recv_counts.data(),
+                recv_firsts.data(), layer, comm.get());
+  MPI_Type_free(&layer);
+  GridVector out(received.size());  // each sender's layers are in the wished order: take them in turn
+  std::vector<int> next = recv_firsts;
+  for (int t = 0; t < wanted.count; ++t) {
+    const int from = next[std::size_t(holder[std::size_t((wanted.first + t) % L)])]++;
+    std::copy_n(received.begin() + std::ptrdiff_t(std::size_t(from) * size), size,
+                out.begin() + std::ptrdiff_t(std::size_t(t) * size));
+  }
+  return out;
+}
+
 }  // namespace
+
+GridVector SlabDistribution::layers(const Grid<2>& grid, const GridVector& local, Slab wanted) const {
+  return fetch_layers(grid, local, wanted, comm_);
+}
+GridVector SlabDistribution::layers(const Grid<3>& grid, const GridVector& local, Slab wanted) const {
+  return fetch_layers(grid, local, wanted, comm_);
+}
 
 Slab SlabDistribution::slab(int layers) const { return default_slab(layers, comm_.rank(), comm_.size()); }
 

@@ -292,9 +292,17 @@ void for_each_omega_sample(const GridVector& u_h, const Grid3& grid, const Surfa
 
 template <int dim>
 void sample_q1_at(const Grid<dim>& grid, const GridVector& u_h, const std::array<std::vector<double>, dim>& x,
-                  std::vector<double>& out) {
+                  std::vector<double>& out, std::optional<Slab> held) {
   const std::size_t n = x[0].size();
   out.resize(n);
+  const int L = grid.layers();
+  const std::size_t layer_size = grid.layer_size();
+  const auto at = [&](const typename Grid<dim>::Index& node) {
+    if (!held) return u_h[grid.index(node)];
+    const int l = grid.layer(node[dim - 1]), place = ((l - held->first) % L + L) % L;
+    if (place >= held->count) throw std::logic_error("sample_q1_at: a point's cell lies outside the held layers");
+    return u_h[grid.index(node) - std::size_t(l) * layer_size + std::size_t(place) * layer_size];
+  };
   for (std::size_t k = 0; k < n; ++k) {
     typename Grid<dim>::Index cell;
     Point<dim> xi;
@@ -306,7 +314,7 @@ void sample_q1_at(const Grid<dim>& grid, const GridVector& u_h, const std::array
     for (int c = 0; c < (1 << dim); ++c) {
       typename Grid<dim>::Index node = cell;
       for (int d = 0; d < dim; ++d) node[d] += (c >> d) & 1;
-      nodal[std::size_t(c)] = grid.has_unknown(node) ? u_h[grid.index(node)] : 0.0;
+      nodal[std::size_t(c)] = grid.has_unknown(node) ? at(node) : 0.0;
     }
     if constexpr (dim == 2)
       out[k] = Q1Element<2>::interpolate(nodal[0], nodal[1], nodal[2], nodal[3], xi, grid.h()).value;
@@ -315,10 +323,28 @@ void sample_q1_at(const Grid<dim>& grid, const GridVector& u_h, const std::array
   }
 }
 
+template <int dim>
+Slab coarse_layers_under(const Grid<dim>& fine, const Slab& slab, const Grid<dim>& coarse) {
+  if (slab.count == 0) return Slab{0, 0};
+  constexpr int s = dim - 1;  // the slowest axis
+  // The cells of the slab's layers (Grid::cell_layer), their extent, the coarse nodes around it.
+  const int c_lo = fine.periodic() || slab.first > 0 ? (fine.periodic() ? slab.first : slab.first + 1) : 0;
+  const int c_hi = fine.periodic() ? slab.first + slab.count - 1 : slab.first + slab.count;
+  const double lower = coarse.box().lower[s], H = coarse.h();
+  const int lo = int(std::floor((fine.coordinate(s, c_lo) - lower) / H)) - 1;
+  const int hi = int(std::floor((fine.coordinate(s, c_hi + 1) - lower) / H)) + 2;
+  const int L = coarse.layers();
+  if (coarse.periodic()) return Slab{((lo % L) + L) % L, std::min(hi - lo + 1, L)};
+  const int first = std::max(lo - 1, 0), last = std::min(hi - 1, L - 1);  // layer = node − 1
+  return Slab{first, std::max(last - first + 1, 0)};
+}
+
 template void sample_q1_at<2>(const Grid<2>&, const GridVector&, const std::array<std::vector<double>, 2>&,
-                              std::vector<double>&);
+                              std::vector<double>&, std::optional<Slab>);
 template void sample_q1_at<3>(const Grid<3>&, const GridVector&, const std::array<std::vector<double>, 3>&,
-                              std::vector<double>&);
+                              std::vector<double>&, std::optional<Slab>);
+template Slab coarse_layers_under(const Grid<2>&, const Slab&, const Grid<2>&);
+template Slab coarse_layers_under(const Grid<3>&, const Slab&, const Grid<3>&);
 
 ErrorNorms compute_errors(const GridVector& u_h, const Grid3& grid, const Surface& gamma, const PatchedSurface& patches,
                           const std::vector<double>& trace, const VectorizedField3& exact,

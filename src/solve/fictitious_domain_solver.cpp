@@ -712,8 +712,9 @@ void errors(const State<dim>& st, const BoundaryDiscretization<dim>& boundary, c
 template <int dim>
 DomainQuantities domain_quantities(const State<dim>& st, const BoundaryDiscretization<dim>& boundary,
                                    const GridVector& u, int quadrature, const BasicSolution<dim>* coarse,
-                                   const GridVector& coarse_u, const typename Fields<dim>::Vectorized& exact,
-                                   double& difference2, std::array<double, 2>& exact_integrals) {
+                                   const GridVector& coarse_u, std::optional<Slab> coarse_held,
+                                   const typename Fields<dim>::Vectorized& exact, double& difference2,
+                                   std::array<double, 2>& exact_integrals) {
   const typename Fields<dim>::Vectorized f = st.f_vectorized ? st.f_vectorized : vectorize(st.f);
   constexpr int K = 9;  // |ω|, ∫û, ∫û², ∫|∇û|², ∫f, ∫fû, ∫(û − û_{N/2})², ∫u, ∫fu (u: the exact solution)
   std::vector<std::array<double, K>> sums(std::size_t(st.execution.threads()), std::array<double, K>{});
@@ -723,7 +724,7 @@ DomainQuantities domain_quantities(const State<dim>& st, const BoundaryDiscretiz
     std::vector<double>& cv = coarse_at[std::size_t(thread)];
     std::vector<double>& ev = exact_at[std::size_t(thread)];
     evaluate_at(f, row.x, fv);
-    if (coarse) sample_q1_at<dim>(coarse->grid, coarse_u, row.x, cv);
+    if (coarse) sample_q1_at<dim>(coarse->grid, coarse_u, row.x, cv, coarse_held);
     if (exact) evaluate_at(exact, row.x, ev);
     std::array<double, K> r{};  // per row, then per thread
     for (std::size_t k = 0; k < row.size(); ++k) {
@@ -821,14 +822,18 @@ void quantities_step(const State<dim>& st, const BoundaryDiscretization<dim>& bo
   std::array<double, 2> exact{};  // ∫u, ∫fu of the exact solution
   typename Fields<dim>::Vectorized exact_u;
   if (sol.errors) exact_u = data.exact_vectorized ? data.exact_vectorized : vectorize(data.exact);
-  // Distributed, each rank samples the whole coarse field at the points of its cells (an eighth of a grid
-  // vector in 3-D, a quarter in 2-D).
+  // Distributed, each rank samples the coarse field at the points of its cells: it fetches the coarse
+  // layers under its own.
   const Distribution& distribution = st.execution.distribution();
-  const GridVector gathered =
-      from && distribution.distributed() ? distribution.gather(from->grid, from->u) : GridVector();
-  const GridVector& coarse_u = from && !distribution.distributed() ? from->u : gathered;
-  sol.domain =
-      domain_quantities<dim>(st, boundary, sol.u, quantity_quadrature, from, coarse_u, exact_u, difference2, exact);
+  std::optional<Slab> held;
+  GridVector fetched;
+  if (from && distribution.distributed()) {
+    held = coarse_layers_under(st.grid, distribution.slab(st.grid), from->grid);
+    fetched = distribution.layers(from->grid, from->u, *held);
+  }
+  const GridVector& coarse_u = held ? fetched : from ? from->u : fetched;
+  sol.domain = domain_quantities<dim>(st, boundary, sol.u, quantity_quadrature, from, coarse_u, held, exact_u,
+                                      difference2, exact);
   if (sol.errors) {
     ErrorNorms& e = *sol.errors;
     const double energy =

@@ -356,6 +356,33 @@ TEST(SlabGreenTable, CompressedBlocksFromThePartsAreThoseOfTheWholeTable) {
   }
 }
 
+/// Distribution::layers: each rank asks for its own run of layers (wrapping past the last one, or none)
+/// and gets the whole vector's layers, in the asked order.
+TEST(SlabLayers, EachRankGetsTheLayersItAsksFor) {
+  const Communicator comm;
+  const fictus::mpi::SlabDistribution distribution(comm);
+  for (Boundary boundary : {Boundary::dirichlet, Boundary::periodic}) {
+    const fictus::Grid<3> grid(fictus::Box<3>{{0, 0, 0}, {1, 1, 1}}, 8, boundary);
+    const GridVector whole = data_of(grid.n_unknowns());
+    const Slab mine = distribution.slab(grid);
+    const GridVector local(whole.begin() + std::ptrdiff_t(grid.slab_offset(mine)),
+                           whole.begin() + std::ptrdiff_t(grid.slab_offset(mine) + grid.slab_size(mine)));
+    const int L = grid.layers();
+    for (const Slab wanted :
+         {Slab{(3 * comm.rank() + L - 2) % L, std::min(5, L)}, Slab{comm.rank() % L, 0}, Slab{0, L}}) {
+      const GridVector got = distribution.layers(grid, local, wanted);
+      ASSERT_EQ(got.size(), grid.slab_size(Slab{0, wanted.count}));
+      double difference = 0;
+      for (int t = 0; t < wanted.count; ++t)
+        for (std::size_t k = 0; k < grid.layer_size(); ++k)
+          difference =
+              std::max(difference, std::abs(got[std::size_t(t) * grid.layer_size() + k] -
+                                            whole[std::size_t((wanted.first + t) % L) * grid.layer_size() + k]));
+      EXPECT_EQ(comm.max(difference), 0.0) << fictus::to_string(boundary) << ", layers from " << wanted.first;
+    }
+  }
+}
+
 TEST(SlabSolver, DefaultSlabsCoverTheLayersInOrder) {
   for (int layers : {1, 2, 7, 34})
     for (int size : {1, 2, 3, 4, 8}) {

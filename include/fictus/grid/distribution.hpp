@@ -64,6 +64,11 @@ class Distribution {
   /// Serial: never asked (GreenTable transforms its whole table itself).
   virtual void dct1(const std::vector<int>& shape, double* local, int threads) const;
 
+  /// Layers first, first + 1, …, first + count − 1 of a grid vector (taken modulo grid.layers(); `local`
+  /// is this rank's slab of it), one after the other, from the ranks that hold them. Each rank asks for
+  /// its own layers (count 0: none). Collective. Serial: copied from the whole vector.
+  virtual GridVector layers(const Grid<2>& grid, const GridVector& local, Slab wanted) const;
+  virtual GridVector layers(const Grid<3>& grid, const GridVector& local, Slab wanted) const;
   /// The whole grid vector from each rank's layers: on every rank, or (`everywhere` false) on rank 0
   /// only (the others get an empty vector).
   virtual GridVector gather(const Grid<2>& grid, const GridVector& local, bool everywhere = true) const;

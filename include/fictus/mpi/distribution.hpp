@@ -26,6 +26,8 @@ class SlabDistribution final : public Distribution {
   GridVector with_next_layer(const Grid<3>& grid, const GridVector& local) const override;
   Slab transform_planes(const std::vector<int>& shape, std::size_t& local_size) const override;
   void dct1(const std::vector<int>& shape, double* local, int threads) const override;
+  GridVector layers(const Grid<2>& grid, const GridVector& local, Slab wanted) const override;
+  GridVector layers(const Grid<3>& grid, const GridVector& local, Slab wanted) const override;
   GridVector gather(const Grid<2>& grid, const GridVector& local, bool everywhere = true) const override;
   GridVector gather(const Grid<3>& grid, const GridVector& local, bool everywhere = true) const override;
 

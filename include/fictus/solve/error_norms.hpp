@@ -89,10 +89,16 @@ void for_each_omega_sample(const GridVector& u_h, const Grid3& grid, const Surfa
                            std::optional<Slab> slab = std::nullopt);
 
 /// The Q1 field u_h of `grid` at the points x (one array per coordinate; points outside the box take
-/// the nearest cell's extension), into `out`.
+/// the nearest cell's extension), into `out`. With `held`, u_h holds only layers held.first, … (modulo
+/// grid.layers()), held.count of them, one after the other (Distribution::layers), and the points' cells
+/// must lie there.
 template <int dim>
 void sample_q1_at(const Grid<dim>& grid, const GridVector& u_h, const std::array<std::vector<double>, dim>& x,
-                  std::vector<double>& out);
+                  std::vector<double>& out, std::optional<Slab> held = std::nullopt);
+/// The layers of `coarse` that sample_q1_at needs at the points of the cells of `slab`'s layers of `fine`
+/// (the same box; a margin of a layer each side).
+template <int dim>
+Slab coarse_layers_under(const Grid<dim>& fine, const Slab& slab, const Grid<dim>& coarse);
 
 /// f at the points x (one array per coordinate), into `out`.
 void evaluate_at(const VectorizedField& f, const std::array<std::vector<double>, 2>& x, std::vector<double>& out);
