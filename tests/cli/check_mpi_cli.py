@@ -133,15 +133,23 @@ assert alone_rank.returncode != 0, "a rank failing alone: exit code 0"
 assert "failed alone" in alone_rank.stderr, alone_rank.stderr
 assert not os.path.exists(os.path.join(out, "alone_rank")), "a rank failing alone: wrote output"
 
+
+def alone_and_on_two_ranks(name, args, result):
+    """The command without mpirun and on 2 ranks: the json file `result` each one wrote, and its stdout."""
+    got = {}
+    for ranks in (0, 2):
+        folder = os.path.join(out, f"{name}{ranks}")
+        command = [fictus, *args, "--out", folder]
+        done = run(ranks, *command[1:]) if ranks else subprocess.run(command, capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, f"{name} on {ranks} ranks: exit {done.returncode}:\n{done.stdout}{done.stderr}"
+        with open(os.path.join(folder, result)) as f:
+            got[ranks] = (json.load(f), done.stdout)
+    return got
+
+
 # A sweep runs distributed as well: every member on the ranks' slabs, rank 0 writing sweep.csv.
-sweeps = {}
-for ranks in (0, 2):
-    folder = os.path.join(out, f"sweep{ranks}")
-    command = [fictus, "sweep", "--g-scale", "0.5,1,2", "--N", "64", "--out", folder]
-    done = run(ranks, *command[1:]) if ranks else subprocess.run(command, capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, f"sweep on {ranks} ranks: exit {done.returncode}:\n{done.stderr}"
-    with open(os.path.join(folder, "sweep.json")) as f:
-        sweeps[ranks] = json.load(f)["rows"]
+sweeps = {ranks: value[0]["rows"] for ranks, value in
+          alone_and_on_two_ranks("sweep", ["sweep", "--g-scale", "0.5,1,2", "--N", "64"], "sweep.json").items()}
 assert len(sweeps[0]) == len(sweeps[2]) == 3
 for serial_row, row in zip(sweeps[0], sweeps[2]):
     assert row["contact_points"] == serial_row["contact_points"], "sweep on 2 ranks: another contact set"
@@ -151,14 +159,10 @@ for serial_row, row in zip(sweeps[0], sweeps[2]):
 
 # reproduce runs its levels distributed (rank 0 writing the tables); plot runs on one rank.
 tables = {}
-for ranks in (0, 2):
-    folder = os.path.join(out, f"reproduce{ranks}")
-    command = [fictus, "reproduce", "--levels", "6-7", "--table", "1", "--out", folder]
-    done = run(ranks, *command[1:]) if ranks else subprocess.run(command, capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, f"reproduce on {ranks} ranks: exit {done.returncode}:\n{done.stdout}{done.stderr}"
-    assert done.stdout.count("Table 1") == 1, f"reproduce on {ranks} ranks: not one table:\n{done.stdout}"
-    with open(os.path.join(folder, "table1.json")) as f:
-        tables[ranks] = json.load(f)["levels"]
+for ranks, (table, stdout) in alone_and_on_two_ranks(
+        "reproduce", ["reproduce", "--levels", "6-7", "--table", "1"], "table1.json").items():
+    assert stdout.count("Table 1") == 1, f"reproduce on {ranks} ranks: not one table:\n{stdout}"
+    tables[ranks] = table["levels"]
 for serial_level, level in zip(tables[0], tables[2]):
     for key in ("l2_omega", "h1_omega", "l2_gamma"):
         x, y = level["errors"][key], serial_level["errors"][key]
