@@ -3,11 +3,11 @@ and the agreement of λ and the force, from results.json and points.csv of `fict
 
   python3 bench/mpi_whole_solve.py [build] [case ...] > bench/results/<date>-mpi-whole-solve.md
 
-(cases by their N: 4096, 128, 192, 384; 384c and 512c for the compressed Schur complement; 4096, 128
-and 192 when none is given)
+(cases by their N: 4096, 128, 192, 256, 384; 384c and 512c for the compressed Schur complement; 4096,
+128 and 192 when none is given)
 
 Cases: 2-D h = 1/4096 (the manufactured circle) and the 3-D sphere of bench/sphere_contact.toml at
-N = 128, 192 and 384 (where a grid array is 429 MiB); serially with 2 threads (with the Schur complement
+N = 128, 192, 256 and 384 (where a grid array is 429 MiB); serially with 2 threads (with the Schur complement
 auto chooses, and dense), on 2 ranks × 1 thread, and on 4 ranks × 1 thread (oversubscribed on 2 cores: its
 times are not the machine's, its memory per rank is). The compressed cases (384c, 512c): the compressed
 Schur complement serially, on 2 and 4 ranks, and the dense one on 2 ranks.
@@ -31,6 +31,7 @@ CASES = [
     ("2-D circle, h = 1/4096", os.path.join(root, "examples", "manufactured_circle.toml"), ["--N", "4096"]),
     ("3-D sphere, N = 128", os.path.join(here, "sphere_contact.toml"), ["--N", "128"]),
     ("3-D sphere, N = 192", os.path.join(here, "sphere_contact.toml"), ["--N", "192"]),
+    ("3-D sphere, N = 256", os.path.join(here, "sphere_contact.toml"), ["--N", "256"]),
     ("3-D sphere, N = 384", os.path.join(here, "sphere_contact.toml"), ["--N", "384"]),
 ]
 RUNS = [  # (name, ranks, threads, extra flags)

@@ -830,8 +830,9 @@ void CompressedBlocks::multiply(const Eigen::VectorXd& x, std::vector<Eigen::Vec
     return set_of_row && wanted[std::size_t(s)][std::size_t(cx.end)] == wanted[std::size_t(s)][std::size_t(cx.begin)];
   };
   // Each thread adds a fixed run of the blocks (of about equal work) into its own copy (tree order),
-  // summed after in thread order: the bits depend on the thread count only, so that ranks with the same
-  // count compute the same product (a distributed run's Newton steps must agree).
+  // summed after in thread order: the bits depend on the thread count only (a run is reproducible).
+  // Distributed, the ranks' products are then added by an allreduce, which gives every rank the same
+  // bits (Newton's steps must agree).
   const int n_threads = std::max(1, threads);
   std::vector<Eigen::MatrixXd> partial(static_cast<std::size_t>(n_threads));
   const int n_b = int(blocks.size());
