@@ -1,6 +1,5 @@
 #include "fictus/grid/distribution.hpp"
 
-#include <algorithm>
 #include <atomic>
 #include <stdexcept>
 #include <utility>
@@ -52,28 +51,8 @@ Slab Distribution::transform_planes(const std::vector<int>& shape, std::size_t& 
   return Slab{0, shape.empty() ? 0 : shape[0]};
 }
 void Distribution::dct1(const std::vector<int>&, double*, int) const { serial_only("dct1"); }
-namespace {
-
-template <int dim>
-GridVector copy_layers(const Grid<dim>& grid, const GridVector& whole, Slab wanted) {
-  const std::size_t size = grid.layer_size();
-  GridVector out(std::size_t(wanted.count) * size);
-  for (int t = 0; t < wanted.count; ++t) {
-    const std::size_t layer = std::size_t((wanted.first + t) % grid.layers());
-    std::copy_n(whole.begin() + std::ptrdiff_t(layer * size), size,
-                out.begin() + std::ptrdiff_t(std::size_t(t) * size));
-  }
-  return out;
-}
-
-}  // namespace
-
-GridVector Distribution::layers(const Grid<2>& grid, const GridVector& local, Slab wanted) const {
-  return copy_layers(grid, local, wanted);
-}
-GridVector Distribution::layers(const Grid<3>& grid, const GridVector& local, Slab wanted) const {
-  return copy_layers(grid, local, wanted);
-}
+GridVector Distribution::layers(const Grid<2>&, const GridVector&, Slab) const { serial_only("layers"); }
+GridVector Distribution::layers(const Grid<3>&, const GridVector&, Slab) const { serial_only("layers"); }
 GridVector Distribution::gather(const Grid<2>&, const GridVector& local, bool) const { return local; }
 GridVector Distribution::gather(const Grid<3>&, const GridVector& local, bool) const { return local; }
 

@@ -328,7 +328,7 @@ Slab coarse_layers_under(const Grid<dim>& fine, const Slab& slab, const Grid<dim
   if (slab.count == 0) return Slab{0, 0};
   constexpr int s = dim - 1;  // the slowest axis
   // The cells of the slab's layers (Grid::cell_layer), their extent, the coarse nodes around it.
-  const int c_lo = fine.periodic() || slab.first > 0 ? (fine.periodic() ? slab.first : slab.first + 1) : 0;
+  const int c_lo = fine.periodic() ? slab.first : slab.first > 0 ? slab.first + 1 : 0;
   const int c_hi = fine.periodic() ? slab.first + slab.count - 1 : slab.first + slab.count;
   const double lower = coarse.box().lower[s], H = coarse.h();
   const int lo = int(std::floor((fine.coordinate(s, c_lo) - lower) / H)) - 1;

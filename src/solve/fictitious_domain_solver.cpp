@@ -267,8 +267,9 @@ void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
   }
   const int m = b.n_points();
   // Distributed, each rank makes its part of every entry from its planes of the table and the parts are
-  // summed (the compressed blocks' cores before their compression); every rank takes rank 0's sums, so
-  // that Newton runs the same on every rank.
+  // summed: the dense blocks' (every rank then takes rank 0's), or the compressed blocks' near entries
+  // and far cores before each block's one owner compresses it (green_blocks.cpp). Newton then runs the
+  // same on every rank.
   const bool hierarchical = compressed_schur(options.schur_storage, dim, m, st.fast->singular());
   if (options.schur_storage == SchurStorageKind::hierarchical && !hierarchical)
     setup.storage_warning =

@@ -66,7 +66,7 @@ class Distribution {
 
   /// Layers first, first + 1, …, first + count − 1 of a grid vector (taken modulo grid.layers(); `local`
   /// is this rank's slab of it), one after the other, from the ranks that hold them. Each rank asks for
-  /// its own layers (count 0: none). Collective. Serial: copied from the whole vector.
+  /// its own layers (count 0: none). Collective. Serial: never asked.
   virtual GridVector layers(const Grid<2>& grid, const GridVector& local, Slab wanted) const;
   virtual GridVector layers(const Grid<3>& grid, const GridVector& local, Slab wanted) const;
   /// The whole grid vector from each rank's layers: on every rank, or (`everywhere` false) on rank 0
