@@ -114,6 +114,76 @@ double contact_end_fraction(double q, double r, double d) {
   return 0.5 * (lo + hi);
 }
 
+namespace {
+
+/// The share of a triangle where the linear interpolant of ψ (its values at the corners) is negative.
+double negative_share(const std::array<double, 3>& psi) {
+  const int negative = int(psi[0] < 0) + int(psi[1] < 0) + int(psi[2] < 0);
+  if (negative == 0 || negative == 3) return negative / 3.0;
+  // The corner alone on its side cuts off a triangle with sides t1, t2 of its two edges.
+  const bool alone_negative = negative == 1;
+  int k = 0;
+  while ((psi[std::size_t(k)] < 0) != alone_negative) ++k;
+  const double p = psi[std::size_t(k)], t1 = p / (p - psi[std::size_t((k + 1) % 3)]),
+               t2 = p / (p - psi[std::size_t((k + 2) % 3)]);
+  return alone_negative ? t1 * t2 : 1 - t1 * t2;
+}
+
+/// The area of γ's triangles on the contact side of the located boundary (the polyline of
+/// contact_boundary and contact_boundary_lines; end k lies between the active point active[k] and its
+/// free neighbour). ψ at a triangle's corner is its distance to the nearest segment, negative on the
+/// side of the segment's active points, where that distance is below 1.5·s; elsewhere a triangle counts
+/// by its patch (in contact or not). Each triangle counts by the share where the linear interpolant of
+/// ψ is negative; only the patches of the located pairs are looked at.
+double contact_area_inside(const BasicSolution<3>& s, const std::vector<int>& active) {
+  struct Segment {
+    Point3 a, b, across;  // ends, and the direction across it towards the active points
+  };
+  const std::vector<Point3>& ends = s.contact_boundary;
+  std::vector<Segment> segments;
+  std::vector<bool> joined(ends.size(), false);
+  const auto towards = [&](std::size_t k) { return s.gamma.point[std::size_t(active[k])] - ends[k]; };
+  for (const auto& [k1, k2] : s.contact_boundary_lines) {
+    const std::size_t i = std::size_t(k1), j = std::size_t(k2);
+    joined[i] = joined[j] = true;
+    const Point3 along = ends[j] - ends[i], toward = 0.5 * (towards(i) + towards(j));
+    const double length2 = dot(along, along);
+    segments.push_back({ends[i], ends[j], length2 > 0 ? toward - (dot(toward, along) / length2) * along : toward});
+  }
+  for (std::size_t k = 0; k < ends.size(); ++k)
+    if (!joined[k]) segments.push_back({ends[k], ends[k], towards(k)});
+  std::vector<bool> located(std::size_t(s.gamma.m), false);  // patches of a located pair
+  for (const NeighbourPair& p : neighbour_pairs<3>(s))
+    if (s.in_contact(p.i) != s.in_contact(p.j)) located[std::size_t(p.i)] = located[std::size_t(p.j)] = true;
+  const double reach = 1.5 * s.spacing();
+  const auto psi = [&](const Point3& x, bool patch_in_contact) {
+    double nearest = reach, sign = patch_in_contact ? -1 : 1;
+    for (const Segment& g : segments) {
+      const Point3 along = g.b - g.a;
+      const double length2 = dot(along, along);
+      const double t = length2 > 0 ? std::clamp(dot(x - g.a, along) / length2, 0.0, 1.0) : 0.0;
+      const Point3 offset = x - (g.a + t * along);
+      const double distance = norm(offset);
+      if (distance < nearest) nearest = distance, sign = dot(offset, g.across) > 0 ? -1 : 1;
+    }
+    return sign * nearest;
+  };
+  double area = 0;
+  for (std::size_t t = 0; t < s.gamma.triangles.size(); ++t) {
+    const int patch = s.gamma.patch_of[t];
+    if (s.condition(patch) != PointCondition::signorini) continue;
+    const Triangle3& tri = s.gamma.triangles[t];
+    const double size = 0.5 * norm(cross(tri.b - tri.a, tri.c - tri.a));
+    const bool in_contact = s.in_contact(patch);
+    area += located[std::size_t(patch)]
+                ? size * negative_share({psi(tri.a, in_contact), psi(tri.b, in_contact), psi(tri.c, in_contact)})
+                : (in_contact ? size : 0.0);
+  }
+  return area;
+}
+
+}  // namespace
+
 template <int dim>
 void resolve_contact(BasicSolution<dim>& s) {
   const std::vector<double>& part = s.weights();
@@ -125,6 +195,7 @@ void resolve_contact(BasicSolution<dim>& s) {
   s.contact_boundary.clear();
   s.contact_boundary_lines.clear();
   std::map<int, std::vector<int>> at_corner;  // 3-D: a mesh vertex → the located ends whose border has it
+  std::vector<int> active_of_end;             // the active point of each located end
   // The part of d between the points that each owns, in proportion to their parts' sizes.
   const auto size = [&part](int i) { return dim == 2 ? part[std::size_t(i)] : std::sqrt(part[std::size_t(i)]); };
   for (const NeighbourPair& p : neighbour_pairs<dim>(s)) {
@@ -137,6 +208,7 @@ void resolve_contact(BasicSolution<dim>& s) {
     const double owned = p.distance * size(a) / (size(a) + size(b));
     measure += (theta * p.distance - owned) * p.border;
     for (int corner : p.corners) at_corner[corner].push_back(int(s.contact_boundary.size()));
+    active_of_end.push_back(a);
     s.contact_boundary.push_back(s.points()[std::size_t(a)] +
                                  theta * (s.points()[std::size_t(b)] - s.points()[std::size_t(a)]));
   }
@@ -149,6 +221,9 @@ void resolve_contact(BasicSolution<dim>& s) {
     for (std::size_t k = 0; k + 1 < ends.size(); ++k) lines.insert({ends[k], ends[k + 1]});
   }
   s.contact_boundary_lines.assign(lines.begin(), lines.end());
+  // In 3-D the border strips above are right only where the contact boundary runs along the patches'
+  // borders; the measure is the area inside the located boundary instead (docs/math.md, "The contact set").
+  if constexpr (dim == 3) measure = contact_area_inside(s, active_of_end);
   s.contact_measure = std::clamp(measure, 0.0, total);
 }
 
