@@ -131,11 +131,13 @@ double negative_share(const std::array<double, 3>& psi) {
 
 /// The area of γ's triangles on the contact side of the located boundary (the polyline of
 /// contact_boundary and contact_boundary_lines; end k lies between the active point active[k] and its
-/// free neighbour). ψ at a triangle's corner is its distance to the nearest segment, negative on the
-/// side of the segment's active points, where that distance is below 1.5·s; elsewhere a triangle counts
-/// by its patch (in contact or not). Each triangle counts by the share where the linear interpolant of
-/// ψ is negative; only the patches of the located pairs are looked at.
-double contact_area_inside(const BasicSolution<3>& s, const std::vector<int>& active) {
+/// free neighbour; `pairs` are the patches' neighbour pairs). ψ at a triangle's corner is its distance
+/// to the nearest segment, negative on the side of the segment's active points, where that distance is
+/// below 1.5·s; elsewhere a triangle counts by its patch (in contact or not). Each triangle counts by
+/// the share where the linear interpolant of ψ is negative; only the patches of the located pairs are
+/// looked at.
+double contact_area_inside(const BasicSolution<3>& s, const std::vector<NeighbourPair>& pairs,
+                           const std::vector<int>& active) {
   struct Segment {
     Point3 a, b, across;  // ends, and the direction across it towards the active points
   };
@@ -153,18 +155,34 @@ double contact_area_inside(const BasicSolution<3>& s, const std::vector<int>& ac
   for (std::size_t k = 0; k < ends.size(); ++k)
     if (!joined[k]) segments.push_back({ends[k], ends[k], towards(k)});
   std::vector<bool> located(std::size_t(s.gamma.m), false);  // patches of a located pair
-  for (const NeighbourPair& p : neighbour_pairs<3>(s))
+  for (const NeighbourPair& p : pairs)
     if (s.in_contact(p.i) != s.in_contact(p.j)) located[std::size_t(p.i)] = located[std::size_t(p.j)] = true;
   const double reach = 1.5 * s.spacing();
-  const auto psi = [&](const Point3& x, bool patch_in_contact) {
-    double nearest = reach, sign = patch_in_contact ? -1 : 1;
-    for (const Segment& g : segments) {
-      const Point3 along = g.b - g.a;
-      const double length2 = dot(along, along);
-      const double t = length2 > 0 ? std::clamp(dot(x - g.a, along) / length2, 0.0, 1.0) : 0.0;
-      const Point3 offset = x - (g.a + t * along);
+  const auto offset_from = [](const Point3& x, const Segment& g) {  // x minus its nearest point of g
+    const Point3 along = g.b - g.a;
+    const double length2 = dot(along, along);
+    return x - (g.a + (length2 > 0 ? std::clamp(dot(x - g.a, along) / length2, 0.0, 1.0) : 0.0) * along);
+  };
+  // Each located patch looks only at the segments that can come within the reach of its triangles'
+  // corners (the same answer as looking at all: its corners lie within `radius` of its point).
+  std::vector<double> radius(std::size_t(s.gamma.m), 0.0);
+  for (std::size_t t = 0; t < s.gamma.triangles.size(); ++t) {
+    const std::size_t patch = std::size_t(s.gamma.patch_of[t]);
+    const Triangle3& tri = s.gamma.triangles[t];
+    for (const Point3& x : {tri.a, tri.b, tri.c})
+      radius[patch] = std::max(radius[patch], norm(x - s.gamma.point[patch]));
+  }
+  std::vector<std::vector<const Segment*>> near(std::size_t(s.gamma.m));
+  for (std::size_t p = 0; p < near.size(); ++p)
+    if (located[p])
+      for (const Segment& g : segments)
+        if (norm(offset_from(s.gamma.point[p], g)) < radius[p] + reach) near[p].push_back(&g);
+  const auto psi = [&](const Point3& x, int patch) {
+    double nearest = reach, sign = s.in_contact(patch) ? -1 : 1;
+    for (const Segment* g : near[std::size_t(patch)]) {
+      const Point3 offset = offset_from(x, *g);
       const double distance = norm(offset);
-      if (distance < nearest) nearest = distance, sign = dot(offset, g.across) > 0 ? -1 : 1;
+      if (distance < nearest) nearest = distance, sign = dot(offset, g->across) > 0 ? -1 : 1;
     }
     return sign * nearest;
   };
@@ -174,10 +192,9 @@ double contact_area_inside(const BasicSolution<3>& s, const std::vector<int>& ac
     if (s.condition(patch) != PointCondition::signorini) continue;
     const Triangle3& tri = s.gamma.triangles[t];
     const double size = 0.5 * norm(cross(tri.b - tri.a, tri.c - tri.a));
-    const bool in_contact = s.in_contact(patch);
     area += located[std::size_t(patch)]
-                ? size * negative_share({psi(tri.a, in_contact), psi(tri.b, in_contact), psi(tri.c, in_contact)})
-                : (in_contact ? size : 0.0);
+                ? size * negative_share({psi(tri.a, patch), psi(tri.b, patch), psi(tri.c, patch)})
+                : (s.in_contact(patch) ? size : 0.0);
   }
   return area;
 }
@@ -198,7 +215,8 @@ void resolve_contact(BasicSolution<dim>& s) {
   std::vector<int> active_of_end;             // the active point of each located end
   // The part of d between the points that each owns, in proportion to their parts' sizes.
   const auto size = [&part](int i) { return dim == 2 ? part[std::size_t(i)] : std::sqrt(part[std::size_t(i)]); };
-  for (const NeighbourPair& p : neighbour_pairs<dim>(s)) {
+  const std::vector<NeighbourPair> pairs = neighbour_pairs<dim>(s);
+  for (const NeighbourPair& p : pairs) {
     if (s.condition(p.i) != PointCondition::signorini || s.condition(p.j) != PointCondition::signorini) continue;
     const bool i_active = s.in_contact(p.i), j_active = s.in_contact(p.j);
     if (i_active == j_active) continue;
@@ -223,7 +241,7 @@ void resolve_contact(BasicSolution<dim>& s) {
   s.contact_boundary_lines.assign(lines.begin(), lines.end());
   // In 3-D the border strips above are right only where the contact boundary runs along the patches'
   // borders; the measure is the area inside the located boundary instead (docs/math.md, "The contact set").
-  if constexpr (dim == 3) measure = contact_area_inside(s, active_of_end);
+  if constexpr (dim == 3) measure = contact_area_inside(s, pairs, active_of_end);
   s.contact_measure = std::clamp(measure, 0.0, total);
 }
 
