@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Regenerates the fitted-mesh reference solutions ellipse.json, star.json and
-# peanut.json in this folder with FreeFEM (signorini.edp: see the comments
-# there for the discretisation, the active-set solver and how convergence is
-# judged).  Usage: ./generate.sh [ellipse|star|peanut ...]
+# Regenerates the fitted-mesh reference solutions ellipse.json, star.json,
+# peanut.json and tips.json in this folder with FreeFEM (signorini.edp: see
+# the comments there for the discretisation, the active-set solver and how
+# convergence is judged).  Usage: ./generate.sh [ellipse|star|peanut|tips ...]
 # Each problem takes 15 to 25 minutes on one core (about 1e6 P2 dofs on the
 # last level) and up to 3 GiB of memory; the full FreeFEM log of each run
 # goes to $LOGDIR (default: a new temporary folder), and its per-level
@@ -22,7 +22,7 @@ LOGDIR=${LOGDIR:-$(mktemp -d)}
 pkg=$(dpkg-query -W -f='${Version}' freefem++ 2>/dev/null || true)
 
 problems=("$@")
-[ ${#problems[@]} -eq 0 ] && problems=(ellipse star peanut)
+[ ${#problems[@]} -eq 0 ] && problems=(ellipse star peanut tips)
 [ "${MIXED:-0}" = only ] || [ "${AXISYM:-0}" = only ] && problems=()
 for p in ${problems[@]+"${problems[@]}"}; do
   echo "== $p (log: $LOGDIR/$p.log)"
