@@ -130,27 +130,33 @@ double negative_share(const std::array<double, 3>& psi) {
 }
 
 /// The area of γ's triangles on the contact side of the located boundary (the polyline of
-/// contact_boundary and contact_boundary_lines; end k lies between the active point active[k] and its
-/// free neighbour; `pairs` are the patches' neighbour pairs). ψ at a triangle's corner is its distance
-/// to the nearest segment, negative on the side of the segment's active points, where that distance is
-/// below 1.5·s; elsewhere a triangle counts by its patch (in contact or not). Each triangle counts by
-/// the share where the linear interpolant of ψ is negative; only the patches of the located pairs are
-/// looked at.
+/// contact_boundary and contact_boundary_lines; end k lies between the active point ends[k][0] and its
+/// free neighbour ends[k][1]; `pairs` are the patches' neighbour pairs). ψ at a triangle's corner is its
+/// distance to the nearest segment, negative on that segment's contact side (that of the active points
+/// of its ends), where that distance is below 1.5·s; where several segments are nearest (beyond a
+/// vertex of the polyline), the sum of their unit normals towards the contact side decides. Elsewhere a
+/// triangle counts by its patch (in contact or not); an end joined to no other acts as a segment of
+/// length 0. Each triangle counts by the share where the linear interpolant of ψ is negative; only the
+/// patches of the located pairs are looked at.
 double contact_area_inside(const BasicSolution<3>& s, const std::vector<NeighbourPair>& pairs,
-                           const std::vector<int>& active) {
+                           const std::vector<std::array<int, 2>>& pair_of_end) {
   struct Segment {
-    Point3 a, b, across;  // ends, and the direction across it towards the active points
+    Point3 a, b, across;  // ends, and the unit normal across it towards the contact side
   };
   const std::vector<Point3>& ends = s.contact_boundary;
   std::vector<Segment> segments;
   std::vector<bool> joined(ends.size(), false);
-  const auto towards = [&](std::size_t k) { return s.gamma.point[std::size_t(active[k])] - ends[k]; };
+  const auto unit = [](const Point3& v) { return norm(v) > 0 ? (1 / norm(v)) * v : v; };
+  const auto towards = [&](std::size_t k) {  // from the free point to the active one: never 0
+    return unit(s.gamma.point[std::size_t(pair_of_end[k][0])] - s.gamma.point[std::size_t(pair_of_end[k][1])]);
+  };
   for (const auto& [k1, k2] : s.contact_boundary_lines) {
     const std::size_t i = std::size_t(k1), j = std::size_t(k2);
     joined[i] = joined[j] = true;
-    const Point3 along = ends[j] - ends[i], toward = 0.5 * (towards(i) + towards(j));
+    const Point3 along = ends[j] - ends[i], toward = towards(i) + towards(j);
     const double length2 = dot(along, along);
-    segments.push_back({ends[i], ends[j], length2 > 0 ? toward - (dot(toward, along) / length2) * along : toward});
+    segments.push_back(
+        {ends[i], ends[j], unit(length2 > 0 ? toward - (dot(toward, along) / length2) * along : toward)});
   }
   for (std::size_t k = 0; k < ends.size(); ++k)
     if (!joined[k]) segments.push_back({ends[k], ends[k], towards(k)});
@@ -178,13 +184,15 @@ double contact_area_inside(const BasicSolution<3>& s, const std::vector<Neighbou
       for (const Segment& g : segments)
         if (norm(offset_from(s.gamma.point[p], g)) < radius[p] + reach) near[p].push_back(&g);
   const auto psi = [&](const Point3& x, int patch) {
-    double nearest = reach, sign = s.in_contact(patch) ? -1 : 1;
+    double nearest = reach;
+    for (const Segment* g : near[std::size_t(patch)]) nearest = std::min(nearest, norm(offset_from(x, *g)));
+    if (!(nearest < reach)) return s.in_contact(patch) ? -reach : reach;
+    double side = 0;  // Σ over the nearest segments of offset·normal
     for (const Segment* g : near[std::size_t(patch)]) {
       const Point3 offset = offset_from(x, *g);
-      const double distance = norm(offset);
-      if (distance < nearest) nearest = distance, sign = dot(offset, g->across) > 0 ? -1 : 1;
+      if (norm(offset) <= nearest + 1e-12 * reach) side += dot(offset, g->across);
     }
-    return sign * nearest;
+    return side > 0 ? -nearest : nearest;
   };
   double area = 0;
   for (std::size_t t = 0; t < s.gamma.triangles.size(); ++t) {
@@ -211,8 +219,8 @@ void resolve_contact(BasicSolution<dim>& s) {
   }
   s.contact_boundary.clear();
   s.contact_boundary_lines.clear();
-  std::map<int, std::vector<int>> at_corner;  // 3-D: a mesh vertex → the located ends whose border has it
-  std::vector<int> active_of_end;             // the active point of each located end
+  std::map<int, std::vector<int>> at_corner;    // 3-D: a mesh vertex → the located ends whose border has it
+  std::vector<std::array<int, 2>> pair_of_end;  // the active and the free point of each located end
   // The part of d between the points that each owns, in proportion to their parts' sizes.
   const auto size = [&part](int i) { return dim == 2 ? part[std::size_t(i)] : std::sqrt(part[std::size_t(i)]); };
   const std::vector<NeighbourPair> pairs = neighbour_pairs<dim>(s);
@@ -226,7 +234,7 @@ void resolve_contact(BasicSolution<dim>& s) {
     const double owned = p.distance * size(a) / (size(a) + size(b));
     measure += (theta * p.distance - owned) * p.border;
     for (int corner : p.corners) at_corner[corner].push_back(int(s.contact_boundary.size()));
-    active_of_end.push_back(a);
+    pair_of_end.push_back({a, b});
     s.contact_boundary.push_back(s.points()[std::size_t(a)] +
                                  theta * (s.points()[std::size_t(b)] - s.points()[std::size_t(a)]));
   }
@@ -241,7 +249,7 @@ void resolve_contact(BasicSolution<dim>& s) {
   s.contact_boundary_lines.assign(lines.begin(), lines.end());
   // In 3-D the border strips above are right only where the contact boundary runs along the patches'
   // borders; the measure is the area inside the located boundary instead (docs/math.md, "The contact set").
-  if constexpr (dim == 3) measure = contact_area_inside(s, pairs, active_of_end);
+  if constexpr (dim == 3) measure = contact_area_inside(s, pairs, pair_of_end);
   s.contact_measure = std::clamp(measure, 0.0, total);
 }
 
