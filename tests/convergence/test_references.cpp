@@ -74,26 +74,23 @@ TEST_P(References, ConvergeToTheFittedMeshSolution) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Problems, References,
-                         ::testing::Values(ReferenceCase{"ellipse", fictus::Variant::smooth},
-                                           ReferenceCase{"star", fictus::Variant::smooth},
-                                           ReferenceCase{"peanut", fictus::Variant::smooth},
-                                           ReferenceCase{"ellipse", fictus::Variant::nonsmooth},
-                                           ReferenceCase{"star", fictus::Variant::nonsmooth},
-                                           ReferenceCase{"peanut", fictus::Variant::nonsmooth},
-                                           // Every contact end where γ's curvature is 10–16 (the tips of a
-                                           // thin ellipse), N = 512 … 4096. Measured: the smooth variant's
-                                           // L²(ω) errors are not monotone there (9.4e-7, 1.3e-7, 1.8e-7,
-                                           // 2.4e-8; rate 1.53; at N = 1024 … 3072 in steps of 256 they
-                                           // swing by 3–5× with how far the located ends are from the
-                                           // reference's, 0.03–0.17 s); the non-smooth variant misses the
-                                           // free zone at one tip (2.9 spacings long) at N = 512 and has an
-                                           // end 1.2 s off at 1024.
-                                           ReferenceCase{"tips", fictus::Variant::smooth, 512, 1.4},
-                                           ReferenceCase{"tips", fictus::Variant::nonsmooth, 512, 1.8, 2048}),
-                         [](const auto& info) {
-                           return info.param.name + "_" + fictus::to_string(info.param.variant);
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    Problems, References,
+    ::testing::Values(
+        ReferenceCase{"ellipse", fictus::Variant::smooth}, ReferenceCase{"star", fictus::Variant::smooth},
+        ReferenceCase{"peanut", fictus::Variant::smooth}, ReferenceCase{"ellipse", fictus::Variant::nonsmooth},
+        ReferenceCase{"star", fictus::Variant::nonsmooth}, ReferenceCase{"peanut", fictus::Variant::nonsmooth},
+        // Every contact end where γ's curvature is 10–16 (the tips of a
+        // thin ellipse), N = 512 … 4096. Measured: the smooth variant's
+        // L²(ω) errors are not monotone there (9.4e-7, 1.3e-7, 1.8e-7,
+        // 2.4e-8; rate 1.53; at N = 1024 … 3072 in steps of 256 they
+        // swing by 3–5× with how far the located ends are from the
+        // reference's, 0.03–0.17 s); the non-smooth variant misses the
+        // free zone at one tip (2.9 spacings long) at N = 512 and has an
+        // end 1.2 s off at 1024 (0.70 s once located inside the arcs).
+        ReferenceCase{.name = "tips", .variant = fictus::Variant::smooth, .coarsest = 512, .smooth_rate = 1.4},
+        ReferenceCase{.name = "tips", .variant = fictus::Variant::nonsmooth, .coarsest = 512, .ends_from = 2048}),
+    [](const auto& info) { return info.param.name + "_" + fictus::to_string(info.param.variant); });
 
 // Mixed conditions in 2-D: the peanut with a Dirichlet part (the right lobe), a Neumann part (the bottom)
 // and two Signorini arcs, one with a contact piece whose ends are free-boundary points in general position
@@ -392,7 +389,7 @@ TEST(References3d, MixedEllipsoidConvergesToTheFittedMeshSolution) {
     EXPECT_LT(pointwise, 0.9 * previous_pointwise);
     EXPECT_LT(part_errors[0], 0.08);
     EXPECT_LT(part_errors[1], 0.3);
-    EXPECT_LT(part_errors[2], 0.5);
+    EXPECT_LT(part_errors[2], 0.3);
     for (int k = 0; k < 3 && N > 96; ++k) EXPECT_LT(part_errors[std::size_t(k)], previous_part_errors[std::size_t(k)]);
     EXPECT_GE(agree, 180);
     previous_pointwise = pointwise;
