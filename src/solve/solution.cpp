@@ -130,14 +130,14 @@ double negative_share(const std::array<double, 3>& psi) {
 }
 
 /// The area of γ's triangles on the contact side of the located boundary (the polyline of
-/// contact_boundary and contact_boundary_lines; end k lies between the active point ends[k][0] and its
-/// free neighbour ends[k][1]; `pairs` are the patches' neighbour pairs). ψ at a triangle's corner is its
-/// distance to the nearest segment, negative on that segment's contact side (that of the active points
-/// of its ends), where that distance is below 1.5·s; where several segments are nearest (beyond a
-/// vertex of the polyline), the sum of their unit normals towards the contact side decides. Elsewhere a
-/// triangle counts by its patch (in contact or not); an end joined to no other acts as a segment of
-/// length 0. Each triangle counts by the share where the linear interpolant of ψ is negative; only the
-/// patches of the located pairs are looked at.
+/// contact_boundary and contact_boundary_lines; end k lies between the active point pair_of_end[k][0]
+/// and its free neighbour pair_of_end[k][1]; `pairs` are the patches' neighbour pairs). ψ at a
+/// triangle's corner is its distance to the nearest segment, negative on that segment's contact side
+/// (that of the active points of its ends), where that distance is below 1.5·s; where several segments
+/// are nearest (beyond a vertex of the polyline), the sum of their unit normals towards the contact side
+/// decides. Elsewhere a triangle counts by its patch (in contact or not); an end joined to no other acts
+/// as a segment of length 0. Each triangle counts by the share where the linear interpolant of ψ is
+/// negative; only the patches of the located pairs are looked at.
 double contact_area_inside(const BasicSolution<3>& s, const std::vector<NeighbourPair>& pairs,
                            const std::vector<std::array<int, 2>>& pair_of_end) {
   struct Segment {
