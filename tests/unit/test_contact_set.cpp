@@ -13,12 +13,19 @@
 
 namespace {
 
+const fictus::Point3 center{0.5, 0.5, 0.5};
+const double radius = 0.3;
+
+/// A solution whose γ is the sphere of `radius` about `center`, split into m patches (triangle edges
+/// about `edge`); the caller sets the per-point values.
+fictus::SurfaceSolution on_sphere(int m, double edge) {
+  fictus::SurfaceSolution s(fictus::Grid3(fictus::Box3{{0, 0, 0}, {1, 1, 1}}, 64));
+  s.gamma = fictus::ellipsoid_patches(center, {radius, radius, radius}, m, edge);
+  return s;
+}
+
 TEST(ContactSet, CapOfASphereFromGenericEnds) {
-  const fictus::Point3 center{0.5, 0.5, 0.5};
-  const double radius = 0.3;
-  const fictus::Grid3 grid(fictus::Box3{{0, 0, 0}, {1, 1, 1}}, 64);
-  fictus::SurfaceSolution s(grid);
-  s.gamma = fictus::ellipsoid_patches(center, {radius, radius, radius}, 600, radius / 40);
+  fictus::SurfaceSolution s = on_sphere(600, radius / 40);
   const int m = s.gamma.m;
   const double spacing = s.spacing();
   // Twelve caps, planes of normals spread over the sphere at heights from −0.15 to 0.15 above the center.
@@ -71,11 +78,7 @@ TEST(ContactSet, CapOfASphereFromGenericEnds) {
 // triangles. Measured: +0.3 %. Signed by the first nearest segment alone, beyond a sharp corner of the
 // polygon the wrong side counted, and the area was 3.0 times the polygon's.
 TEST(ContactSet, StarOfOnePatchWithSharpCorners) {
-  const fictus::Point3 center{0.5, 0.5, 0.5};
-  const double radius = 0.3;
-  const fictus::Grid3 grid(fictus::Box3{{0, 0, 0}, {1, 1, 1}}, 64);
-  fictus::SurfaceSolution s(grid);
-  s.gamma = fictus::ellipsoid_patches(center, {radius, radius, radius}, 600, radius / 120);
+  fictus::SurfaceSolution s = on_sphere(600, radius / 120);
   const std::size_t m = std::size_t(s.gamma.m), a = 0;  // patch 0 in contact
   s.newton.active.assign(m, 0), s.newton.active[a] = 1;
   s.trace.assign(m, 1.0), s.g.assign(m, 0.0), s.normal_derivative.assign(m, 0.0);
