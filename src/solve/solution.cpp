@@ -221,8 +221,6 @@ void resolve_contact(BasicSolution<dim>& s) {
   s.contact_boundary_lines.clear();
   std::map<int, std::vector<int>> at_corner;    // 3-D: a mesh vertex → the located ends whose border has it
   std::vector<std::array<int, 2>> pair_of_end;  // the active and the free point of each located end
-  // The part of d between the points that each owns, in proportion to their parts' sizes.
-  const auto size = [&part](int i) { return dim == 2 ? part[std::size_t(i)] : std::sqrt(part[std::size_t(i)]); };
   const std::vector<NeighbourPair> pairs = neighbour_pairs<dim>(s);
   for (const NeighbourPair& p : pairs) {
     if (s.condition(p.i) != PointCondition::signorini || s.condition(p.j) != PointCondition::signorini) continue;
@@ -231,8 +229,10 @@ void resolve_contact(BasicSolution<dim>& s) {
     const int a = i_active ? p.i : p.j, b = i_active ? p.j : p.i;
     const double q = s.normal_derivative[std::size_t(a)], r = s.trace[std::size_t(b)] - s.g[std::size_t(b)];
     const double theta = contact_end_fraction(q, r, p.distance);
-    const double owned = p.distance * size(a) / (size(a) + size(b));
-    measure += (theta * p.distance - owned) * p.border;
+    if constexpr (dim == 2) {  // the end moves the border between the arcs, each owning d in proportion
+      const double owned = p.distance * part[std::size_t(a)] / (part[std::size_t(a)] + part[std::size_t(b)]);
+      measure += (theta * p.distance - owned) * p.border;
+    }
     for (int corner : p.corners) at_corner[corner].push_back(int(s.contact_boundary.size()));
     pair_of_end.push_back({a, b});
     s.contact_boundary.push_back(s.points()[std::size_t(a)] +
@@ -247,8 +247,7 @@ void resolve_contact(BasicSolution<dim>& s) {
     for (std::size_t k = 0; k + 1 < ends.size(); ++k) lines.insert({ends[k], ends[k + 1]});
   }
   s.contact_boundary_lines.assign(lines.begin(), lines.end());
-  // In 3-D the border strips above are right only where the contact boundary runs along the patches'
-  // borders; the measure is the area inside the located boundary instead (docs/math.md, "The contact set").
+  // On a surface the measure is the area inside the located boundary (docs/math.md, "The contact set").
   if constexpr (dim == 3) measure = contact_area_inside(s, pairs, pair_of_end);
   s.contact_measure = std::clamp(measure, 0.0, total);
 }
