@@ -1,10 +1,11 @@
 """Whole solves under mpirun against the serial solve, on this machine: time, each rank's peak memory
 and the agreement of λ and the force, from results.json and points.csv of `fictus solve`.
 
-  python3 bench/mpi_whole_solve.py [build] [case ...] > bench/results/<date>-mpi-whole-solve.md
+  python3 bench/mpi_whole_solve.py [build] [case ...] [--against OTHER_BUILD] > bench/results/<date>-mpi-whole-solve.md
 
-(cases by their N: 4096, 128, 192, 256, 384; 384c and 512c for the compressed Schur complement; 4096,
-128 and 192 when none is given)
+(cases by their N: 4096, 128, 192, 256, 384; 384c and 512c for the compressed Schur complement, 192m for
+it with many points; 4096, 128 and 192 when none is given. With --against, every run on ranks of a
+compressed case is made with both builds, one after the other.)
 
 Cases: 2-D h = 1/4096 (the manufactured circle) and the 3-D sphere of bench/sphere_contact.toml at
 N = 128, 192, 256 and 384 (where a grid array is 429 MiB); serially with 2 threads (with the Schur complement
@@ -20,7 +21,13 @@ import subprocess
 import sys
 import tempfile
 
-build = sys.argv[1] if len(sys.argv) > 1 else "build"
+args = sys.argv[1:]
+other = None
+if "--against" in args:
+    at = args.index("--against")
+    other = args[at + 1]
+    del args[at:at + 2]
+build = args[0] if args else "build"
 fictus = os.path.join(build, "apps", "fictus")
 here = os.path.dirname(os.path.abspath(__file__))
 root = os.path.dirname(here)
@@ -51,12 +58,16 @@ COMPRESSED_RUNS = [
 ]
 for N in ("384", "512"):
     CASES.append((f"3-D sphere, N = {N}, compressed", os.path.join(here, "sphere_contact.toml"), ["--N", N], "c"))
-chosen = sys.argv[2:] or ["4096", "128", "192"]
+# Many points on a small grid (s = 2.2h): the preconditioner's groups and the blocks at m = 6000.
+CASES.append(("3-D sphere, N = 192, m = 6000, compressed", os.path.join(here, "sphere_contact.toml"),
+              ["--N", "192", "--multipliers", "6000"], "m"))
+MANY_POINTS_RUNS = [COMPRESSED_RUNS[0], COMPRESSED_RUNS[1], ("3 ranks, compressed S (oversubscribed)", 3, 1, COMPRESSED)]
+chosen = args[1:] or ["4096", "128", "192"]
 CASES = [c for c in CASES if c[2][1] + (c[3] if len(c) > 3 else "") in chosen]
 
 
-def run(problem, flags, ranks, threads, folder):
-    command = [fictus, "solve", problem, *flags, "--threads", str(threads), "--quiet", "--files",
+def run(problem, flags, ranks, threads, folder, program=fictus):
+    command = [program, "solve", problem, *flags, "--threads", str(threads), "--quiet", "--files",
                "results.json,points.csv", "--out", folder]
     if ranks:
         command = ["mpiexec", "--oversubscribe", "--bind-to", "none", "-n", str(ranks)] + command
@@ -82,14 +93,20 @@ print(f"- Machine: {platform.node()}, {os.cpu_count()} CPUs; {mpi}; commit {comm
 print("- Each run: `fictus solve FILE --N N --threads T`, under `mpiexec --oversubscribe --bind-to none -n P` for P")
 print("  ranks. Time: results.json's total; memory: each rank's peak (VmHWM), the largest and the sum.")
 print("- λ and the force against the first serial run: max |Δλ| / max |λ|, and |ΔF| / |F|.\n")
-print("| case | run | m | Schur | Newton steps | time [s] | peak of a rank [MiB] | peaks summed [MiB] "
-      "| Δλ | ΔF |")
-print("|---|---|---|---|---|---|---|---|---|---|")
-for n_case, (case, problem, flags, *compressed) in enumerate(CASES):
+if other:
+    print(f"- Runs marked {other} are that build's, the others {build}'s.")
+print("| case | run | m | Schur | Newton steps | time [s] | schur, newton [s] | peak of a rank [MiB] "
+      "| peaks summed [MiB] | Δλ | ΔF |")
+print("|---|---|---|---|---|---|---|---|---|---|---|")
+for n_case, (case, problem, flags, *kind) in enumerate(CASES):
     reference = None
-    for n_run, (name, ranks, threads, extra) in enumerate(COMPRESSED_RUNS if compressed else RUNS):
+    runs = {(): RUNS, ("c",): COMPRESSED_RUNS, ("m",): MANY_POINTS_RUNS}[tuple(kind)]
+    if other and kind:
+        runs = [(r[0] + (f", {other}" if b else ""), *r[1:], b) for r in runs for b in ([0, 1] if r[1] else [0])]
+    for n_run, (name, ranks, threads, extra, *by_other) in enumerate(runs):
         folder = os.path.join(work, f"{n_case}-{n_run}")
-        results, lam = run(problem, flags + extra, ranks, threads, folder)
+        program = os.path.join(other, "apps", "fictus") if by_other and by_other[0] else fictus
+        results, lam = run(problem, flags + extra, ranks, threads, folder, program)
         peaks = results.get("ranks", {}).get("peak_memory_bytes", [results["peak_memory_bytes"]])
         force = results["contact"]["force"]
         if reference is None:
@@ -99,4 +116,5 @@ for n_case, (case, problem, flags, *compressed) in enumerate(CASES):
         storage = ((results.get("inner") or {}).get("schur_storage") or {}).get("kind", "")
         print(f"| {case} | {name}, {max(ranks, 1)} × {threads} | {results['multipliers']} | {storage} "
               f"| {results['newton']['iterations']} | {results['timings']['total']:.2f} "
+              f"| {results['timings']['schur']:.1f}, {results['timings']['newton']:.1f} "
               f"| {max(peaks) / 2**20:.0f} | {sum(peaks) / 2**20:.0f} | {dl:.1e} | {df:.1e} |", flush=True)

@@ -63,6 +63,17 @@ void Communicator::sum(double* values, std::size_t n) const {
     MPI_Allreduce(MPI_IN_PLACE, values + first, int(std::min(most, n - first)), MPI_DOUBLE, MPI_SUM, comm_);
 }
 
+void Communicator::sum_onto(double* values, std::size_t n, int root) const {
+  constexpr std::size_t most = std::size_t(1) << 30;
+  for (std::size_t first = 0; first < n; first += most) {
+    const int count = int(std::min(most, n - first));
+    if (rank_ == root)
+      MPI_Reduce(MPI_IN_PLACE, values + first, count, MPI_DOUBLE, MPI_SUM, root, comm_);
+    else
+      MPI_Reduce(values + first, nullptr, count, MPI_DOUBLE, MPI_SUM, root, comm_);
+  }
+}
+
 double Communicator::max(double value) const {
   MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_DOUBLE, MPI_MAX, comm_);
   return value;

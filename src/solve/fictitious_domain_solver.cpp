@@ -973,11 +973,11 @@ std::size_t estimated_peak_bytes(const BasicProblem<dim>& problem, const SolverO
   const auto [nodes, m] = nodes_and_multipliers(problem, options);
   // Dense: S_B, S_C and the LU's copy (2-D: and the condition number's). Compressed: S_B and S_C as
   // measured on the sphere (16m²·0.44 at m = 3217, ·0.25 at m = 7238, ·0.16 at m = 12 868:
-  // 2600·m^1.27 bytes, shared out over the ranks) and the preconditioner's blocks of 256 points (three
-  // matrices, on every rank).
+  // 2600·m^1.27 bytes) and the preconditioner's blocks of 256 points (three matrices), both shared out
+  // over the ranks.
   const double P = process_distribution()->size(), arrays = dim == 2 ? 3 : 4;
   const double schur = compressed(problem, options, m)
-                           ? std::min(16 * m * m, 2600 * std::pow(m, 1.27)) / P + 3 * 8 * 256 * m
+                           ? (std::min(16 * m * m, 2600 * std::pow(m, 1.27)) + 3 * 8 * 256 * m) / P
                            : (dim == 2 ? 4 : 3) * 8 * m * m;
   // On P ranks (one rank's peak, measured at 3-D N = 384 on 2 and 4 ranks, bench/results): 0.8 arrays on
   // every rank (the boundary setup) and 2.4 split, FFTW-MPI's transposes included.

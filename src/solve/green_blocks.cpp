@@ -629,9 +629,9 @@ void BlockAssembly<dim>::fill(std::vector<Eigen::MatrixXd>& out) {
 
 /// The kept blocks, in batches of them whose numbers (near: the entries; far: the core, G between the
 /// interpolation nodes) take about summed_chunk doubles. A batch's near entries and far cores are made
-/// (with a partial table: this rank's part), summed over the ranks, and each block is kept by one rank,
-/// chosen for equal work, which compresses it if it is far (cross approximation is not linear in the
-/// entries: it takes the sum; only the owner uses a sum, so the ranks need not agree on its bits).
+/// (with a partial table: this rank's part), and each block is kept by one rank, chosen for equal work:
+/// the ranks' parts are summed onto it alone, and it compresses the block if it is far (cross
+/// approximation is not linear in the entries: it takes the sum).
 /// Serially every block is kept and comes out as in one pass.
 template <int dim>
 template <class Piece>
@@ -651,32 +651,23 @@ void BlockAssembly<dim>::fill_kept(const Piece& piece) {
   };
   // The owners: the blocks by their work (near: the entries; far: the cross approximation's rows and
   // columns through the core), dearest first, each to the rank with the least so far.
-  std::vector<int> owner(n, 0);
-  if (distribution.distributed()) {
-    std::vector<double> work(n), load(std::size_t(distribution.size()), 0.0);
-    for (std::size_t k = 0; k < n; ++k)
-      work[k] = stores[k].far ? double(rows(k) + cols(k)) * double(x_interp[std::size_t(stores[k].x)]->size() +
-                                                                   y_interp[std::size_t(stores[k].y)]->size())
-                              : double(rows(k) * cols(k));
-    std::vector<std::size_t> order(n);
-    std::iota(order.begin(), order.end(), std::size_t(0));
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return work[a] > work[b]; });
-    for (std::size_t k : order) {
-      const auto least = std::size_t(std::min_element(load.begin(), load.end()) - load.begin());
-      owner[k] = int(least);
-      load[least] += work[k];
-    }
-  }
+  std::vector<double> work(n);
+  for (std::size_t k = 0; k < n; ++k)
+    work[k] = stores[k].far ? double(rows(k) + cols(k)) * double(x_interp[std::size_t(stores[k].x)]->size() +
+                                                                 y_interp[std::size_t(stores[k].y)]->size())
+                            : double(rows(k) * cols(k));
+  const std::vector<int> owner = share_out(work, distribution.size());
   const std::size_t n_sets = row_sets.size();
   std::vector<Eigen::MatrixXd> cores;
   std::vector<Eigen::MatrixXd*> summed;
+  std::vector<int> summed_owner;  // only a block's owner uses its sums
   std::vector<std::size_t> made, kept_far;
   for (std::size_t first = 0, last = 0; first < n; first = last) {
     std::size_t numbers = 0;
     for (last = first; last < n && (last == first || numbers <= summed_chunk); ++last)
       numbers += stores[last].far ? core_size(last) : n_sets * rows(last) * cols(last);
     cores.assign(last - first, Eigen::MatrixXd());
-    made.clear(), summed.clear(), kept_far.clear();
+    made.clear(), summed.clear(), summed_owner.clear(), kept_far.clear();
     for (std::size_t k = first; k < last; ++k) {
       CompressedBlocks::Block& kept = compressed->blocks[k];
       if (stores[k].far) {
@@ -686,6 +677,7 @@ void BlockAssembly<dim>::fill_kept(const Piece& piece) {
         kept.dense.assign(n_sets, Eigen::MatrixXd(Eigen::Index(rows(k)), Eigen::Index(cols(k))));
         for (Eigen::MatrixXd& d : kept.dense) summed.push_back(&d);
       }
+      summed_owner.resize(summed.size(), owner[k]);
       made.insert(made.end(), pieces[k].begin(), pieces[k].end());
     }
     each(made.size(), [&](std::size_t a, Scratch& s) {
@@ -695,7 +687,7 @@ void BlockAssembly<dim>::fill_kept(const Piece& piece) {
       else
         piece(b, s);
     });
-    sum_over_ranks(distribution, summed);
+    sum_over_ranks(distribution, summed, &summed_owner);
     each(kept_far.size(), [&](std::size_t a, Scratch& s) {
       const std::size_t k = kept_far[a];
       std::vector<Eigen::MatrixXd> unused;
@@ -787,22 +779,56 @@ CompressedBlocks compressed_green_blocks(const GreenTable<dim>& green, const std
   return c;
 }
 
-void sum_over_ranks(const Distribution& distribution, const std::vector<Eigen::MatrixXd*>& mats) {
+std::vector<int> share_out(const std::vector<double>& work, int ranks) {
+  std::vector<int> owner(work.size(), 0);
+  if (ranks <= 1) return owner;
+  std::vector<double> load(std::size_t(ranks), 0.0);
+  std::vector<std::size_t> order(work.size());
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return work[a] > work[b]; });
+  for (std::size_t k : order) {
+    const auto least = std::size_t(std::min_element(load.begin(), load.end()) - load.begin());
+    owner[k] = int(least);
+    load[least] += work[k];
+  }
+  return owner;
+}
+
+void sum_over_ranks(const Distribution& distribution, const std::vector<Eigen::MatrixXd*>& mats,
+                    const std::vector<int>* owners) {
   if (!distribution.distributed()) return;
+  if (owners && owners->size() != mats.size()) throw std::logic_error("sum_over_ranks: one owner for each matrix");
   std::vector<double> buffer;
+  // One message per chunk, or per owner of a chunk's matrices: every rank takes the same turns.
+  const auto sum = [&](std::size_t first, std::size_t last, int owner) {
+    std::size_t n = 0;
+    for (std::size_t k = first; k < last; ++k)
+      if (owner < 0 || (*owners)[k] == owner) n += std::size_t(mats[k]->size());
+    if (n == 0) return;
+    buffer.resize(n);
+    double* at = buffer.data();
+    for (std::size_t k = first; k < last; ++k)
+      if (owner < 0 || (*owners)[k] == owner) at = std::copy_n(mats[k]->data(), mats[k]->size(), at);
+    if (owner < 0)
+      distribution.sum(buffer.data(), n);
+    else
+      distribution.sum_onto(buffer.data(), n, owner);
+    if (owner >= 0 && owner != distribution.rank()) return;
+    at = buffer.data();
+    for (std::size_t k = first; k < last; ++k)
+      if (owner < 0 || (*owners)[k] == owner) {
+        std::copy_n(at, mats[k]->size(), mats[k]->data());
+        at += mats[k]->size();
+      }
+  };
   for (std::size_t first = 0, last = 0; first < mats.size(); first = last) {
     std::size_t n = 0;
     for (last = first; last < mats.size() && (last == first || n + std::size_t(mats[last]->size()) <= summed_chunk);)
       n += std::size_t(mats[last++]->size());
-    buffer.resize(n);
-    double* at = buffer.data();
-    for (std::size_t k = first; k < last; ++k) at = std::copy_n(mats[k]->data(), mats[k]->size(), at);
-    distribution.sum(buffer.data(), n);
-    at = buffer.data();
-    for (std::size_t k = first; k < last; ++k) {
-      std::copy_n(at, mats[k]->size(), mats[k]->data());
-      at += mats[k]->size();
-    }
+    if (!owners)
+      sum(first, last, -1);
+    else
+      for (int r = 0; r < distribution.size(); ++r) sum(first, last, r);
   }
 }
 

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <exception>
 #include <stdexcept>
 #include <unordered_map>
@@ -102,7 +103,8 @@ struct HierarchicalSchur::Impl {
   SchurStorage storage;
   GmresOptions gmres;
   std::vector<std::vector<int>> groups;         // the points of each preconditioner block
-  std::vector<Eigen::MatrixXd> diag_B, diag_C;  // S̃_B and S̃_C on each group × group
+  std::vector<char> mine;                       // the groups this rank holds (serially: all)
+  std::vector<Eigen::MatrixXd> diag_B, diag_C;  // S̃_B and S̃_C on each group × group (held groups only)
   mutable std::vector<Eigen::PartialPivLU<Eigen::MatrixXd>> lu;
   mutable std::vector<ActiveSet> lu_active;
   mutable int factorizations = 0;
@@ -141,6 +143,7 @@ struct HierarchicalSchur::Impl {
     int made = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : made)
     for (int g = 0; g < n; ++g) try {
+        if (!mine[std::size_t(g)]) continue;
         const std::vector<int>& items = groups[std::size_t(g)];
         ActiveSet flags(items.size());
         for (std::size_t a = 0; a < items.size(); ++a) flags[a] = active[std::size_t(items[a])];
@@ -156,20 +159,26 @@ struct HierarchicalSchur::Impl {
         if (!failure) failure = std::current_exception();
       }
     if (failure) std::rethrow_exception(failure);
+    if (blocks.distribution) made = int(blocks.distribution->sum(double(made)));  // every rank's groups
     factorizations += made;
   }
 
+  /// y = the block-Jacobi preconditioner applied to r. Distributed: each rank solves on its groups and
+  /// the ranks' parts are summed; each entry is one rank's (the others add zeros), so every rank gets
+  /// the same bits.
   void precondition(const Eigen::VectorXd& r, Eigen::VectorXd& y) const {
-    y.resize(r.size());
+    y.setZero(r.size());
     const int n = int(groups.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int g = 0; g < n; ++g) {
+      if (!mine[std::size_t(g)]) continue;
       const std::vector<int>& items = groups[std::size_t(g)];
       Eigen::VectorXd v(Eigen::Index(items.size()));
       for (std::size_t a = 0; a < items.size(); ++a) v(Eigen::Index(a)) = r(items[a]);
       v = lu[std::size_t(g)].solve(v);
       for (std::size_t a = 0; a < items.size(); ++a) y(items[a]) = v(Eigen::Index(a));
     }
+    if (blocks.distribution) blocks.distribution->sum(y.data(), std::size_t(y.size()));
   }
 };
 
@@ -193,38 +202,58 @@ HierarchicalSchur::HierarchicalSchur(const GreenTable<dim>& green, const SparseR
   execution.throw_if_interrupted();
   s.D_B = direct.trace;
   s.D_C = direct.normal_derivative;
-  // The preconditioner: S̃_B and S̃_C on each group of nearby points.
+  // The preconditioner: S̃_B and S̃_C on each group of nearby points. Distributed, each group is one
+  // rank's (shared out by its LU's work): every rank makes its blocks' entries of each group, they are
+  // summed onto the owner, and the other ranks drop them; a batch of groups at a time, so that no rank
+  // holds more than its own groups and one batch.
   const std::vector<int> groups = s.blocks.groups(options.group);
-  const int n_groups = int(groups.size());
-  s.groups.resize(std::size_t(n_groups));
-  s.diag_B.resize(std::size_t(n_groups));
-  s.diag_C.resize(std::size_t(n_groups));
-  s.lu.resize(std::size_t(n_groups));
-  s.lu_active.resize(std::size_t(n_groups));
-  std::exception_ptr failure;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(s.threads)
-  for (int g = 0; g < n_groups; ++g) try {
-      const CompressedBlocks::Cluster& cl = s.blocks.row_clusters[std::size_t(groups[std::size_t(g)])];
-      std::vector<int>& items = s.groups[std::size_t(g)];
-      items.assign(s.blocks.row_item.begin() + cl.begin, s.blocks.row_item.begin() + cl.end);
-      s.diag_B[std::size_t(g)] = s.blocks.diagonal_block(0, groups[std::size_t(g)]);
-      s.diag_C[std::size_t(g)] = s.blocks.diagonal_block(1, groups[std::size_t(g)]);
-    } catch (...) {
-#pragma omp critical(fictus_hierarchical_failure)
-      if (!failure) failure = std::current_exception();
-    }
-  if (failure) std::rethrow_exception(failure);
-  // Distributed: each rank's blocks' entries, summed; every entry is one rank's (the others add zeros), so
-  // every rank holds the same bits of the whole groups.
-  if (s.blocks.distribution) {
-    std::vector<Eigen::MatrixXd*> parts;
-    for (auto* diag : {&s.diag_B, &s.diag_C})
-      for (Eigen::MatrixXd& M : *diag) parts.push_back(&M);
-    sum_over_ranks(*s.blocks.distribution, parts);
+  const std::size_t n_groups = groups.size();
+  s.groups.resize(n_groups);
+  s.diag_B.resize(n_groups);
+  s.diag_C.resize(n_groups);
+  s.lu.resize(n_groups);
+  s.lu_active.resize(n_groups);
+  std::vector<double> work(n_groups);
+  for (std::size_t g = 0; g < n_groups; ++g) {
+    const CompressedBlocks::Cluster& cl = s.blocks.row_clusters[std::size_t(groups[g])];
+    s.groups[g].assign(s.blocks.row_item.begin() + cl.begin, s.blocks.row_item.begin() + cl.end);
+    work[g] = std::pow(double(s.groups[g].size()), 3);
   }
-  for (int g = 0; g < n_groups; ++g) {
-    add_direct(s.D_B, s.groups[std::size_t(g)], s.diag_B[std::size_t(g)]);
-    add_direct(s.D_C, s.groups[std::size_t(g)], s.diag_C[std::size_t(g)]);
+  const Distribution* distribution = s.blocks.distribution.get();
+  const std::vector<int> owner = share_out(work, distribution ? distribution->size() : 1);
+  const int rank = distribution ? distribution->rank() : 0;
+  s.mine.resize(n_groups);
+  for (std::size_t g = 0; g < n_groups; ++g) s.mine[g] = owner[g] == rank;
+  constexpr std::size_t batch = std::size_t(1) << 22;  // doubles (32 MiB) of blocks at a time
+  for (std::size_t first = 0, last = 0; first < n_groups; first = last) {
+    std::size_t numbers = 0;
+    for (last = first; last < n_groups && (last == first || numbers <= batch); ++last)
+      numbers += 2 * s.groups[last].size() * s.groups[last].size();
+    std::exception_ptr failure;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(s.threads)
+    for (std::size_t g = first; g < last; ++g) try {
+        s.diag_B[g] = s.blocks.diagonal_block(0, groups[g]);
+        s.diag_C[g] = s.blocks.diagonal_block(1, groups[g]);
+      } catch (...) {
+#pragma omp critical(fictus_hierarchical_failure)
+        if (!failure) failure = std::current_exception();
+      }
+    if (failure) std::rethrow_exception(failure);
+    if (!distribution) continue;
+    std::vector<Eigen::MatrixXd*> parts;
+    std::vector<int> part_owner;
+    for (std::size_t g = first; g < last; ++g) {
+      parts.insert(parts.end(), {&s.diag_B[g], &s.diag_C[g]});
+      part_owner.insert(part_owner.end(), {owner[g], owner[g]});
+    }
+    sum_over_ranks(*distribution, parts, &part_owner);
+    for (std::size_t g = first; g < last; ++g)
+      if (!s.mine[g]) s.diag_B[g] = Eigen::MatrixXd(), s.diag_C[g] = Eigen::MatrixXd();
+  }
+  for (std::size_t g = 0; g < n_groups; ++g) {
+    if (!s.mine[g]) continue;
+    add_direct(s.D_B, s.groups[g], s.diag_B[g]);
+    add_direct(s.D_C, s.groups[g], s.diag_C[g]);
   }
   SchurStorage& t = s.storage;
   t.kind = "hierarchical";
@@ -239,15 +268,14 @@ HierarchicalSchur::HierarchicalSchur(const GreenTable<dim>& green, const SparseR
       t.full_blocks += 1;
     }
   }
-  if (s.blocks.distribution) {  // the blocks of all ranks
-    const Distribution& d = *s.blocks.distribution;
-    std::vector<double> totals{t.bytes, t.low_rank_blocks, t.full_blocks};
-    d.sum(totals);
-    t.bytes = totals[0], t.low_rank_blocks = totals[1], t.full_blocks = totals[2];
-    t.largest_rank = int(d.max(t.largest_rank));
+  for (const Eigen::MatrixXd& M : s.diag_B) t.preconditioner_bytes += 3.0 * 8.0 * double(M.size());  // held
+  if (distribution) {  // the blocks and groups of all ranks
+    std::vector<double> totals{t.bytes, t.low_rank_blocks, t.full_blocks, t.preconditioner_bytes};
+    distribution->sum(totals);
+    t.bytes = totals[0], t.low_rank_blocks = totals[1], t.full_blocks = totals[2], t.preconditioner_bytes = totals[3];
+    t.largest_rank = int(distribution->max(t.largest_rank));
   }
   t.bytes += 12.0 * double(s.D_B.nonZeros() + s.D_C.nonZeros());  // every rank's
-  for (const Eigen::MatrixXd& M : s.diag_B) t.preconditioner_bytes += 3.0 * 8.0 * double(M.size());
   t.far_fraction = report.far_pairs / (report.far_pairs + report.near_pairs);
   t.seconds_assembly = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }

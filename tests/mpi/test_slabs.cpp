@@ -356,6 +356,49 @@ TEST(SlabGreenTable, CompressedBlocksFromThePartsAreThoseOfTheWholeTable) {
   }
 }
 
+/// The compressed Schur complement's Newton solves from the ranks' planes of the table: the blocks and
+/// the preconditioner's groups shared out (each group's LU on one rank, the ranks' parts of each
+/// preconditioned vector summed), against the solver of the whole table. The answers agree to round-off,
+/// every rank gets the same bits, and the ranks together make the serial solver's LUs.
+TEST(SlabGreenTable, CompressedNewtonSolvesWithTheGroupsSharedOut) {
+  const Communicator comm;
+  const fictus::test_support::SphereRows rows(Boundary::dirichlet, 0.3, 48, 2.0, 1.5);
+  const int m = rows.B.n_rows();
+  fictus::GmresOptions gmres;
+  gmres.relative_tolerance = 1e-12;
+  fictus::HierarchicalOptions options;
+  options.far_field = fictus::default_far_field_3d;
+  options.storage.leaf = 8;
+  options.group = 32;
+  const fictus::GreenTable<3> whole(rows.grid, 1.0, fictus::Execution(1));
+  const fictus::HierarchicalSchur serial(whole, rows.B, rows.C, rows.Q, fictus::Execution(2), {}, options, gmres);
+  const auto distribution = std::make_shared<fictus::mpi::SlabDistribution>(comm);
+  fictus::set_process_distribution(distribution);
+  const fictus::Execution execution(2);
+  const fictus::GreenTable<3> part(rows.grid, 1.0, execution);
+  const fictus::HierarchicalSchur parts(part, rows.B, rows.C, rows.Q, execution, {}, options, gmres);
+  fictus::set_process_distribution(nullptr);
+  EXPECT_NEAR(parts.storage().preconditioner_bytes, serial.storage().preconditioner_bytes, 0.5);
+  fictus::ActiveSet active(static_cast<std::size_t>(m));
+  const Eigen::VectorXd d = Eigen::VectorXd::LinSpaced(m, 0.0, 3.0).array().cos();
+  for (int turn = 0; turn < 2; ++turn) {  // the second: one point's status changed
+    for (int i = 0; i < m; ++i) active[std::size_t(i)] = char(i % 3 != 0);
+    if (turn == 1) active[0] = 1;
+    Eigen::VectorXd want = Eigen::VectorXd::Zero(m), got = Eigen::VectorXd::Zero(m);
+    const fictus::LinearSolveReport a = serial.solve(active, d, want, 1e-12);
+    const fictus::LinearSolveReport b = parts.solve(active, d, got, 1e-12);
+    const std::string name = "compressed Newton solve " + std::to_string(turn);
+    ASSERT_TRUE(a.converged && b.converged) << name;
+    EXPECT_EQ(a.inner_iterations, b.inner_iterations) << name;
+    expect_agreement((got - want).norm() / want.norm(), name, comm);
+    std::vector<double> mine(got.data(), got.data() + m), first = mine;
+    distribution->broadcast(first.data(), first.size());
+    EXPECT_EQ(comm.max(mine == first ? 0.0 : 1.0), 0.0) << name << ": the ranks' answers differ";
+    EXPECT_EQ(parts.factorizations(), serial.factorizations()) << name;
+  }
+  EXPECT_GT(serial.factorizations(), 2);
+}
+
 /// Distribution::layers: each rank asks for its own run of layers (wrapping past the last one, or none)
 /// and gets the whole vector's layers, in the asked order.
 TEST(SlabLayers, EachRankGetsTheLayersItAsksFor) {

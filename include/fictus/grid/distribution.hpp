@@ -42,6 +42,9 @@ class Distribution {
     sum(&value, 1);
     return value;
   }
+  /// values[i] ← Σ over the ranks of values[i], on rank `root` only: what one rank alone needs, at about
+  /// half an all-ranks sum's traffic. The other ranks' values are kept (serial: unchanged).
+  virtual void sum_onto(double* values, std::size_t n, int root) const { (void)values, (void)n, (void)root; }
   virtual double max(double value) const { return value; }
   /// values ← rank 0's values, on every rank.
   virtual void broadcast(double* values, std::size_t n) const { (void)values, (void)n; }

@@ -37,6 +37,8 @@ class Communicator {
   int size() const { return size_; }
   /// values[i] ← Σ over the ranks of values[i], on every rank.
   void sum(double* values, std::size_t n) const;
+  /// values[i] ← Σ over the ranks of values[i], on rank `root` only (the others' values are kept).
+  void sum_onto(double* values, std::size_t n, int root) const;
   double max(double value) const;
   void barrier() const;
 

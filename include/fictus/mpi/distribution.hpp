@@ -18,6 +18,7 @@ class SlabDistribution final : public Distribution {
   using Distribution::slab;
   void sum(double* values, std::size_t n) const override { comm_.sum(values, n); }
   using Distribution::sum;
+  void sum_onto(double* values, std::size_t n, int root) const override { comm_.sum_onto(values, n, root); }
   double max(double value) const override { return comm_.max(value); }
   void broadcast(double* values, std::size_t n) const override;
   std::unique_ptr<FastSolver<2>> fast_solver(const Grid<2>& grid, double c, const Execution& execution) const override;
