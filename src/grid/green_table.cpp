@@ -31,6 +31,7 @@ GreenTable<dim>::GreenTable(const Grid<dim>& grid, double c, const Execution& ex
   plane_.resize(size_[dim - 1]);
   for (int z = 0; z < shape[0]; ++z)
     plane_[std::size_t(z)] = (held.holds(z) ? std::size_t(z - held.first) : std::size_t(held.count)) * plane;
+  if (partial_) zeros_ = std::size_t(held.count) * plane;
   table_.assign(partial_ ? std::max(local, std::size_t(held.count + 1) * plane) : entries, 0.0);
   // Table entry p holds 1/λ of mode p. Dirichlet: p_d = 1..n_d−1 (spectrum index p_d − 1), zero at
   // p_d ∈ {0, n_d}; periodic: p_d = 0..n_d/2 (spectrum index p_d), the zero mode dropped when λ = 0.
@@ -83,6 +84,14 @@ inline double reflections(const double* tm, const double* tp, std::size_t m, std
   return tm[m] - tm[p] - tp[m] + tp[p];
 }
 
+/// Which of the two table rows (planes) of a reflection pair, at offsets `minus` and `plus`, this rank
+/// holds: distributed, a row held elsewhere is the zero plane (`zeros`; serially none), and the sums
+/// skip its terms. They are exact zeros, so the sums' bits are those with them.
+enum Held { both, minus_only, plus_only, neither };
+inline Held held(std::size_t minus, std::size_t plus, std::size_t zeros) {
+  return minus != zeros ? (plus != zeros ? both : minus_only) : (plus != zeros ? plus_only : neither);
+}
+
 }  // namespace
 
 template <int dim>
@@ -109,14 +118,25 @@ void GreenTable<dim>::G(const std::array<std::vector<int>, dim>& a, const std::a
         const std::size_t* sm = minus[0].data() + q0 * na0;
         const std::size_t* sp = plus[0].data() + q0 * na0;  // empty in a periodic box
         for (std::size_t p1 = 0; p1 < na1; ++p1) {
-          const double* tm = t + minus[1][q1 * na1 + p1];
+          const std::size_t ym = minus[1][q1 * na1 + p1], yp = periodic_ ? zeros_ : plus[1][q1 * na1 + p1];
+          const double *tm = t + ym, *tp = periodic_ ? t : t + yp;
           double* o = column + p1 * na0;
-          if (periodic_) {
-            for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = tm[sm[p0]];
-            continue;
+          switch (held(ym, yp, zeros_)) {  // the terms of the rows held elsewhere are zeros: skipped (the same bits)
+            case both:
+              for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = reflections(tm, tp, sm[p0], sp[p0]);
+              break;
+            case minus_only:
+              if (periodic_)
+                for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = tm[sm[p0]];
+              else
+                for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = tm[sm[p0]] - tm[sp[p0]];
+              break;
+            case plus_only:
+              for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = -tp[sm[p0]] + tp[sp[p0]];
+              break;
+            case neither:
+              std::fill(o, o + na0, 0.0);
           }
-          const double* tp = t + plus[1][q1 * na1 + p1];
-          for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = reflections(tm, tp, sm[p0], sp[p0]);
         }
       }
   } else {
@@ -127,18 +147,36 @@ void GreenTable<dim>::G(const std::array<std::vector<int>, dim>& a, const std::a
           double* column = out + ld * ((q2 * nb1 + q1) * nb0 + q0);
           const std::size_t* xm = minus[0].data() + q0 * na0;
           const std::size_t* xp = plus[0].data() + q0 * na0;  // empty in a periodic box
-          for (std::size_t p2 = 0; p2 < na2; ++p2)
+          for (std::size_t p2 = 0; p2 < na2; ++p2) {
+            const std::size_t zm = minus[2][q2 * na2 + p2], zp = periodic_ ? zeros_ : plus[2][q2 * na2 + p2];
+            const Held z = held(zm, zp, zeros_);  // the terms of the planes held elsewhere are zeros: skipped (the same bits)
             for (std::size_t p1 = 0; p1 < na1; ++p1) {
-              const std::size_t ym = minus[1][q1 * na1 + p1], zm = minus[2][q2 * na2 + p2];
+              const std::size_t ym = minus[1][q1 * na1 + p1];
               double* o = column + (p2 * na1 + p1) * na0;
               if (periodic_) {
-                for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = t[zm + ym + xm[p0]];
+                if (z == neither)
+                  std::fill(o, o + na0, 0.0);
+                else
+                  for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = t[zm + ym + xm[p0]];
                 continue;
               }
-              const std::size_t yp = plus[1][q1 * na1 + p1], zp = plus[2][q2 * na2 + p2];
+              const std::size_t yp = plus[1][q1 * na1 + p1];
               const double *mm = t + ym + zm, *pm = t + yp + zm, *mp = t + ym + zp, *pp = t + yp + zp;
-              for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = reflections(mm, pm, mp, pp, xm[p0], xp[p0]);
+              switch (z) {
+                case both:
+                  for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = reflections(mm, pm, mp, pp, xm[p0], xp[p0]);
+                  break;
+                case minus_only:
+                  for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = reflections(mm, pm, xm[p0], xp[p0]);
+                  break;
+                case plus_only:
+                  for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = -reflections(mp, pp, xm[p0], xp[p0]);
+                  break;
+                case neither:
+                  std::fill(o, o + na0, 0.0);
+              }
             }
+          }
         }
   }
 }
@@ -185,23 +223,36 @@ void GreenTable<dim>::G(const Index* a, std::size_t n_a, const Index* b, const d
     double sum = 0.0;
     if constexpr (dim == 2) {
       if (periodic_) {
-        for (std::size_t k = 0; k < n_b; ++k) sum += t[ym[c[2 * k + 1]] + xm[c[2 * k]]] * w[k];
+        for (std::size_t k = 0; k < n_b; ++k)
+          if (ym[c[2 * k + 1]] != zeros_) sum += t[ym[c[2 * k + 1]] + xm[c[2 * k]]] * w[k];
       } else {
         for (std::size_t k = 0; k < n_b; ++k) {
           const int cx = c[2 * k], cy = c[2 * k + 1];
-          sum += reflections(t + ym[cy], t + yp[cy], xm[cx], xp[cx]) * w[k];
+          const double *tm = t + ym[cy], *tp = t + yp[cy];
+          switch (held(ym[cy], yp[cy], zeros_)) {  // rows held elsewhere: zeros, skipped (the same bits)
+            case both: sum += reflections(tm, tp, xm[cx], xp[cx]) * w[k]; break;
+            case minus_only: sum += (tm[xm[cx]] - tm[xp[cx]]) * w[k]; break;
+            case plus_only: sum += (-tp[xm[cx]] + tp[xp[cx]]) * w[k]; break;
+            case neither: break;
+          }
         }
       }
     } else {
       const std::size_t *zm = offsets.data() + minus_at[2], *zp = offsets.data() + plus_at[2];
       if (periodic_) {
-        for (std::size_t k = 0; k < n_b; ++k) sum += t[zm[c[3 * k + 2]] + ym[c[3 * k + 1]] + xm[c[3 * k]]] * w[k];
+        for (std::size_t k = 0; k < n_b; ++k)
+          if (zm[c[3 * k + 2]] != zeros_) sum += t[zm[c[3 * k + 2]] + ym[c[3 * k + 1]] + xm[c[3 * k]]] * w[k];
       } else {
         for (std::size_t k = 0; k < n_b; ++k) {
           const int cx = c[3 * k], cy = c[3 * k + 1], cz = c[3 * k + 2];
-          sum += reflections(t + ym[cy] + zm[cz], t + yp[cy] + zm[cz], t + ym[cy] + zp[cz], t + yp[cy] + zp[cz], xm[cx],
-                             xp[cx]) *
-                 w[k];
+          const double *mm = t + ym[cy] + zm[cz], *pm = t + yp[cy] + zm[cz], *mp = t + ym[cy] + zp[cz],
+                       *pp = t + yp[cy] + zp[cz];
+          switch (held(zm[cz], zp[cz], zeros_)) {  // planes held elsewhere: zeros, skipped (the same bits)
+            case both: sum += reflections(mm, pm, mp, pp, xm[cx], xp[cx]) * w[k]; break;
+            case minus_only: sum += reflections(mm, pm, xm[cx], xp[cx]) * w[k]; break;
+            case plus_only: sum += -reflections(mp, pp, xm[cx], xp[cx]) * w[k]; break;
+            case neither: break;
+          }
         }
       }
     }

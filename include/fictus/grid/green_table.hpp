@@ -18,6 +18,8 @@
 #include <cstddef>
 #include <vector>
 
+#include <cstdint>
+
 #include "fictus/grid/execution.hpp"
 #include "fictus/grid/grid.hpp"
 
@@ -98,6 +100,7 @@ class GreenTable {
   std::array<std::size_t, dim> size_;  // table entries along each axis: period/2 + 1
   bool partial_ = false;
   std::vector<std::size_t> plane_;  // where plane z of the slowest axis begins in table_ (a zero plane if not held)
+  std::size_t zeros_ = SIZE_MAX;    // where the zero plane begins (none serially): the block sums skip its lookups
   AlignedVector<double> table_;
 };
 
