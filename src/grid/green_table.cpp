@@ -149,33 +149,36 @@ void GreenTable<dim>::G(const std::array<std::vector<int>, dim>& a, const std::a
           const std::size_t* xp = plus[0].data() + q0 * na0;  // empty in a periodic box
           for (std::size_t p2 = 0; p2 < na2; ++p2) {
             const std::size_t zm = minus[2][q2 * na2 + p2], zp = periodic_ ? zeros_ : plus[2][q2 * na2 + p2];
-            const Held z = held(zm, zp, zeros_);  // the terms of the planes held elsewhere are zeros: skipped (the same bits)
-            for (std::size_t p1 = 0; p1 < na1; ++p1) {
-              const std::size_t ym = minus[1][q1 * na1 + p1];
-              double* o = column + (p2 * na1 + p1) * na0;
-              if (periodic_) {
-                if (z == neither)
-                  std::fill(o, o + na0, 0.0);
-                else
-                  for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = t[zm + ym + xm[p0]];
-                continue;
-              }
-              const std::size_t yp = plus[1][q1 * na1 + p1];
-              const double *mm = t + ym + zm, *pm = t + yp + zm, *mp = t + ym + zp, *pp = t + yp + zp;
-              switch (z) {
-                case both:
-                  for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = reflections(mm, pm, mp, pp, xm[p0], xp[p0]);
-                  break;
-                case minus_only:
-                  for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = reflections(mm, pm, xm[p0], xp[p0]);
-                  break;
-                case plus_only:
-                  for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = -reflections(mp, pp, xm[p0], xp[p0]);
-                  break;
-                case neither:
-                  std::fill(o, o + na0, 0.0);
-              }
+            double* block = column + p2 * na1 * na0;  // rows p1 of plane p2, na0 each
+            // The terms of the planes held elsewhere are zeros: skipped (the same bits).
+            const Held z = held(zm, zp, zeros_);
+            if (z == neither) {
+              std::fill(block, block + na1 * na0, 0.0);
+              continue;
             }
+            const auto rows = [&](const auto& row) {
+              for (std::size_t p1 = 0; p1 < na1; ++p1) row(block + p1 * na0, minus[1][q1 * na1 + p1], q1 * na1 + p1);
+            };
+            if (periodic_)
+              rows([&](double* o, std::size_t ym, std::size_t) {
+                for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = t[zm + ym + xm[p0]];
+              });
+            else if (z == both)
+              rows([&](double* o, std::size_t ym, std::size_t at) {
+                const std::size_t yp = plus[1][at];
+                const double *mm = t + ym + zm, *pm = t + yp + zm, *mp = t + ym + zp, *pp = t + yp + zp;
+                for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = reflections(mm, pm, mp, pp, xm[p0], xp[p0]);
+              });
+            else if (z == minus_only)
+              rows([&](double* o, std::size_t ym, std::size_t at) {
+                const double *mm = t + ym + zm, *pm = t + plus[1][at] + zm;
+                for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = reflections(mm, pm, xm[p0], xp[p0]);
+              });
+            else
+              rows([&](double* o, std::size_t ym, std::size_t at) {
+                const double *mp = t + ym + zp, *pp = t + plus[1][at] + zp;
+                for (std::size_t p0 = 0; p0 < na0; ++p0) o[p0] = -reflections(mp, pp, xm[p0], xp[p0]);
+              });
           }
         }
   }
@@ -225,15 +228,27 @@ void GreenTable<dim>::G(const Index* a, std::size_t n_a, const Index* b, const d
       if (periodic_) {
         for (std::size_t k = 0; k < n_b; ++k)
           if (ym[c[2 * k + 1]] != zeros_) sum += t[ym[c[2 * k + 1]] + xm[c[2 * k]]] * w[k];
+      } else if (!partial_) {
+        for (std::size_t k = 0; k < n_b; ++k) {
+          const int cx = c[2 * k], cy = c[2 * k + 1];
+          sum += reflections(t + ym[cy], t + yp[cy], xm[cx], xp[cx]) * w[k];
+        }
       } else {
         for (std::size_t k = 0; k < n_b; ++k) {
           const int cx = c[2 * k], cy = c[2 * k + 1];
           const double *tm = t + ym[cy], *tp = t + yp[cy];
           switch (held(ym[cy], yp[cy], zeros_)) {  // rows held elsewhere: zeros, skipped (the same bits)
-            case both: sum += reflections(tm, tp, xm[cx], xp[cx]) * w[k]; break;
-            case minus_only: sum += (tm[xm[cx]] - tm[xp[cx]]) * w[k]; break;
-            case plus_only: sum += (-tp[xm[cx]] + tp[xp[cx]]) * w[k]; break;
-            case neither: break;
+            case both:
+              sum += reflections(tm, tp, xm[cx], xp[cx]) * w[k];
+              break;
+            case minus_only:
+              sum += (tm[xm[cx]] - tm[xp[cx]]) * w[k];
+              break;
+            case plus_only:
+              sum += (-tp[xm[cx]] + tp[xp[cx]]) * w[k];
+              break;
+            case neither:
+              break;
           }
         }
       }
@@ -242,16 +257,30 @@ void GreenTable<dim>::G(const Index* a, std::size_t n_a, const Index* b, const d
       if (periodic_) {
         for (std::size_t k = 0; k < n_b; ++k)
           if (zm[c[3 * k + 2]] != zeros_) sum += t[zm[c[3 * k + 2]] + ym[c[3 * k + 1]] + xm[c[3 * k]]] * w[k];
+      } else if (!partial_) {
+        for (std::size_t k = 0; k < n_b; ++k) {
+          const int cx = c[3 * k], cy = c[3 * k + 1], cz = c[3 * k + 2];
+          sum += reflections(t + ym[cy] + zm[cz], t + yp[cy] + zm[cz], t + ym[cy] + zp[cz], t + yp[cy] + zp[cz], xm[cx],
+                             xp[cx]) *
+                 w[k];
+        }
       } else {
         for (std::size_t k = 0; k < n_b; ++k) {
           const int cx = c[3 * k], cy = c[3 * k + 1], cz = c[3 * k + 2];
           const double *mm = t + ym[cy] + zm[cz], *pm = t + yp[cy] + zm[cz], *mp = t + ym[cy] + zp[cz],
                        *pp = t + yp[cy] + zp[cz];
           switch (held(zm[cz], zp[cz], zeros_)) {  // planes held elsewhere: zeros, skipped (the same bits)
-            case both: sum += reflections(mm, pm, mp, pp, xm[cx], xp[cx]) * w[k]; break;
-            case minus_only: sum += reflections(mm, pm, xm[cx], xp[cx]) * w[k]; break;
-            case plus_only: sum += -reflections(mp, pp, xm[cx], xp[cx]) * w[k]; break;
-            case neither: break;
+            case both:
+              sum += reflections(mm, pm, mp, pp, xm[cx], xp[cx]) * w[k];
+              break;
+            case minus_only:
+              sum += reflections(mm, pm, xm[cx], xp[cx]) * w[k];
+              break;
+            case plus_only:
+              sum += -reflections(mp, pp, xm[cx], xp[cx]) * w[k];
+              break;
+            case neither:
+              break;
           }
         }
       }
