@@ -86,7 +86,7 @@ inline double reflections(const double* tm, const double* tp, std::size_t m, std
 
 /// Which of the two table rows (planes) of a reflection pair, at offsets `minus` and `plus`, this rank
 /// holds: distributed, a row held elsewhere is the zero plane (`zeros`; serially none), and the sums
-/// skip its terms. They are exact zeros, so the sums' bits are those with them.
+/// skip its terms. They are exact zeros, so the sums' bits are those with them (up to the sign of a zero).
 enum Held { both, minus_only, plus_only, neither };
 inline Held held(std::size_t minus, std::size_t plus, std::size_t zeros) {
   return minus != zeros ? (plus != zeros ? both : minus_only) : (plus != zeros ? plus_only : neither);
@@ -227,7 +227,7 @@ void GreenTable<dim>::G(const Index* a, std::size_t n_a, const Index* b, const d
     if constexpr (dim == 2) {
       if (periodic_) {
         for (std::size_t k = 0; k < n_b; ++k)
-          if (ym[c[2 * k + 1]] != zeros_) sum += t[ym[c[2 * k + 1]] + xm[c[2 * k]]] * w[k];
+          if (!partial_ || ym[c[2 * k + 1]] != zeros_) sum += t[ym[c[2 * k + 1]] + xm[c[2 * k]]] * w[k];
       } else if (!partial_) {
         for (std::size_t k = 0; k < n_b; ++k) {
           const int cx = c[2 * k], cy = c[2 * k + 1];
@@ -256,7 +256,8 @@ void GreenTable<dim>::G(const Index* a, std::size_t n_a, const Index* b, const d
       const std::size_t *zm = offsets.data() + minus_at[2], *zp = offsets.data() + plus_at[2];
       if (periodic_) {
         for (std::size_t k = 0; k < n_b; ++k)
-          if (zm[c[3 * k + 2]] != zeros_) sum += t[zm[c[3 * k + 2]] + ym[c[3 * k + 1]] + xm[c[3 * k]]] * w[k];
+          if (!partial_ || zm[c[3 * k + 2]] != zeros_)
+            sum += t[zm[c[3 * k + 2]] + ym[c[3 * k + 1]] + xm[c[3 * k]]] * w[k];
       } else if (!partial_) {
         for (std::size_t k = 0; k < n_b; ++k) {
           const int cx = c[3 * k], cy = c[3 * k + 1], cz = c[3 * k + 2];

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <exception>
 #include <stdexcept>
 #include <unordered_map>
@@ -80,6 +81,15 @@ LinearSolveReport SettlingSchur::solve(const ActiveSet& active, const Eigen::Vec
 }
 
 namespace {
+
+/// Rethrows a failure of this rank's threads; distributed, after all ranks agree that one failed (a
+/// failure may be one rank's alone, as an allocation of its own groups' LUs), so that none is left
+/// waiting in the next sum.
+void rethrow_together(const std::exception_ptr& failure, const Distribution* distribution) {
+  if (distribution && !distribution->all(!failure) && !failure)
+    throw std::runtime_error("hierarchical Schur complement: another rank failed (its error is on its stderr)");
+  if (failure) std::rethrow_exception(failure);
+}
 
 using RowMajorSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
@@ -158,7 +168,7 @@ struct HierarchicalSchur::Impl {
 #pragma omp critical(fictus_hierarchical_failure)
         if (!failure) failure = std::current_exception();
       }
-    if (failure) std::rethrow_exception(failure);
+    rethrow_together(failure, blocks.distribution.get());
     if (blocks.distribution) made = int(blocks.distribution->sum(double(made)));  // every rank's groups
     factorizations += made;
   }
@@ -224,11 +234,14 @@ HierarchicalSchur::HierarchicalSchur(const GreenTable<dim>& green, const SparseR
   const int rank = distribution ? distribution->rank() : 0;
   s.mine.resize(n_groups);
   for (std::size_t g = 0; g < n_groups; ++g) s.mine[g] = owner[g] == rank;
-  constexpr std::size_t batch = std::size_t(1) << 22;  // doubles (32 MiB) of blocks at a time
+  // Distributed: 32 MiB of blocks at a time (one message each, as sum_over_ranks sends them); serially
+  // all at once.
+  const std::size_t batch = distribution ? std::size_t(1) << 22 : SIZE_MAX;
+  const auto numbers_of = [&](std::size_t g) { return 2 * s.groups[g].size() * s.groups[g].size(); };
   for (std::size_t first = 0, last = 0; first < n_groups; first = last) {
     std::size_t numbers = 0;
-    for (last = first; last < n_groups && (last == first || numbers <= batch); ++last)
-      numbers += 2 * s.groups[last].size() * s.groups[last].size();
+    for (last = first; last < n_groups && (last == first || numbers + numbers_of(last) <= batch); ++last)
+      numbers += numbers_of(last);
     std::exception_ptr failure;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(s.threads)
     for (std::size_t g = first; g < last; ++g) try {
@@ -238,7 +251,7 @@ HierarchicalSchur::HierarchicalSchur(const GreenTable<dim>& green, const SparseR
 #pragma omp critical(fictus_hierarchical_failure)
         if (!failure) failure = std::current_exception();
       }
-    if (failure) std::rethrow_exception(failure);
+    rethrow_together(failure, distribution);
     if (!distribution) continue;
     std::vector<Eigen::MatrixXd*> parts;
     std::vector<int> part_owner;
@@ -269,6 +282,7 @@ HierarchicalSchur::HierarchicalSchur(const GreenTable<dim>& green, const SparseR
     }
   }
   for (const Eigen::MatrixXd& M : s.diag_B) t.preconditioner_bytes += 3.0 * 8.0 * double(M.size());  // held
+  t.preconditioner_bytes_here = t.preconditioner_bytes;
   if (distribution) {  // the blocks and groups of all ranks
     std::vector<double> totals{t.bytes, t.low_rank_blocks, t.full_blocks, t.preconditioner_bytes};
     distribution->sum(totals);

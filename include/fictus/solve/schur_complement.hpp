@@ -76,9 +76,10 @@ struct SchurStorage {
   double bytes = 0;            // both blocks (distributed: over all ranks, each holding its share)
   double dense_bytes = 0;      // both blocks dense: 2·m²·8
   double low_rank_blocks = 0, full_blocks = 0;
-  int largest_rank = 0;  // of the compressed block that takes the most memory
-  double preconditioner_bytes = 0;
-  double far_fraction = 0;  // of the pairs, interpolated
+  int largest_rank = 0;                  // of the compressed block that takes the most memory
+  double preconditioner_bytes = 0;       // distributed: of all ranks
+  double preconditioner_bytes_here = 0;  // this rank's share
+  double far_fraction = 0;               // of the pairs, interpolated
   double seconds_assembly = 0;
 };
 
