@@ -687,7 +687,7 @@ void BlockAssembly<dim>::fill_kept(const Piece& piece) {
       else
         piece(b, s);
     });
-    sum_over_ranks(distribution, summed, &summed_owner);
+    sum_onto_owners(distribution, summed, summed_owner);
     each(kept_far.size(), [&](std::size_t a, Scratch& s) {
       const std::size_t k = kept_far[a];
       std::vector<Eigen::MatrixXd> unused;
@@ -794,41 +794,29 @@ std::vector<int> share_out(const std::vector<double>& work, int ranks) {
   return owner;
 }
 
-void sum_over_ranks(const Distribution& distribution, const std::vector<Eigen::MatrixXd*>& mats,
-                    const std::vector<int>* owners) {
+void sum_onto_owners(const Distribution& distribution, const std::vector<Eigen::MatrixXd*>& mats,
+                     const std::vector<int>& owners) {
   if (!distribution.distributed()) return;
-  if (owners && owners->size() != mats.size()) throw std::logic_error("sum_over_ranks: one owner for each matrix");
+  if (owners.size() != mats.size()) throw std::logic_error("sum_onto_owners: one owner for each matrix");
   std::vector<double> buffer;
-  // One message per chunk, or per owner of a chunk's matrices: every rank takes the same turns.
-  const auto sum = [&](std::size_t first, std::size_t last, int owner) {
-    std::size_t n = 0;
-    for (std::size_t k = first; k < last; ++k)
-      if (owner < 0 || (*owners)[k] == owner) n += std::size_t(mats[k]->size());
-    if (n == 0) return;
-    buffer.resize(n);
-    double* at = buffer.data();
-    for (std::size_t k = first; k < last; ++k)
-      if (owner < 0 || (*owners)[k] == owner) at = std::copy_n(mats[k]->data(), mats[k]->size(), at);
-    if (owner < 0)
-      distribution.sum(buffer.data(), n);
-    else
-      distribution.sum_onto(buffer.data(), n, owner);
-    if (owner >= 0 && owner != distribution.rank()) return;
-    at = buffer.data();
-    for (std::size_t k = first; k < last; ++k)
-      if (owner < 0 || (*owners)[k] == owner) {
-        std::copy_n(at, mats[k]->size(), mats[k]->data());
-        at += mats[k]->size();
-      }
-  };
   for (std::size_t first = 0, last = 0; first < mats.size(); first = last) {
     std::size_t n = 0;
     for (last = first; last < mats.size() && (last == first || n + std::size_t(mats[last]->size()) <= summed_chunk);)
       n += std::size_t(mats[last++]->size());
-    if (!owners)
-      sum(first, last, -1);
-    else
-      for (int r = 0; r < distribution.size(); ++r) sum(first, last, r);
+    for (int owner = 0; owner < distribution.size(); ++owner) {  // one message per owner: the same turns everywhere
+      buffer.clear();
+      for (std::size_t k = first; k < last; ++k)
+        if (owners[k] == owner) buffer.insert(buffer.end(), mats[k]->data(), mats[k]->data() + mats[k]->size());
+      if (buffer.empty()) continue;
+      distribution.sum_onto(buffer.data(), buffer.size(), owner);
+      if (owner != distribution.rank()) continue;
+      const double* at = buffer.data();
+      for (std::size_t k = first; k < last; ++k)
+        if (owners[k] == owner) {
+          std::copy_n(at, mats[k]->size(), mats[k]->data());
+          at += mats[k]->size();
+        }
+    }
   }
 }
 

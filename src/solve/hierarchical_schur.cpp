@@ -234,7 +234,7 @@ HierarchicalSchur::HierarchicalSchur(const GreenTable<dim>& green, const SparseR
   const int rank = distribution ? distribution->rank() : 0;
   s.mine.resize(n_groups);
   for (std::size_t g = 0; g < n_groups; ++g) s.mine[g] = owner[g] == rank;
-  // Distributed: 32 MiB of blocks at a time (one message each, as sum_over_ranks sends them); serially
+  // Distributed: 32 MiB of blocks at a time (one message each, as sum_onto_owners sends them); serially
   // all at once.
   const std::size_t batch = distribution ? std::size_t(1) << 22 : SIZE_MAX;
   const auto numbers_of = [&](std::size_t g) { return 2 * s.groups[g].size() * s.groups[g].size(); };
@@ -259,7 +259,7 @@ HierarchicalSchur::HierarchicalSchur(const GreenTable<dim>& green, const SparseR
       parts.insert(parts.end(), {&s.diag_B[g], &s.diag_C[g]});
       part_owner.insert(part_owner.end(), {owner[g], owner[g]});
     }
-    sum_over_ranks(*distribution, parts, &part_owner);
+    sum_onto_owners(*distribution, parts, part_owner);
     for (std::size_t g = first; g < last; ++g)
       if (!s.mine[g]) s.diag_B[g] = Eigen::MatrixXd(), s.diag_C[g] = Eigen::MatrixXd();
   }

@@ -311,11 +311,11 @@ struct CompressedBlocks {
 /// far (all 0 on one rank). The same answer on every rank for the same work.
 std::vector<int> share_out(const std::vector<double>& work, int ranks);
 
-/// Each matrix ← its sum over the ranks, in messages of about 32 MiB. Serial: unchanged. Collective.
-/// With `owners` (a rank for each matrix, the same on every rank), matrix k is summed onto rank
-/// owners[k] only; on the other ranks it is left as it was.
-void sum_over_ranks(const Distribution& distribution, const std::vector<Eigen::MatrixXd*>& matrices,
-                    const std::vector<int>* owners = nullptr);
+/// Matrix k ← its sum over the ranks on rank owners[k] only (a rank for each matrix, the same on every
+/// rank); on the other ranks it is left as it was. In messages of about 32 MiB. Serial: unchanged.
+/// Collective.
+void sum_onto_owners(const Distribution& distribution, const std::vector<Eigen::MatrixXd*>& matrices,
+                     const std::vector<int>& owners);
 
 /// The relative accuracy of the far blocks' recompression: two orders below the interpolation's own
 /// error (1e-3 … 1e-4), so S̃ steers Newton as well as with 1e-8 (the same steps and fast solves on the
