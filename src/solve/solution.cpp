@@ -129,6 +129,30 @@ double negative_share(const std::array<double, 3>& psi) {
   return alone_negative ? t1 * t2 : 1 - t1 * t2;
 }
 
+/// Whether the polyline p–x–n turns at x by less than 60° (and none of its points coincide): where it
+/// turns more, it does not follow a smooth curve at its spacing.
+bool turns_gently(const Point3& p, const Point3& x, const Point3& n) {
+  const Point3 before = x - p, after = n - x;
+  const double lb = norm(before), la = norm(after);
+  return lb > 0 && la > 0 && dot(before, after) > 0.5 * lb * la;
+}
+
+/// The area between the chord from a to b and the cubic through h, a, b, k (its parameter the distance
+/// along the polyline h–a–b–k), positive where the cubic lies on the side opposite `across`. The cubic
+/// less the chord is D(t) = t(t − ℓ)(α + βt), which vanishes at a (t = 0) and b (t = ℓ); its values at h
+/// and k fix α and β, and ∫₀^ℓ D = −αℓ³/6 − βℓ⁴/12. Zero where a turn of the polyline at a or b is 60° or
+/// more (no smooth curve at that spacing) or two of the points coincide.
+double bulge(const Point3& h, const Point3& a, const Point3& b, const Point3& k, const Point3& across) {
+  if (!(turns_gently(h, a, b) && turns_gently(a, b, k))) return 0.0;
+  const Point3 chord = b - a;
+  const double l = norm(chord), th = -norm(a - h), tk = l + norm(k - b);
+  const Point3 dh = h - (a + (th / l) * chord), dk = k - (a + (tk / l) * chord);
+  const double a11 = th * (th - l), a12 = th * a11, a21 = tk * (tk - l), a22 = tk * a21;
+  const double det = a11 * a22 - a12 * a21;  // a11·a21·(tk − th) > 0
+  const Point3 alpha = (1 / det) * (a22 * dh - a12 * dk), beta = (1 / det) * (a11 * dk - a21 * dh);
+  return dot((l * l * l / 6) * alpha + (l * l * l * l / 12) * beta, across);
+}
+
 /// The area of γ's triangles on the contact side of the located boundary (the polyline of
 /// contact_boundary and contact_boundary_lines; end k lies between the active point pair_of_end[k][0]
 /// and its free neighbour pair_of_end[k][1]; `pairs` are the patches' neighbour pairs). ψ at a
@@ -137,7 +161,9 @@ double negative_share(const std::array<double, 3>& psi) {
 /// are nearest (beyond a vertex of the polyline), the sum of their unit normals towards the contact side
 /// decides. Elsewhere a triangle counts by its patch (in contact or not); an end joined to no other acts
 /// as a segment of length 0. Each triangle counts by the share where the linear interpolant of ψ is
-/// negative; only the patches of the located pairs are looked at.
+/// negative; only the patches of the located pairs are looked at. The boundary is a smooth curve, not
+/// its polyline: each segment whose ends have one other neighbour each adds the bulge of the cubic
+/// through the four ends (the chords of a curve of geodesic curvature κ cut off κℓ³/12 each).
 double contact_area_inside(const BasicSolution<3>& s, const std::vector<NeighbourPair>& pairs,
                            const std::vector<std::array<int, 2>>& pair_of_end) {
   struct Segment {
@@ -157,6 +183,19 @@ double contact_area_inside(const BasicSolution<3>& s, const std::vector<Neighbou
     const double length2 = dot(along, along);
     segments.push_back(
         {ends[i], ends[j], unit(length2 > 0 ? toward - (dot(toward, along) / length2) * along : toward)});
+  }
+  std::vector<std::vector<std::size_t>> neighbours(ends.size());
+  for (const auto& [k1, k2] : s.contact_boundary_lines) {
+    neighbours[std::size_t(k1)].push_back(std::size_t(k2));
+    neighbours[std::size_t(k2)].push_back(std::size_t(k1));
+  }
+  double bulges = 0;
+  for (std::size_t g = 0; g < s.contact_boundary_lines.size(); ++g) {
+    const std::size_t i = std::size_t(s.contact_boundary_lines[g][0]), j = std::size_t(s.contact_boundary_lines[g][1]);
+    if (neighbours[i].size() != 2 || neighbours[j].size() != 2) continue;
+    const std::size_t h = neighbours[i][0] == j ? neighbours[i][1] : neighbours[i][0];
+    const std::size_t k = neighbours[j][0] == i ? neighbours[j][1] : neighbours[j][0];
+    if (h != j && k != i && h != k) bulges += bulge(ends[h], ends[i], ends[j], ends[k], segments[g].across);
   }
   for (std::size_t k = 0; k < ends.size(); ++k)
     if (!joined[k]) segments.push_back({ends[k], ends[k], towards(k)});
@@ -204,7 +243,7 @@ double contact_area_inside(const BasicSolution<3>& s, const std::vector<Neighbou
                 ? size * negative_share({psi(tri.a, patch), psi(tri.b, patch), psi(tri.c, patch)})
                 : (s.in_contact(patch) ? size : 0.0);
   }
-  return area;
+  return area + bulges;
 }
 
 }  // namespace

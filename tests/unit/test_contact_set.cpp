@@ -65,11 +65,14 @@ TEST(ContactSet, CapOfASphereFromGenericEnds) {
     EXPECT_LT(std::abs(located), 0.01);
     squares_located += located * located;
   }
-  // Measured: at most 0.13 s and 0.57 %, rms 0.44 % (the end model takes the pair's direction for the
-  // boundary's normal, which puts ends on oblique pairs a little outside: +0.03 s on average). The
-  // statuses here are exact, so the whole patches are as close (rms 0.35 %); in a solve they are not
-  // (bench/results/2026-11-28-contact-measure-3d.md).
-  EXPECT_LT(std::sqrt(squares_located / caps), 0.006);
+  // Measured: ends at most 0.13 s from the circle, areas +0.34 … +0.79 %, rms 0.55 %. The end's law is
+  // taken along the pair, not across the boundary, which puts ends on oblique pairs a little outside
+  // (+0.03 s on average; across it, the ends came within 0.07 s and the areas within 0.09 %, but on
+  // solved problems the readings' own bias points the other way: bench/results/2026-11-29-contact-
+  // boundary-curve.md). Before the curve's bulges were added the chords cut some of that excess back
+  // (0.30 … 0.57 %, rms 0.44 %). The statuses here are exact, so the whole patches are close too (rms
+  // 0.35 %); in a solve they are not (bench/results/2026-11-28-contact-measure-3d.md).
+  EXPECT_LT(std::sqrt(squares_located / caps), 0.007);
 }
 
 // One patch in contact among free ones, its ends alternately near and far (θ = 0.2 and 0.8 of the way to
