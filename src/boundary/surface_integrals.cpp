@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <map>
 #include <numbers>
 #include <queue>
@@ -80,18 +81,20 @@ const std::vector<TrianglePoint>& degree4_rule() {
 double area(const Triangle3& t) { return 0.5 * norm(cross(t.b - t.a, t.c - t.a)); }
 
 std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Triangle3>& triangles,
-                                         const std::vector<int>& patch_of, int n_patches, const SurfaceMap& onto) {
+                                         const std::vector<int>& patch_of, int n_patches, const SurfaceMap& onto,
+                                         int threads) {
   if (patch_of.size() != triangles.size())
     throw std::invalid_argument("patch_integrals: one patch per triangle is needed");
   const double h = grid.h();
   const Box<3>& box = grid.box();
-  // (patch, k, j, i) and value, for every piece's corner; sorted and merged at the end.
+  // (patch, k, j, i) and value, for every piece's corner; sorted and merged at the end. Each thread
+  // collects the items of one run of consecutive triangles, and the runs are joined in order: the
+  // items, and so the sums, are those of one thread.
   struct Item {
     std::tuple<int, int, int, int> key;
     double value;
   };
-  std::vector<Item> items;
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
+  const auto add_triangle = [&](std::size_t t, auto& items) {
     const int patch = patch_of[t];
     if (patch < 0 || patch >= n_patches) throw std::invalid_argument("patch_integrals: patch out of range");
     const Triangle3& tri = triangles[t];
@@ -137,7 +140,23 @@ std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Tr
         items.push_back({{patch, node[2], node[1], node[0]}, corner_sum[corner]});
       }
     }
-  }
+  };
+  const int teams = std::max(1, threads);
+  std::vector<std::vector<Item>> items_of(static_cast<std::size_t>(teams));
+  std::vector<std::exception_ptr> failure(static_cast<std::size_t>(teams));
+#pragma omp parallel for num_threads(teams) schedule(static, 1)
+  for (int team = 0; team < teams; ++team) try {
+      std::vector<Item>& items = items_of[std::size_t(team)];
+      const std::size_t first = triangles.size() * std::size_t(team) / std::size_t(teams),
+                        last = triangles.size() * std::size_t(team + 1) / std::size_t(teams);
+      for (std::size_t t = first; t < last; ++t) add_triangle(t, items);
+    } catch (...) {
+      failure[std::size_t(team)] = std::current_exception();
+    }
+  for (const std::exception_ptr& e : failure)
+    if (e) std::rethrow_exception(e);
+  std::vector<Item> items;
+  for (std::vector<Item>& run : items_of) items.insert(items.end(), run.begin(), run.end());
   // Sorted by patch, then by the node with i fastest; the sums over equal keys in a fixed order.
   std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.key < b.key; });
   std::vector<PatchWeight> out;

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <exception>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -54,11 +55,26 @@ Eigen::Matrix3d shape_operator(const Point3& gradient, const Matrix3& hessian) {
   return P * H * P / slope;
 }
 
+SurfaceStart surface_start(const Surface& gamma, const Point3& start, double tolerance) {
+  SurfaceStart s;
+  s.point = drop_onto(gamma, start, tolerance);
+  s.gradient = gamma.level_gradient(s.point);
+  s.hessian = gamma.level_hessian(s.point);
+  return s;
+}
+
 SurfaceFoot nearest_point(const Surface& gamma, const Point3& x, const Point3& start, double tolerance) {
-  Point3 p = drop_onto(gamma, start, tolerance);
+  return nearest_point(gamma, x, surface_start(gamma, start, tolerance), tolerance);
+}
+
+SurfaceFoot nearest_point(const Surface& gamma, const Point3& x, const SurfaceStart& start, double tolerance) {
+  // The start's gradient and Hessian stand for the first iteration's, and for the end's where no step
+  // was taken: the same values as computed there (the Hessian at the start is needed either way).
+  Point3 p = start.point;
+  Point3 g = start.gradient;
+  bool moved = false;
   double previous = std::numeric_limits<double>::infinity();
   for (int it = 0; it < 20; ++it) {
-    const Point3 g = gamma.level_gradient(p);
     const double slope = norm(g);
     if (!(slope > 0)) break;
     const Point3 n = (1.0 / slope) * g;
@@ -70,17 +86,19 @@ SurfaceFoot nearest_point(const Surface& gamma, const Point3& x, const Point3& s
     previous = norm(t);
     // (I + d W) δ = t with W = P Hess P / |∇level| the shape operator (P the tangent projector): the
     // step that keeps x − p along the normal to first order; the normal direction is left as is.
-    const Eigen::Matrix3d M = Eigen::Matrix3d::Identity() + d * shape_operator(g, gamma.level_hessian(p));
+    const Eigen::Matrix3d M =
+        Eigen::Matrix3d::Identity() + d * shape_operator(g, it == 0 ? start.hessian : gamma.level_hessian(p));
     const Eigen::Vector3d step = M.partialPivLu().solve(Eigen::Vector3d(t.x, t.y, t.z));
     p = drop_onto(gamma, p + Point3{step[0], step[1], step[2]}, tolerance);
+    moved = true;
+    g = gamma.level_gradient(p);  // the next iteration's, or the end's
   }
   SurfaceFoot k;
   k.foot = p;
-  const Point3 g = gamma.level_gradient(p);
   const double slope = norm(g);
   k.normal = (1.0 / slope) * g;
   k.d = dot(x - p, k.normal);
-  const Matrix3 hessian = gamma.level_hessian(p);
+  const Matrix3 hessian = moved ? gamma.level_hessian(p) : start.hessian;
   const double trace = hessian[0][0] + hessian[1][1] + hessian[2][2];
   k.H = (trace * slope * slope - dot(g, times(hessian, g))) / (slope * slope * slope);
   const Eigen::Matrix3d W = shape_operator(g, hessian);
@@ -453,6 +471,7 @@ void SurfaceKink::State::Build::voxel_residual(const Grid3::Index& cell_index, s
   const Point3 lower{grid.x(cell[0]), grid.y(cell[1]), grid.z(cell[2])};
   const Point3 center = lower + Point3{h / 2, h / 2, h / 2};
   const SurfaceFoot centre = nearest_point(gamma, center, center, tolerance);
+  const SurfaceStart from_centre = surface_start(gamma, centre.foot, tolerance);  // every point's start
   locate.near(centre.foot, near);
   // The triangles that can hold the feet within `spread` of the centre's (the margin covers the
   // triangles' distance from γ): each point's patch is sought among those alone.
@@ -467,7 +486,7 @@ void SurfaceKink::State::Build::voxel_residual(const Grid3::Index& cell_index, s
     return sums.emplace_back(patch, std::array<double, 8>{}).second;
   };
   auto add_point = [&](const Point3& x, double w) {
-    const SurfaceFoot foot = nearest_point(gamma, x, centre.foot, tolerance);
+    const SurfaceFoot foot = nearest_point(gamma, x, from_centre, tolerance);
     const bool close = norm(foot.foot - centre.foot) <= spread && !local.empty();
     const std::vector<int>& pool = close ? local : near;
     const int patch = close && one_patch ? patches.patch_of[std::size_t(local[0])]

@@ -40,6 +40,28 @@ TEST(Expression, BatchesEqualPointwiseValues) {
   EXPECT_EQ(fictus::Expression("_e", {"x"}, "data.f")({0.0}), std::numbers::e);
 }
 
+// Squares of parenthesised bases and calls are evaluated as products (std::pow was a third of the time
+// of a level function's evaluation), and nothing else changes: "^" is right-associative and binds
+// tighter than the sign. The values below are those of std::pow to the last bit (std::pow is one unit
+// in the last place off the correctly rounded square for about 1 in 1200 values, none of these).
+TEST(Expression, SquaresAsProductsKeepTheValues) {
+  EXPECT_EQ(fictus::squares_as_products("(x - 0.49)^2 + (y)^ 2"), "__fictus_square((x - 0.49)) + __fictus_square((y))");
+  EXPECT_EQ(fictus::squares_as_products("((x)^2 + sin(y)^2)^2"),
+            "__fictus_square((__fictus_square((x)) + __fictus_square(sin(y))))");
+  EXPECT_EQ(fictus::squares_as_products("-(x)^2 + 2^(y)^2"), "-__fictus_square((x)) + 2^__fictus_square((y))");
+  for (const std::string kept : {"x^2", "(x)^2^3", "(x)^2.5", "(x)^20", "(x)^2e1", "(x)^-2", "(x)^(2)", "x)^2", "(x^2"})
+    EXPECT_EQ(fictus::squares_as_products(kept), kept);
+  const fictus::Expression e("a = (x - 0.49)^2, -(y)^2 + 2^(x)^2 + max(x, y)^2 * a + (x)^2^3 + ((x + y)^2)^2",
+                             {"x", "y"}, "data.f");
+  for (const double x : {0.3, -1.7, 12.25})
+    for (const double y : {0.1, 2.5}) {
+      const double a = std::pow(x - 0.49, 2);
+      const double expected = -std::pow(y, 2) + std::pow(2, std::pow(x, 2)) + std::pow(std::max(x, y), 2) * a +
+                              std::pow(x, 8) + std::pow(std::pow(x + y, 2), 2);
+      EXPECT_EQ(e({x, y}), expected) << x << ", " << y;
+    }
+}
+
 TEST(Expression, UnknownOrUnassignedNamesAreErrors) {
   auto message = [](const std::string& text) {
     try {

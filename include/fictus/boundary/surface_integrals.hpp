@@ -30,9 +30,11 @@ struct PatchWeight {
 /// With `onto`, the integrals are over the curved surface the triangles approximate: `onto(x, n, factor)`
 /// maps a point x of a triangle with unit normal n to the surface and sets factor = dS_surface/dS_triangle
 /// there (the quadrature stays the pieces' rule: exact no longer, but free of the triangles' O(h²) offset).
+/// `threads` share the triangles (and may call `onto` at once); the answer does not depend on their number.
 using SurfaceMap = std::function<Point3(const Point3& x, const Point3& normal, double& factor)>;
 std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Triangle3>& triangles,
-                                         const std::vector<int>& patch_of, int n_patches, const SurfaceMap& onto = {});
+                                         const std::vector<int>& patch_of, int n_patches, const SurfaceMap& onto = {},
+                                         int threads = 1);
 
 /// The area of a triangle.
 double area(const Triangle3& t);

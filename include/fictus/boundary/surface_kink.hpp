@@ -53,6 +53,17 @@ Eigen::Matrix3d shape_operator(const Point3& gradient, const Matrix3& hessian);
 /// step (I + d·W)δ = t, W the shape operator, until the tangential residual is below `tolerance`.
 SurfaceFoot nearest_point(const Surface& gamma, const Point3& x, const Point3& start, double tolerance);
 
+/// Where nearest_point begins from `start`: the start dropped onto γ along the level gradient, with the
+/// level's gradient and Hessian there. Points that share a start (a voxel's quadrature points, from the
+/// foot of its centre) share these 32 evaluations of the level function.
+struct SurfaceStart {
+  Point3 point, gradient;
+  Matrix3 hessian;
+};
+SurfaceStart surface_start(const Surface& gamma, const Point3& start, double tolerance);
+/// nearest_point from a start made once: the same answer, to the bit, as from its point.
+SurfaceFoot nearest_point(const Surface& gamma, const Point3& x, const SurfaceStart& start, double tolerance);
+
 /// The map of patch_integrals onto γ itself: a point x of a triangle (unit normal n) goes to its nearest
 /// point of γ, with dS_γ/dS_triangle = |n·n_γ|/(1 + H d) there (d the distance of x, O(h²)).
 SurfaceMap onto_surface(const Surface& gamma, double tolerance);
