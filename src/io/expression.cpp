@@ -189,18 +189,21 @@ Expression::Expression(std::string text, std::vector<std::string> variables, std
       throw std::invalid_argument(shared->key + ": cannot parse \"" + shown(shared->text) + "\": unknown variable \"" +
                                   unknown + "\"" + hint);
     }
+    // The text as evaluated: its squares as products, or the text as given where that does not compile
+    // (past muParser's length limit, or a muParser that refuses a form the given text uses).
+    shared->evaluated = squares_as_products(shared->text);
+    std::unique_ptr<Compiled> evaluated;
+    try {
+      evaluated = compile(shared->evaluated, shared->variables, shared->constants, true);
+      evaluated->parser.Eval();
+    } catch (const mu::Parser::exception_type&) {
+      shared->evaluated = shared->text;
+      evaluated = compile(shared->text, shared->variables, shared->constants, true);
+    }
     bool constant = c->local_names.empty();
     for (const std::string& name : shared->variables)
       constant = constant && find_word(shared->text, name) == std::string::npos;
-    if (constant) shared->constant = c->parser.Eval();
-    // The text as evaluated; should its squares written as products not compile (they always should),
-    // the text as given.
-    shared->evaluated = squares_as_products(shared->text);
-    try {
-      compile(shared->evaluated, shared->variables, shared->constants, true)->parser.Eval();
-    } catch (const mu::Parser::exception_type&) {
-      shared->evaluated = shared->text;
-    }
+    if (constant) shared->constant = evaluated->parser.Eval();  // the value evaluate() and operator() give
   } catch (const mu::Parser::exception_type& e) {
     for (const auto& [name, value] : shared->constants) {  // "a = …" where a is a parameter
       const std::size_t at = find_word(shared->text, name);
