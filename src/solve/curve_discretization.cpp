@@ -79,38 +79,38 @@ OffsetRoom curve_offset_room(std::shared_ptr<const Curve> gamma, const Box2& box
 
 }  // namespace
 
-std::vector<PointCondition> CurveDiscretization::part_layout(const PartConditions<2>& parts) const {
-  if (!parts.mixed()) return {};
+std::vector<int> CurveDiscretization::part_layout(const PartConditions<2>& parts) const {
+  if (!parts.placed()) return {};
   const int samples = std::max(4096, 16 * spacing_.m);
-  std::vector<PointCondition> layout(static_cast<std::size_t>(samples));
+  std::vector<int> layout(static_cast<std::size_t>(samples));
   for (int k = 0; k < samples; ++k)
-    layout[std::size_t(k)] = parts.at(gamma_->position(2 * std::numbers::pi * (k + 0.5) / samples));
+    layout[std::size_t(k)] = parts.label(gamma_->position(2 * std::numbers::pi * (k + 0.5) / samples));
   return layout;
 }
 
 bool CurveDiscretization::same_parts(const PartConditions<2>& parts) const {
-  const std::vector<PointCondition> layout = part_layout(parts);
+  const std::vector<int> layout = part_layout(parts);
   if (layout != part_layout_) return false;
-  const std::vector<std::pair<double, PointCondition>> now = junctions(parts, layout);
+  const std::vector<std::pair<double, int>> now = junctions(parts, layout);
   if (now.size() != junctions_.size()) return false;
   for (std::size_t k = 0; k < now.size(); ++k)
     if (now[k].second != junctions_[k].second || std::abs(now[k].first - junctions_[k].first) > 1e-12) return false;
   return true;
 }
 
-std::vector<std::pair<double, PointCondition>> CurveDiscretization::junctions(
-    const PartConditions<2>& parts, const std::vector<PointCondition>& layout) const {
-  std::vector<std::pair<double, PointCondition>> out;
+std::vector<std::pair<double, int>> CurveDiscretization::junctions(const PartConditions<2>& parts,
+                                                                   const std::vector<int>& layout) const {
+  std::vector<std::pair<double, int>> out;
   const int samples = int(layout.size());
   if (samples == 0) return out;
   const double step = 2 * std::numbers::pi / samples;
   for (int k = 0; k < samples; ++k) {
-    const PointCondition before = layout[std::size_t(k)], after = layout[std::size_t(k + 1) % std::size_t(samples)];
+    const int before = layout[std::size_t(k)], after = layout[std::size_t(k + 1) % std::size_t(samples)];
     if (before == after) continue;
     double lo = (k + 0.5) * step, hi = lo + step;
     for (int i = 0; i < 60; ++i) {
       const double t = 0.5 * (lo + hi);
-      (parts.at(gamma_->position(std::fmod(t, 2 * std::numbers::pi))) == before ? lo : hi) = t;
+      (parts.label(gamma_->position(std::fmod(t, 2 * std::numbers::pi))) == before ? lo : hi) = t;
     }
     out.emplace_back(std::fmod(0.5 * (lo + hi), 2 * std::numbers::pi), after);
   }
@@ -160,7 +160,7 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
   // otherwise keep the points away from), so that each point's arc lies in one part.
   part_layout_ = part_layout(parts);
   junctions_ = junctions(parts, part_layout_);
-  const std::vector<std::pair<double, PointCondition>>& joins = junctions_;
+  const std::vector<std::pair<double, int>>& joins = junctions_;
   std::vector<double> breaks;
   for (const auto& [t, part] : joins) breaks.push_back(t);
   // The corners too (non-smooth), where they are few: one within a quarter spacing of a junction is
@@ -177,12 +177,13 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
     }
   const auto set_point_parts = [&]() {
     if (part_layout_.empty()) return;
-    point_parts_.assign(std::size_t(m), part_layout_[0]);
+    point_parts_.assign(std::size_t(m), PartConditions<2>::condition_of(part_layout_[0]));
     if (joins.empty()) return;
     for (int i = 0; i < m; ++i) {  // the part after the last junction before t_i (cyclically)
       const double t = collocation_.t[std::size_t(i)];
       auto it = std::upper_bound(joins.begin(), joins.end(), t, [](double v, const auto& j) { return v < j.first; });
-      point_parts_[std::size_t(i)] = (it == joins.begin() ? joins.back() : *std::prev(it)).second;
+      point_parts_[std::size_t(i)] =
+          PartConditions<2>::condition_of((it == joins.begin() ? joins.back() : *std::prev(it)).second);
     }
   };
   if (options.variant == Variant::nonsmooth) {

@@ -864,28 +864,97 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
   Eigen::setNbThreads(st.execution.threads());  // the dense LU of the Newton steps follows the threads option
   BasicSolution<dim> sol(st.grid);
   PhaseClock clock(sol.timings, st.execution);
-  BoundarySetup<dim>& setup = boundary_setup<dim>(st, data, options, clock, sol.reused_curve);  // 1–2
-  obstacle_and_conditions<dim>(*setup.boundary, data, st.c, sol);                               // 4
-  st.execution.throw_if_interrupted();
   ActiveSet start;
-  const std::optional<BasicSolution<dim>> coarse =
-      coarse_step<dim>(st, data, options, compute_field, *setup.boundary, clock, start, sol);
-  load_and_u0<dim>(st, clock, sol.fast_solves);  // 0
-  st.execution.throw_if_interrupted();
-  const bool made = !setup.schur;
-  schur_blocks<dim>(st, setup, options, clock, keep);  // 2b–3
-  if (made) sol.fast_solves += setup.fast_solves;
-  load_terms<dim>(st, setup);
+  std::optional<BasicSolution<dim>> coarse;
+  // solver.fit_contact: each solve after the first places its points to the contact boundary the one
+  // before located (docs/math.md, "Fitting the points to the contact set").
+  BasicContactData<dim> fitted;
+  const BasicContactData<dim>* current = &data;
+  std::vector<Point<dim>> placed_for;  // the located ends the points were placed for
+  for (int pass = 0;; ++pass) {
+    const std::size_t pass_begins = sol.timings.phases.size();
+    BoundarySetup<dim>& setup = boundary_setup<dim>(st, *current, options, clock, sol.reused_curve);  // 1–2
+    obstacle_and_conditions<dim>(*setup.boundary, *current, st.c, sol);                               // 4
+    st.execution.throw_if_interrupted();
+    if (pass > 0) {  // Newton starts from the contact side at the new points
+      const std::vector<Point<dim>>& x = setup.boundary->points();
+      start.assign(x.size(), 0);
+      for (std::size_t i = 0; i < x.size(); ++i) start[i] = char(fitted.conditions.contact_side(x[i]) != 0);
+    }
+    if (pass == 0) coarse = coarse_step<dim>(st, data, options, compute_field, *setup.boundary, clock, start, sol);
+    load_and_u0<dim>(st, clock, sol.fast_solves);  // 0
+    st.execution.throw_if_interrupted();
+    const bool made = !setup.schur;
+    const bool last = pass >= options.fit_contact;
+    schur_blocks<dim>(st, setup, options, clock, keep || !last);  // 2b–3
+    if (made) sol.fast_solves += setup.fast_solves;
+    load_terms<dim>(st, setup);
+    const BoundaryDiscretization<dim>& boundary = *setup.boundary;
+    boundary.describe(sol);
+    locate_junctions<dim>(*current, sol);
+    junction_warning<dim>(boundary, *current, sol);
+    sol.delta = boundary.delta();
+    sol.flux_balance = boundary.flux_balance(setup.shift);
+    newton<dim>(st, setup, options, start, sol);  // 5
+    clock.mark("newton");
+    st.execution.throw_if_interrupted();
+    if (pass > 0) {
+      // How far the ends now located lie from those the points were placed for.
+      sol.trace.assign(sol.newton.trace.data(), sol.newton.trace.data() + sol.newton.trace.size());
+      sol.normal_derivative.assign(sol.newton.normal_derivative.data(),
+                                   sol.newton.normal_derivative.data() + sol.newton.normal_derivative.size());
+      resolve_contact<dim>(sol);
+      double moved = 0;
+      for (const Point<dim>& e : sol.contact_boundary) {
+        double nearest = std::numeric_limits<double>::infinity();
+        for (const Point<dim>& p : placed_for) nearest = std::min(nearest, norm(e - p));
+        moved = std::max(moved, nearest);
+      }
+      sol.contact_fit->moved.push_back(moved / sol.spacing());
+      sol.contact_fit->newton_steps.push_back(sol.newton.iterations);
+    }
+    if (!last && sol.newton.converged) {
+      if (pass == 0) {
+        sol.trace.assign(sol.newton.trace.data(), sol.newton.trace.data() + sol.newton.trace.size());
+        sol.normal_derivative.assign(sol.newton.normal_derivative.data(),
+                                     sol.newton.normal_derivative.data() + sol.newton.normal_derivative.size());
+        resolve_contact<dim>(sol);
+      }
+      std::function<double(const Point<dim>&)> side = contact_side<dim>(sol);
+      if (side) {
+        if (!sol.contact_fit) sol.contact_fit.emplace(), sol.contact_fit->newton_steps.push_back(sol.newton.iterations);
+        ++sol.contact_fit->passes;
+        placed_for = sol.contact_boundary;
+        fitted = data;
+        fitted.conditions.contact_side = side;
+        current = &fitted;
+        st.setup.reset();  // the points move: new rows and blocks
+        // This pass's phases (but the coarse solve and u₀, made once) become one: fit_contact.
+        std::vector<std::pair<std::string, double>>& phases = sol.timings.phases;
+        double seconds = 0;
+        for (std::size_t k = pass_begins; k < phases.size();) {
+          const std::string& name = phases[k].first;
+          if (name == "coarse_solve" || name == "nested_start" || name == "load" || name == "u0") {
+            ++k;
+            continue;
+          }
+          seconds += phases[k].second;
+          phases.erase(phases.begin() + std::ptrdiff_t(k));
+        }
+        sol.contact_fit->seconds += seconds;
+        const auto earlier = std::find_if(phases.begin(), phases.end(), [](const auto& p) { return p.first == "fit_contact"; });
+        if (earlier == phases.end())
+          phases.emplace_back("fit_contact", seconds);
+        else
+          earlier->second += seconds;
+        continue;
+      }
+    }
+    if (!keep) setup.schur.reset(), setup.exact.reset();  // S_B, S_C and the kept LU: freed before the field
+    break;
+  }
+  BoundarySetup<dim>& setup = *st.setup;
   const BoundaryDiscretization<dim>& boundary = *setup.boundary;
-  boundary.describe(sol);
-  locate_junctions<dim>(data, sol);
-  junction_warning<dim>(boundary, data, sol);
-  sol.delta = boundary.delta();
-  sol.flux_balance = boundary.flux_balance(setup.shift);
-  newton<dim>(st, setup, options, start, sol);          // 5
-  if (!keep) setup.schur.reset(), setup.exact.reset();  // S_B, S_C and the kept LU: freed before the field
-  clock.mark("newton");
-  st.execution.throw_if_interrupted();
   if (compute_field) {  // 6
     field<dim>(st, setup, sol);
     if (!keep) st.u0 = GridVector(), st.have_u0 = false;
@@ -900,11 +969,11 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
   resolve_contact<dim>(sol);
   if (compute_field) clock.mark("check");
   if ((data.exact || data.exact_vectorized) && compute_field) {  // 8
-    errors<dim>(st, boundary, data, options, sol);
+    errors<dim>(st, boundary, *current, options, sol);
     clock.mark("errors");
   }
   if (compute_field) {  // 9–10
-    quantities_step<dim>(st, boundary, data, coarse, sol);
+    quantities_step<dim>(st, boundary, *current, coarse, sol);
     clock.mark("quantities");
   }
   sol.options = options;

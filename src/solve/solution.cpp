@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <functional>
 #include <map>
+#include <memory>
 #include <set>
 #include <tuple>
 
@@ -153,37 +155,76 @@ double bulge(const Point3& h, const Point3& a, const Point3& b, const Point3& k,
   return dot((l * l * l / 6) * alpha + (l * l * l * l / 12) * beta, across);
 }
 
-/// The area of γ's triangles on the contact side of the located boundary (the polyline of
-/// contact_boundary and contact_boundary_lines; end k lies between the active point pair_of_end[k][0]
-/// and its free neighbour pair_of_end[k][1]; `pairs` are the patches' neighbour pairs). ψ at a
-/// triangle's corner is its distance to the nearest segment, negative on that segment's contact side
-/// (that of the active points of its ends), where that distance is below 1.5·s; where several segments
-/// are nearest (beyond a vertex of the polyline), the sum of their unit normals towards the contact side
-/// decides. Elsewhere a triangle counts by its patch (in contact or not); an end joined to no other acts
-/// as a segment of length 0. Each triangle counts by the share where the linear interpolant of ψ is
-/// negative; only the patches of the located pairs are looked at. The boundary is a smooth curve, not
-/// its polyline: each segment whose ends have one other neighbour each adds the bulge of the cubic
-/// through the four ends (the chords of a curve of geodesic curvature κ cut off κℓ³/12 each).
-double contact_area_inside(const BasicSolution<3>& s, const std::vector<NeighbourPair>& pairs,
-                           const std::vector<std::array<int, 2>>& pair_of_end) {
-  struct Segment {
-    Point3 a, b, across;  // ends, and the unit normal across it towards the contact side
-  };
-  const std::vector<Point3>& ends = s.contact_boundary;
-  std::vector<Segment> segments;
-  std::vector<bool> joined(ends.size(), false);
-  const auto unit = [](const Point3& v) { return norm(v) > 0 ? (1 / norm(v)) * v : v; };
+/// A piece of the located contact boundary: a segment between two consecutive ends (3-D), or one end
+/// joined to no other (a = b; every end in 2-D), with the unit normal across it towards the contact side
+/// (that of the active points of its ends).
+template <int dim>
+struct Segment {
+  Point<dim> a, b, across;
+};
+
+template <int dim>
+Point<dim> unit(const Point<dim>& v) {
+  return norm(v) > 0 ? (1 / norm(v)) * v : v;
+}
+
+/// The segments of s's located boundary: its lines, then the ends on none.
+template <int dim>
+std::vector<Segment<dim>> located_segments(const BasicSolution<dim>& s) {
+  const std::vector<Point<dim>>& ends = s.contact_boundary;
   const auto towards = [&](std::size_t k) {  // from the free point to the active one: never 0
-    return unit(s.gamma.point[std::size_t(pair_of_end[k][0])] - s.gamma.point[std::size_t(pair_of_end[k][1])]);
+    const std::array<int, 2>& pair = s.contact_boundary_pairs[k];
+    return unit<dim>(s.points()[std::size_t(pair[0])] - s.points()[std::size_t(pair[1])]);
   };
+  std::vector<Segment<dim>> segments;
+  std::vector<bool> joined(ends.size(), false);
   for (const auto& [k1, k2] : s.contact_boundary_lines) {
     const std::size_t i = std::size_t(k1), j = std::size_t(k2);
     joined[i] = joined[j] = true;
-    const Point3 along = ends[j] - ends[i], toward = towards(i) + towards(j);
+    const Point<dim> along = ends[j] - ends[i], toward = towards(i) + towards(j);
     const double length2 = dot(along, along);
     segments.push_back(
-        {ends[i], ends[j], unit(length2 > 0 ? toward - (dot(toward, along) / length2) * along : toward)});
+        {ends[i], ends[j], unit<dim>(length2 > 0 ? toward - (dot(toward, along) / length2) * along : toward)});
   }
+  for (std::size_t k = 0; k < ends.size(); ++k)
+    if (!joined[k]) segments.push_back({ends[k], ends[k], towards(k)});
+  return segments;
+}
+
+/// x minus its nearest point of g.
+template <int dim>
+Point<dim> offset_from(const Point<dim>& x, const Segment<dim>& g) {
+  const Point<dim> along = g.b - g.a;
+  const double length2 = dot(along, along);
+  return x - (g.a + (length2 > 0 ? std::clamp(dot(x - g.a, along) / length2, 0.0, 1.0) : 0.0) * along);
+}
+
+/// ψ at x: the distance to the nearest of the `candidates`, negative on its contact side; where several
+/// are nearest (beyond a vertex of the polyline), the sum of their unit normals towards the contact side
+/// decides. `outside` where none comes within `reach`.
+template <int dim>
+double signed_distance(const Point<dim>& x, const std::vector<const Segment<dim>*>& candidates, double reach,
+                       double outside) {
+  double nearest = reach;
+  for (const Segment<dim>* g : candidates) nearest = std::min(nearest, norm(offset_from(x, *g)));
+  if (!(nearest < reach)) return outside;
+  double side = 0;  // Σ over the nearest segments of offset·normal
+  for (const Segment<dim>* g : candidates) {
+    const Point<dim> offset = offset_from(x, *g);
+    if (norm(offset) <= nearest + 1e-12 * reach) side += dot(offset, g->across);
+  }
+  return side > 0 ? -nearest : nearest;
+}
+
+/// The area of γ's triangles on the contact side of the located boundary (located_segments). ψ at a
+/// triangle's corner is signed_distance within 1.5·s; elsewhere a triangle counts by its patch (in
+/// contact or not). Each triangle counts by the share where the linear interpolant of ψ is negative;
+/// only the patches of the located pairs are looked at. The boundary is a smooth curve, not its
+/// polyline: each segment whose ends have one other neighbour each adds the bulge of the cubic through
+/// the four ends (the chords of a curve of geodesic curvature κ cut off κℓ³/12 each).
+double contact_area_inside(const BasicSolution<3>& s, const std::vector<NeighbourPair>& pairs) {
+  const std::vector<Point3>& ends = s.contact_boundary;
+  const std::vector<Segment<3>> segments = located_segments(s);
   std::vector<std::vector<std::size_t>> neighbours(ends.size());
   for (const auto& [k1, k2] : s.contact_boundary_lines) {
     neighbours[std::size_t(k1)].push_back(std::size_t(k2));
@@ -197,17 +238,10 @@ double contact_area_inside(const BasicSolution<3>& s, const std::vector<Neighbou
     const std::size_t k = neighbours[j][0] == i ? neighbours[j][1] : neighbours[j][0];
     if (h != j && k != i && h != k) bulges += bulge(ends[h], ends[i], ends[j], ends[k], segments[g].across);
   }
-  for (std::size_t k = 0; k < ends.size(); ++k)
-    if (!joined[k]) segments.push_back({ends[k], ends[k], towards(k)});
   std::vector<bool> located(std::size_t(s.gamma.m), false);  // patches of a located pair
   for (const NeighbourPair& p : pairs)
     if (s.in_contact(p.i) != s.in_contact(p.j)) located[std::size_t(p.i)] = located[std::size_t(p.j)] = true;
   const double reach = 1.5 * s.spacing();
-  const auto offset_from = [](const Point3& x, const Segment& g) {  // x minus its nearest point of g
-    const Point3 along = g.b - g.a;
-    const double length2 = dot(along, along);
-    return x - (g.a + (length2 > 0 ? std::clamp(dot(x - g.a, along) / length2, 0.0, 1.0) : 0.0) * along);
-  };
   // Each located patch looks only at the segments that can come within the reach of its triangles'
   // corners (the same answer as looking at all: its corners lie within `radius` of its point).
   std::vector<double> radius(std::size_t(s.gamma.m), 0.0);
@@ -217,21 +251,13 @@ double contact_area_inside(const BasicSolution<3>& s, const std::vector<Neighbou
     for (const Point3& x : {tri.a, tri.b, tri.c})
       radius[patch] = std::max(radius[patch], norm(x - s.gamma.point[patch]));
   }
-  std::vector<std::vector<const Segment*>> near(std::size_t(s.gamma.m));
+  std::vector<std::vector<const Segment<3>*>> near(std::size_t(s.gamma.m));
   for (std::size_t p = 0; p < near.size(); ++p)
     if (located[p])
-      for (const Segment& g : segments)
+      for (const Segment<3>& g : segments)
         if (norm(offset_from(s.gamma.point[p], g)) < radius[p] + reach) near[p].push_back(&g);
   const auto psi = [&](const Point3& x, int patch) {
-    double nearest = reach;
-    for (const Segment* g : near[std::size_t(patch)]) nearest = std::min(nearest, norm(offset_from(x, *g)));
-    if (!(nearest < reach)) return s.in_contact(patch) ? -reach : reach;
-    double side = 0;  // Σ over the nearest segments of offset·normal
-    for (const Segment* g : near[std::size_t(patch)]) {
-      const Point3 offset = offset_from(x, *g);
-      if (norm(offset) <= nearest + 1e-12 * reach) side += dot(offset, g->across);
-    }
-    return side > 0 ? -nearest : nearest;
+    return signed_distance(x, near[std::size_t(patch)], reach, s.in_contact(patch) ? -reach : reach);
   };
   double area = 0;
   for (std::size_t t = 0; t < s.gamma.triangles.size(); ++t) {
@@ -246,6 +272,40 @@ double contact_area_inside(const BasicSolution<3>& s, const std::vector<Neighbou
   return area + bulges;
 }
 
+/// Cubes of side `size` holding indices, for the searches near a point.
+template <int dim>
+class Buckets {
+ public:
+  explicit Buckets(double size) : size_(size) {}
+  std::array<long, dim> cell(const Point<dim>& x) const {
+    std::array<long, dim> c;
+    for (int d = 0; d < dim; ++d) c[std::size_t(d)] = long(std::floor(x[d] / size_));
+    return c;
+  }
+  void add(const std::array<long, dim>& c, int index) { cells_[c].push_back(index); }
+  const std::vector<int>* at(const std::array<long, dim>& c) const {
+    const auto it = cells_.find(c);
+    return it == cells_.end() ? nullptr : &it->second;
+  }
+  /// Calls visit(c) for the cells within `rings` cells of c (in every coordinate).
+  template <typename Visit>
+  static void around(const std::array<long, dim>& c, long rings, Visit&& visit) {
+    std::array<long, dim> k = c;
+    for (int d = 0; d < dim; ++d) k[std::size_t(d)] = c[std::size_t(d)] - rings;
+    while (true) {
+      visit(k);
+      int d = 0;
+      while (d < dim && ++k[std::size_t(d)] > c[std::size_t(d)] + rings) k[std::size_t(d)] = c[std::size_t(d)] - rings, ++d;
+      if (d == dim) return;
+    }
+  }
+  double size() const { return size_; }
+
+ private:
+  double size_;
+  std::map<std::array<long, dim>, std::vector<int>> cells_;
+};
+
 }  // namespace
 
 template <int dim>
@@ -258,8 +318,8 @@ void resolve_contact(BasicSolution<dim>& s) {
   }
   s.contact_boundary.clear();
   s.contact_boundary_lines.clear();
-  std::map<int, std::vector<int>> at_corner;    // 3-D: a mesh vertex → the located ends whose border has it
-  std::vector<std::array<int, 2>> pair_of_end;  // the active and the free point of each located end
+  s.contact_boundary_pairs.clear();
+  std::map<int, std::vector<int>> at_corner;  // 3-D: a mesh vertex → the located ends whose border has it
   const std::vector<NeighbourPair> pairs = neighbour_pairs<dim>(s);
   for (const NeighbourPair& p : pairs) {
     if (s.condition(p.i) != PointCondition::signorini || s.condition(p.j) != PointCondition::signorini) continue;
@@ -273,7 +333,7 @@ void resolve_contact(BasicSolution<dim>& s) {
       measure += (theta * p.distance - owned) * p.border;
     }
     for (int corner : p.corners) at_corner[corner].push_back(int(s.contact_boundary.size()));
-    pair_of_end.push_back({a, b});
+    s.contact_boundary_pairs.push_back({a, b});
     s.contact_boundary.push_back(s.points()[std::size_t(a)] +
                                  theta * (s.points()[std::size_t(b)] - s.points()[std::size_t(a)]));
   }
@@ -287,8 +347,66 @@ void resolve_contact(BasicSolution<dim>& s) {
   }
   s.contact_boundary_lines.assign(lines.begin(), lines.end());
   // On a surface the measure is the area inside the located boundary (docs/math.md, "The contact set").
-  if constexpr (dim == 3) measure = contact_area_inside(s, pairs, pair_of_end);
+  if constexpr (dim == 3) measure = contact_area_inside(s, pairs);
   s.contact_measure = std::clamp(measure, 0.0, total);
+}
+
+template <int dim>
+std::function<double(const Point<dim>&)> contact_side(const BasicSolution<dim>& s) {
+  if (s.contact_boundary.empty()) return {};
+  struct Side {
+    std::vector<Segment<dim>> segments;
+    std::vector<Point<dim>> points;
+    std::vector<char> active;
+    Buckets<dim> point_cells, segment_cells;
+    double reach;
+  };
+  const double spacing = s.spacing();
+  auto side = std::make_shared<Side>(Side{located_segments(s), s.points(), {}, Buckets<dim>(spacing),
+                                          Buckets<dim>(spacing), 1.5 * spacing});
+  for (int i = 0; i < s.n_points(); ++i) {
+    side->active.push_back(char(s.in_contact(i)));
+    side->point_cells.add(side->point_cells.cell(s.points()[std::size_t(i)]), i);
+  }
+  // A segment goes into every cell its box, widened by the reach, touches.
+  for (std::size_t k = 0; k < side->segments.size(); ++k) {
+    const Segment<dim>& g = side->segments[k];
+    Point<dim> low = g.a, high = g.a;
+    for (int d = 0; d < dim; ++d)
+      low[d] = std::min(g.a[d], g.b[d]) - side->reach, high[d] = std::max(g.a[d], g.b[d]) + side->reach;
+    const std::array<long, dim> lo = side->segment_cells.cell(low), hi = side->segment_cells.cell(high);
+    std::array<long, dim> mid = lo;
+    long rings = 0;
+    for (int d = 0; d < dim; ++d)
+      mid[std::size_t(d)] = (lo[std::size_t(d)] + hi[std::size_t(d)]) / 2,
+      rings = std::max(rings, std::max(mid[std::size_t(d)] - lo[std::size_t(d)], hi[std::size_t(d)] - mid[std::size_t(d)]));
+    Buckets<dim>::around(mid, rings, [&](const std::array<long, dim>& c) {
+      for (int d = 0; d < dim; ++d)
+        if (c[std::size_t(d)] < lo[std::size_t(d)] || c[std::size_t(d)] > hi[std::size_t(d)]) return;
+      side->segment_cells.add(c, int(k));
+    });
+  }
+  return [side](const Point<dim>& x) {
+    const std::array<long, dim> c = side->segment_cells.cell(x);
+    std::vector<const Segment<dim>*> candidates;
+    if (const std::vector<int>* in = side->segment_cells.at(c))
+      for (int k : *in) candidates.push_back(&side->segments[std::size_t(k)]);
+    const double psi = signed_distance(x, candidates, side->reach, 0.0);
+    if (psi != 0) return psi < 0 ? 1.0 : 0.0;
+    // Beyond the reach: the nearest point's status (the rings widen until one is found and no nearer
+    // one can lie farther out).
+    double best = std::numeric_limits<double>::infinity();
+    int nearest = -1;
+    for (long rings = 1; rings < (1L << 20); rings *= 2) {
+      Buckets<dim>::around(side->point_cells.cell(x), rings, [&](const std::array<long, dim>& cell) {
+        if (const std::vector<int>* in = side->point_cells.at(cell))
+          for (int i : *in)
+            if (const double d = norm(x - side->points[std::size_t(i)]); d < best) best = d, nearest = i;
+      });
+      if (nearest >= 0 && best <= double(rings) * side->point_cells.size()) break;
+    }
+    return nearest >= 0 && side->active[std::size_t(nearest)] ? 1.0 : 0.0;
+  };
 }
 
 template <int dim>
@@ -314,6 +432,8 @@ template ContactSummary contact_summary(const BasicSolution<3>&);
 template std::string describe_newton_failure(const BasicSolution<2>&);
 template void resolve_contact(BasicSolution<2>&);
 template void resolve_contact(BasicSolution<3>&);
+template std::function<double(const Point2&)> contact_side(const BasicSolution<2>&);
+template std::function<double(const Point3&)> contact_side(const BasicSolution<3>&);
 template std::string describe_newton_failure(const BasicSolution<3>&);
 
 }  // namespace fictus

@@ -80,11 +80,11 @@ SurfaceDiscretization::SurfaceDiscretization(std::shared_ptr<const Surface> gamm
 
 SurfaceDiscretization::~SurfaceDiscretization() = default;
 
-std::vector<PointCondition> SurfaceDiscretization::part_layout(const PartConditions<3>& parts) const {
-  if (!parts.mixed()) return {};
-  std::vector<PointCondition> layout;
+std::vector<int> SurfaceDiscretization::part_layout(const PartConditions<3>& parts) const {
+  if (!parts.placed()) return {};
+  std::vector<int> layout;
   layout.reserve(gamma_patches_.triangles.size());
-  for (const Triangle3& t : gamma_patches_.triangles) layout.push_back(parts.at((1.0 / 3) * (t.a + t.b + t.c)));
+  for (const Triangle3& t : gamma_patches_.triangles) layout.push_back(parts.label((1.0 / 3) * (t.a + t.b + t.c)));
   return layout;
 }
 
@@ -109,13 +109,11 @@ void SurfaceDiscretization::make_geometry(const SolverOptions& options, const Pa
   execution_.throw_if_interrupted();
   part_layout_ = part_layout(parts);
   if (!part_layout_.empty() &&
-      std::any_of(part_layout_.begin(), part_layout_.end(), [&](PointCondition c) { return c != part_layout_[0]; })) {
+      std::any_of(part_layout_.begin(), part_layout_.end(), [&](int c) { return c != part_layout_[0]; })) {
     // The patches again, each in one part. A patch's point: the foot on γ of the centroid of its triangle
     // nearest to the patch's centroid (inside the patch, whatever its shape).
-    std::vector<int> labels;
-    for (PointCondition part : part_layout_) labels.push_back(int(part));
     std::vector<int> patch_labels;
-    const std::vector<Point3> seeds = split_into_patches(gamma_patches_, plan_.m, labels, &patch_labels);
+    const std::vector<Point3> seeds = split_into_patches(gamma_patches_, plan_.m, part_layout_, &patch_labels);
     const std::vector<Triangle3>& triangles = gamma_patches_.triangles;
     std::vector<Point3> start(std::size_t(plan_.m));
     std::vector<double> best(std::size_t(plan_.m), 1e300);
@@ -133,10 +131,11 @@ void SurfaceDiscretization::make_geometry(const SolverOptions& options, const Pa
       gamma_patches_.normal[std::size_t(p)] = foot.normal;
     }
     point_parts_.assign(patch_labels.size(), PointCondition::signorini);
-    for (std::size_t p = 0; p < patch_labels.size(); ++p) point_parts_[p] = PointCondition(patch_labels[p]);
+    for (std::size_t p = 0; p < patch_labels.size(); ++p)
+      point_parts_[p] = PartConditions<3>::condition_of(patch_labels[p]);
     execution_.throw_if_interrupted();
   } else if (!part_layout_.empty()) {
-    point_parts_.assign(std::size_t(plan_.m), part_layout_[0]);
+    point_parts_.assign(std::size_t(plan_.m), PartConditions<3>::condition_of(part_layout_[0]));
   }
   Gamma_patches_ = gamma_patches_;
   if (options.variant == Variant::smooth) {

@@ -96,10 +96,11 @@ class BoundaryDiscretization {
   virtual bool same_parts(const PartConditions<dim>& parts) const { return part_layout(parts) == part_layout_; }
 
  protected:
-  /// The part of each of γ's fine pieces (2-D: samples of the curve; 3-D: the triangles) under `parts`;
-  /// empty without mixed conditions.
-  virtual std::vector<PointCondition> part_layout(const PartConditions<dim>& parts) const = 0;
-  std::vector<PointCondition> point_parts_, part_layout_;
+  /// The label (PartConditions::label) of each of γ's fine pieces (2-D: samples of the curve; 3-D: the
+  /// triangles) under `parts`; empty without mixed conditions or a contact side.
+  virtual std::vector<int> part_layout(const PartConditions<dim>& parts) const = 0;
+  std::vector<PointCondition> point_parts_;
+  std::vector<int> part_layout_;
 };
 
 /// The boundary of dimension dim for γ on `grid`: a CurveDiscretization or a SurfaceDiscretization

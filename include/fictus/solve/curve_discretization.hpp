@@ -56,15 +56,14 @@ class CurveDiscretization final : public BoundaryDiscretization<2> {
 
  private:
   void make_geometry(const Grid2& grid, SolverOptions options, const PartConditions<2>& parts);
-  /// The parts at K = max(4096, 16m) samples of γ, at t = 2π(k + ½)/K.
-  std::vector<PointCondition> part_layout(const PartConditions<2>& parts) const override;
-  /// The parameters where the parts meet, each with the part that follows it, from the samples' parts
-  /// (each change bisected to round-off).
-  std::vector<std::pair<double, PointCondition>> junctions(const PartConditions<2>& parts,
-                                                           const std::vector<PointCondition>& layout) const;
+  /// The labels at K = max(4096, 16m) samples of γ, at t = 2π(k + ½)/K.
+  std::vector<int> part_layout(const PartConditions<2>& parts) const override;
+  /// The parameters where the pieces meet, each with the label of the piece that follows it, from the
+  /// samples' labels (each change bisected to round-off).
+  std::vector<std::pair<double, int>> junctions(const PartConditions<2>& parts, const std::vector<int>& layout) const;
   /// The samples' parts and the junctions (to 1e-12 in the parameter) as when the points were placed.
   bool same_parts(const PartConditions<2>& parts) const override;
-  std::vector<std::pair<double, PointCondition>> junctions_;
+  std::vector<std::pair<double, int>> junctions_;
   void make_trace_rows(const Grid2& grid, const SolverOptions& options, double c);
 
   const Execution& execution_;

@@ -50,7 +50,13 @@ struct PartConditions {
   std::function<double(const Point<dim>&x)> dirichlet, neumann;          // where (non-zero: in the part)
   std::function<double(const Point<dim>& x)> u;                          // u_D on the Dirichlet part
   std::function<double(const Point<dim>& x, const Point<dim>& n)> flux;  // q on the Neumann part (unset: 0)
+  /// Placement only (solver.fit_contact, docs/math.md "Fitting the points to the contact set"): non-zero on
+  /// the contact side of a located contact boundary. The Signorini part's points are placed as if it
+  /// were a junction there (arcs end on it, patches do not straddle it); their conditions stay Signorini's.
+  std::function<double(const Point<dim>& x)> contact_side;
   bool mixed() const { return bool(dirichlet) || bool(neumann); }
+  /// Whether the points are placed part by part (mixed conditions, or a contact side to fit).
+  bool placed() const { return mixed() || bool(contact_side); }
   /// The part x lies in: Dirichlet where that expression is finite and non-zero, else Neumann where that
   /// one is, else Signorini (the overlap of the two parts is refused at the points, not here).
   PointCondition at(const Point<dim>& x) const {
@@ -63,6 +69,16 @@ struct PartConditions {
            : holds(neumann) ? PointCondition::neumann
                             : PointCondition::signorini;
   }
+  /// The piece of γ x is placed in: int(at(x)), or contact_label on the Signorini part's contact side.
+  static constexpr int contact_label = 3;
+  int label(const Point<dim>& x) const {
+    const PointCondition part = at(x);
+    if (part != PointCondition::signorini || !contact_side) return int(part);
+    const double side = contact_side(x);
+    return std::isfinite(side) && side != 0 ? contact_label : int(part);
+  }
+  /// The condition of a piece's label.
+  static PointCondition condition_of(int label) { return label == contact_label ? PointCondition::signorini : PointCondition(label); }
 };
 
 /// What may change from one solve to the next on the same grid: γ, the obstacle, the conditions on

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -154,6 +155,15 @@ struct SolutionBoundary<3> {
   }
 };
 
+/// solver.fit_contact: the solves whose points were placed to the previous solve's contact boundary.
+struct ContactFit {
+  int passes = 0;                   // solves after the first (the solution is the last one's)
+  std::vector<double> moved;        // per pass: the largest distance of a located end from the nearest end
+                                    // it was placed for, in spacings s
+  std::vector<int> newton_steps;    // per solve, the first included
+  double seconds = 0;               // the solves before the last one
+};
+
 template <int dim>
 struct BasicSolution : SolutionBoundary<dim> {
   explicit BasicSolution(const Grid<dim>& g) : grid(g) {}
@@ -197,7 +207,9 @@ struct BasicSolution : SolutionBoundary<dim> {
   // contact between an active point and its free neighbour, and the measure that follows.
   std::vector<Point<dim>> contact_boundary;                // one point per active–free pair of neighbours
   std::vector<std::array<int, 2>> contact_boundary_lines;  // 3-D: consecutive points of contact_boundary
+  std::vector<std::array<int, 2>> contact_boundary_pairs;  // each such point's active and free point
   double contact_measure = 0;                              // length (2-D) or area (3-D)
+  std::optional<ContactFit> contact_fit;                   // with solver.fit_contact
   std::optional<ErrorNorms> errors;
   std::optional<PointErrors> point_errors;
   Timings timings;
@@ -217,9 +229,18 @@ std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<dim>& boundary
 /// through both values: √θ/(1 − θ)^{3/2} = q·d/(1.5·r).
 double contact_end_fraction(double q, double r, double d);
 
-/// Sets solution.contact_boundary, contact_boundary_lines and contact_measure from the per-point values.
+/// Sets solution.contact_boundary, contact_boundary_lines, contact_boundary_pairs and contact_measure from
+/// the per-point values.
 template <int dim>
 void resolve_contact(BasicSolution<dim>& solution);
+
+/// The contact side of a solution's located contact boundary, for placing the points of the next solve
+/// (PartConditions::contact_side, solver.fit_contact): 1 at a point x of γ on the contact side, else 0.
+/// Within 1.5·s of the boundary, the side of its nearest segment (in 2-D: of the nearest located end,
+/// along the curve from the free point to the active one); farther away, the status of the nearest point.
+/// Empty where the solution has no located end (nothing to fit).
+template <int dim>
+std::function<double(const Point<dim>&)> contact_side(const BasicSolution<dim>& solution);
 
 /// One part of γ under one condition: its points, its measure Σ part_i and the flux through it
 /// Σ (C_γû)_i·part_i.

@@ -77,8 +77,8 @@ class SurfaceDiscretization final : public BoundaryDiscretization<3> {
 
  private:
   void make_geometry(const SolverOptions& options, const PartConditions<3>& parts);
-  /// The parts at the centroids of γ's triangles.
-  std::vector<PointCondition> part_layout(const PartConditions<3>& parts) const override;
+  /// The labels at the centroids of γ's triangles.
+  std::vector<int> part_layout(const PartConditions<3>& parts) const override;
   void make_trace_rows(const SolverOptions& options, const MarkPhase& mark);
 
   Grid3 grid_;
