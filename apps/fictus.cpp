@@ -140,7 +140,7 @@ std::string parse_error_line(const std::string& message, const std::vector<std::
 
 bool formulation_or_solver(const fictus::OptionSpec& s) { return s.section == "formulation" || s.section == "solver"; }
 
-/// What a 3-D solve adds to the summary: the nested start, the flux balance, the far field.
+/// What a solve adds to the summary: the nested start, the contact fit, the flux balance, the far field.
 template <int dim>
 void print_solver_extras(const fictus::BasicSolution<dim>& s) {
   if (s.nested_start && s.nested_start->skipped.empty())
@@ -148,6 +148,11 @@ void print_solver_extras(const fictus::BasicSolution<dim>& s) {
                 s.nested_start->N, s.nested_start->multipliers, s.nested_start->newton_steps, s.nested_start->seconds);
   else if (s.nested_start)
     std::printf("no nested start (%s)\n", s.nested_start->skipped.c_str());
+  if (s.contact_fit)
+    std::printf(
+        "points fitted to the contact boundary: %d more solve(s), %.2f s; the ends then moved by %.3f s (spacings)\n",
+        s.contact_fit->passes, s.contact_fit->seconds,
+        s.contact_fit->moved.empty() ? 0.0 : s.contact_fit->moved.back());
   if (s.flux_balance)
     std::printf(
         "flux balance: before it each patch's reading missed its share of the flux by %.2e (scatter), "
@@ -559,6 +564,7 @@ int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out,
       fictus::Problem problem = fictus::paper_problem(N);
       fictus::SolverOptions options = fictus::paper_options(N, variant);  // the paper's m and δ
       options.error_estimate = false;  // the tables time the paper's method; --error_estimate true adds it
+      options.fit_contact = 0;         // (one solve; --fit_contact adds passes)
       flags.apply(problem, options);
       fictus::cli::agree_on_threads(distribution, options);
       fictus::cli::on_rank_0(distribution, [&] { fictus::check_memory(problem, options); });  // rank 0's node

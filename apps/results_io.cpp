@@ -247,6 +247,12 @@ json solution_to_json(const BasicProblem<dim>& problem, const BasicSolution<dim>
   }
   j["contact"]["boundary_lines"] = json::array();  // 3-D: consecutive points of contact.boundary
   for (const auto& line : s.contact_boundary_lines) j["contact"]["boundary_lines"].push_back({line[0], line[1]});
+  j["contact"]["fit"] = nullptr;  // solver.fit_contact: the solves that placed the points to the contact boundary
+  if (s.contact_fit)
+    j["contact"]["fit"] = {{"passes", s.contact_fit->passes},
+                           {"moved", s.contact_fit->moved},
+                           {"newton_steps", s.contact_fit->newton_steps},
+                           {"seconds", s.contact_fit->seconds}};
   j["domain"] = s.domain ? domain_json(*s.domain) : json(nullptr);
   j["estimate"] = s.estimate ? estimate_json(*s.estimate) : json(nullptr);
   j["flux_balance"] = s.flux_balance ? json{{"scatter", s.flux_balance->scatter},

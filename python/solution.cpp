@@ -137,6 +137,15 @@ py::dict contact(const BasicSolution<dim>& s) {
     for (int a = 0; a < 2; ++a)
       lines.mutable_at(py::ssize_t(k), py::ssize_t(a)) = s.contact_boundary_lines[k][std::size_t(a)];
   d["boundary_lines"] = lines;  // 3-D: the rows of consecutive ends
+  d["fit"] = py::none();         // solver.fit_contact: the solves placed to the contact boundary
+  if (const auto& f = s.contact_fit) {
+    py::dict fit;
+    fit["passes"] = f->passes;
+    fit["moved"] = f->moved;
+    fit["newton_steps"] = f->newton_steps;
+    fit["seconds"] = f->seconds;
+    d["fit"] = fit;
+  }
   d["force"] = c.force;
   d["force_patches"] = c.force_patches;
   d["force_rule"] = c.force_from_domain ? "domain" : "patches";

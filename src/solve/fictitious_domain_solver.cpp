@@ -183,9 +183,17 @@ SolverOptions solve_options(const State<dim>& st, const BasicContactData<dim>& d
   if (!has_g) throw std::invalid_argument("data.g: not given");
   chosen = options.variant == Variant::automatic;
   options.variant = resolved_variant(options.variant, smooth_boundary(*data.gamma));
+  // Measured (docs/math.md, "Fitting the points to the contact set"): two passes make the 2-D smooth
+  // variant's errors second order where the ends fall anywhere between the points; on surfaces and in the
+  // non-smooth variant they were no better.
+  if (options.fit_contact < 0) options.fit_contact = dim == 2 && options.variant == Variant::smooth ? 2 : 0;
   options.threads = st.execution.threads();
   return options;
 }
+
+template <int dim>
+std::unique_ptr<BoundarySetup<dim>> new_boundary_setup(const State<dim>& st, const BasicContactData<dim>& data,
+                                                       const SolverOptions& options, PhaseClock& clock);
 
 /// Steps 1–2 for data.gamma, or the previous ones when the boundary and its options are unchanged.
 template <int dim>
@@ -195,6 +203,14 @@ BoundarySetup<dim>& boundary_setup(State<dim>& st, const BasicContactData<dim>& 
            same_boundary_options(st.setup->options, options) && st.setup->boundary->same_parts(data.conditions);
   if (reused) return *st.setup;
   st.setup.reset();
+  st.setup = new_boundary_setup<dim>(st, data, options, clock);
+  return *st.setup;
+}
+
+/// Steps 1–2 for data.gamma, made afresh (and not kept by the solver).
+template <int dim>
+std::unique_ptr<BoundarySetup<dim>> new_boundary_setup(const State<dim>& st, const BasicContactData<dim>& data,
+                                                       const SolverOptions& options, PhaseClock& clock) {
   auto setup = std::make_unique<BoundarySetup<dim>>();
   setup->gamma = data.gamma;
   setup->options = options;
@@ -207,8 +223,7 @@ BoundarySetup<dim>& boundary_setup(State<dim>& st, const BasicContactData<dim>& 
     setup->boundary = std::make_unique<SurfaceDiscretization>(data.gamma, st.grid, options, st.c, st.execution, mark,
                                                               data.conditions);
   }
-  st.setup = std::move(setup);
-  return *st.setup;
+  return setup;
 }
 
 /// Step 0: the load vector and u₀ = A⁻¹f (A⁺f for a singular A), once per load.
@@ -871,10 +886,15 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
   BasicContactData<dim> fitted;
   const BasicContactData<dim>* current = &data;
   std::vector<Point<dim>> placed_for;  // the located ends the points were placed for
+  // The first solve's setup is the solver's (a new obstacle or load reuses it); the fitted ones are made
+  // for this solve only.
+  std::unique_ptr<BoundarySetup<dim>> fitted_setup;
   for (int pass = 0;; ++pass) {
     const std::size_t pass_begins = sol.timings.phases.size();
-    BoundarySetup<dim>& setup = boundary_setup<dim>(st, *current, options, clock, sol.reused_curve);  // 1–2
-    obstacle_and_conditions<dim>(*setup.boundary, *current, st.c, sol);                               // 4
+    if (pass > 0) fitted_setup = new_boundary_setup<dim>(st, fitted, options, clock);
+    BoundarySetup<dim>& setup =
+        pass > 0 ? *fitted_setup : boundary_setup<dim>(st, data, options, clock, sol.reused_curve);  // 1–2
+    obstacle_and_conditions<dim>(*setup.boundary, *current, st.c, sol);                              // 4
     st.execution.throw_if_interrupted();
     if (pass > 0) {  // Newton starts from the contact side at the new points
       const std::vector<Point<dim>>& x = setup.boundary->points();
@@ -928,7 +948,8 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
         fitted = data;
         fitted.conditions.contact_side = side;
         current = &fitted;
-        st.setup.reset();  // the points move: new rows and blocks
+        if (!keep) setup.schur.reset(), setup.exact.reset();  // the points move: new rows and blocks
+        fitted_setup.reset();
         // This pass's phases (but the coarse solve and u₀, made once) become one: fit_contact.
         std::vector<std::pair<std::string, double>>& phases = sol.timings.phases;
         double seconds = 0;
@@ -942,7 +963,8 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
           phases.erase(phases.begin() + std::ptrdiff_t(k));
         }
         sol.contact_fit->seconds += seconds;
-        const auto earlier = std::find_if(phases.begin(), phases.end(), [](const auto& p) { return p.first == "fit_contact"; });
+        const auto earlier =
+            std::find_if(phases.begin(), phases.end(), [](const auto& p) { return p.first == "fit_contact"; });
         if (earlier == phases.end())
           phases.emplace_back("fit_contact", seconds);
         else
@@ -953,7 +975,7 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
     if (!keep) setup.schur.reset(), setup.exact.reset();  // S_B, S_C and the kept LU: freed before the field
     break;
   }
-  BoundarySetup<dim>& setup = *st.setup;
+  BoundarySetup<dim>& setup = fitted_setup ? *fitted_setup : *st.setup;
   const BoundaryDiscretization<dim>& boundary = *setup.boundary;
   if (compute_field) {  // 6
     field<dim>(st, setup, sol);

@@ -328,9 +328,10 @@ void more_solver_specs(std::vector<OptionSpec>& specs) {
     n.dims = {3};
     specs.push_back(n);
   }
-  specs.push_back(integer("solver", "fit_contact", &SolverOptions::fit_contact, 0, 8,
+  specs.push_back(integer("solver", "fit_contact", &SolverOptions::fit_contact, -1, 8,
                           "solves more, each with the points placed so that their arcs (2-D) or patches (3-D) end "
-                          "at the contact boundary the solve before located (0: one solve)"));
+                          "at the contact boundary the solve before located (0: one solve; -1: 2 with the smooth "
+                          "variant in 2-D, else 0)"));
   {
     OptionSpec e = member(std::string("solver"), std::string("error_estimate"), OptionType::boolean,
                           &SolverOptions::error_estimate,

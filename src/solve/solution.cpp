@@ -4,8 +4,8 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <set>
@@ -295,7 +295,8 @@ class Buckets {
     while (true) {
       visit(k);
       int d = 0;
-      while (d < dim && ++k[std::size_t(d)] > c[std::size_t(d)] + rings) k[std::size_t(d)] = c[std::size_t(d)] - rings, ++d;
+      while (d < dim && ++k[std::size_t(d)] > c[std::size_t(d)] + rings)
+        k[std::size_t(d)] = c[std::size_t(d)] - rings, ++d;
       if (d == dim) return;
     }
   }
@@ -362,8 +363,8 @@ std::function<double(const Point<dim>&)> contact_side(const BasicSolution<dim>& 
     double reach;
   };
   const double spacing = s.spacing();
-  auto side = std::make_shared<Side>(Side{located_segments(s), s.points(), {}, Buckets<dim>(spacing),
-                                          Buckets<dim>(spacing), 1.5 * spacing});
+  auto side = std::make_shared<Side>(
+      Side{located_segments(s), s.points(), {}, Buckets<dim>(spacing), Buckets<dim>(spacing), 1.5 * spacing});
   for (int i = 0; i < s.n_points(); ++i) {
     side->active.push_back(char(s.in_contact(i)));
     side->point_cells.add(side->point_cells.cell(s.points()[std::size_t(i)]), i);
@@ -379,7 +380,8 @@ std::function<double(const Point<dim>&)> contact_side(const BasicSolution<dim>& 
     long rings = 0;
     for (int d = 0; d < dim; ++d)
       mid[std::size_t(d)] = (lo[std::size_t(d)] + hi[std::size_t(d)]) / 2,
-      rings = std::max(rings, std::max(mid[std::size_t(d)] - lo[std::size_t(d)], hi[std::size_t(d)] - mid[std::size_t(d)]));
+      rings =
+          std::max(rings, std::max(mid[std::size_t(d)] - lo[std::size_t(d)], hi[std::size_t(d)] - mid[std::size_t(d)]));
     Buckets<dim>::around(mid, rings, [&](const std::array<long, dim>& c) {
       for (int d = 0; d < dim; ++d)
         if (c[std::size_t(d)] < lo[std::size_t(d)] || c[std::size_t(d)] > hi[std::size_t(d)]) return;

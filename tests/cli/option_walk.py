@@ -61,6 +61,7 @@ WALK = {
     "flux_balance": False,
     "nested_start": 28,
     "error_estimate": False,
+    "fit_contact": 1,
     "condition_number": False,
 }
 

@@ -106,12 +106,12 @@ def check_success(folder):
     # Optional figures are null by design when not computed (no exact solution, krylov's cond(S)); the
     # optional blocks are null where they do not apply (the flux balance in 2-D and the smooth variant,
     # the far field, the Schur storage (krylov), the nested start, the independent check, a failure of a
-    # converged Newton).
+    # converged Newton, the contact fit).
     for key in ("errors", "condition_number", "problem"):
         results.pop(key, None)
     for block, key in ((None, "flux_balance"), ("inner", "far_field"), ("inner", "schur_storage"),
                        ("newton", "nested_start"),
-                       ("newton", "failure"), ("signorini", "check")):
+                       ("newton", "failure"), ("signorini", "check"), ("contact", "fit")):
         table = results if block is None else results.get(block, {})
         if isinstance(table, dict) and key in table and table[key] is None:
             table.pop(key)

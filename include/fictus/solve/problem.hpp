@@ -78,7 +78,9 @@ struct PartConditions {
     return std::isfinite(side) && side != 0 ? contact_label : int(part);
   }
   /// The condition of a piece's label.
-  static PointCondition condition_of(int label) { return label == contact_label ? PointCondition::signorini : PointCondition(label); }
+  static PointCondition condition_of(int label) {
+    return label == contact_label ? PointCondition::signorini : PointCondition(label);
+  }
 };
 
 /// What may change from one solve to the next on the same grid: γ, the obstacle, the conditions on

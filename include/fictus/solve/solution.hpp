@@ -157,11 +157,11 @@ struct SolutionBoundary<3> {
 
 /// solver.fit_contact: the solves whose points were placed to the previous solve's contact boundary.
 struct ContactFit {
-  int passes = 0;                   // solves after the first (the solution is the last one's)
-  std::vector<double> moved;        // per pass: the largest distance of a located end from the nearest end
-                                    // it was placed for, in spacings s
-  std::vector<int> newton_steps;    // per solve, the first included
-  double seconds = 0;               // the solves before the last one
+  int passes = 0;                 // solves after the first (the solution is the last one's)
+  std::vector<double> moved;      // per pass: the largest distance of a located end from the nearest end
+                                  // it was placed for, in spacings s
+  std::vector<int> newton_steps;  // per solve, the first included
+  double seconds = 0;             // the solves before the last one
 };
 
 template <int dim>

@@ -60,7 +60,8 @@ struct SolverOptions {
   int nested_start = 160;        // 3-D: from this N on, Newton starts from the active set of a solve on the N/2 grid
   bool condition_number = true;  // of the final Newton matrix (2-D green path only)
   bool error_estimate = true;    // estimate the errors from the same problem solved on the grid of N/2
-  int fit_contact = 0;           // solves more with the points placed to the previous one's contact boundary
+  int fit_contact = -1;          // solves more, the points placed to the contact boundary the one before located;
+                                 // −1: automatic (2 with the smooth variant in 2-D, else 0; docs/math.md)
   int threads = 0;               // 0: the machine's (default_threads(), execution.hpp)
   double max_memory = 0;         // GiB a solve may use; 0: the memory available when it starts
 

@@ -1,0 +1,132 @@
+// The contact fit (solver.fit_contact, docs/math.md "Fitting the points to the contact set") against the
+// 2-D fitted-mesh references: relative L²(ω) errors and the located ends' distance from the reference's,
+// per N, for 0 … 3 passes, and for the limit the fit aims at: the same problem with the contact set
+// fixed to the reference's own intervals (u = g there, ∂u/∂n = 0 elsewhere, mixed conditions), whose
+// points are placed part by part so that their arcs end at the exact ends. Least-squares rates over the
+// powers of two and over all N, and the spread of error·N² (1 for clean second order).
+// Usage: fictus_bench_contact_fit REFERENCE smooth|nonsmooth N... (accuracy only; times are one run each).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "fictus/io/problem_file.hpp"
+#include "fictus/solve/fictitious_domain_solver.hpp"
+#include "reference_comparison.hpp"
+
+namespace {
+
+/// The polar angle of x about c, in [0, 2π).
+double angle_about(const fictus::Point2& c, const fictus::Point2& x) {
+  const double t = std::atan2(x.y - c.y, x.x - c.x);
+  return t < 0 ? t + reference::two_pi : t;
+}
+
+/// Whether θ lies in one of the reference's contact intervals [ends[2k], ends[2k+1]] (cyclic).
+bool in_reference_contact(const std::vector<double>& ends, double theta) {
+  for (std::size_t k = 0; k + 1 < ends.size(); k += 2) {
+    const double a = ends[k], b = ends[k + 1];
+    if (a < b ? (theta >= a && theta < b) : (theta >= a || theta < b)) return true;
+  }
+  return false;
+}
+
+double fitted_rate(const std::vector<int>& N, const std::vector<double>& e) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  const double n = double(N.size());
+  for (std::size_t k = 0; k < N.size(); ++k) {
+    const double x = -std::log(double(N[k])), y = std::log(e[k]);
+    sx += x, sy += y, sxx += x * x, sxy += x * y;
+  }
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 4) {
+    std::fprintf(stderr, "usage: %s REFERENCE smooth|nonsmooth N...\n", argv[0]);
+    return 1;
+  }
+  const std::string dir = std::string(FICTUS_SOURCE_DIR) + "/tests/references/", name = argv[1];
+  const fictus::Variant variant =
+      std::string(argv[2]) == "nonsmooth" ? fictus::Variant::nonsmooth : fictus::Variant::smooth;
+  const reference::Reference ref = reference::load(dir, name);
+  constexpr int max_passes = 3;
+  std::vector<int> Ns;
+  std::vector<std::vector<double>> errors(max_passes + 2);  // passes 0 … 3, then the exact ends
+  std::printf("| N | m | exact ends | 0 passes | 1 | 2 | 3 | ends [s]: 0 / 1 / 2 / 3 | seconds: 0 / 2 |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|\n");
+  for (int a = 3; a < argc; ++a) {
+    const int N = std::stoi(argv[a]);
+    fictus::ProblemSpec spec = fictus::read_problem_file(dir + name + ".toml");
+    spec.problem.N = N;
+    spec.options.variant = variant;
+    spec.options.condition_number = false;
+    spec.options.error_estimate = false;
+    spec.options.threads = 2;
+    Ns.push_back(N);
+    std::string ends, seconds;
+    int m = 0;
+    for (int passes = 0; passes <= max_passes; ++passes) {
+      fictus::SolverOptions o = spec.options;
+      o.fit_contact = passes;
+      const fictus::Solution s = fictus::solve(spec.problem, o);
+      const reference::Comparison c = reference::compare(ref, s);
+      errors[std::size_t(passes)].push_back(c.level.l2_omega);
+      char text[64];
+      std::snprintf(text, sizeof text, "%s%.3f", passes ? " / " : "", c.resolved_end_error_spacings);
+      ends += text;
+      if (passes == 0 || passes == 2) {
+        std::snprintf(text, sizeof text, "%s%.2f", passes ? " / " : "", s.timings.total);
+        seconds += text;
+      }
+      m = s.collocation.m;
+    }
+    // The contact set fixed to the reference's intervals (the tips' g depends on x, y only).
+    fictus::Problem fixed = spec.problem;
+    const auto g = spec.problem.g_along_curve;
+    const fictus::Point2 centre = ref.center;
+    const std::vector<double> reference_ends = ref.ends;
+    fixed.conditions.dirichlet = [=](const fictus::Point2& x) {
+      return in_reference_contact(reference_ends, angle_about(centre, x)) ? 1.0 : 0.0;
+    };
+    fixed.conditions.neumann = [=](const fictus::Point2& x) {
+      return in_reference_contact(reference_ends, angle_about(centre, x)) ? 0.0 : 1.0;
+    };
+    fixed.conditions.u = [g](const fictus::Point2& x) { return g(x.x, x.y, 0.0); };
+    fictus::SolverOptions o = spec.options;
+    o.fit_contact = 0;
+    errors[max_passes + 1].push_back(reference::compare(ref, fictus::solve(fixed, o)).level.l2_omega);
+    std::printf("| %d | %d | %.2e | %.2e | %.2e | %.2e | %.2e | %s | %s |\n", N, m, errors[max_passes + 1].back(),
+                errors[0].back(), errors[1].back(), errors[2].back(), errors[3].back(), ends.c_str(), seconds.c_str());
+    std::fflush(stdout);
+  }
+  std::vector<int> powers;
+  for (int N : Ns)
+    if ((N & (N - 1)) == 0) powers.push_back(N);
+  std::printf("\n| | exact ends | 0 passes | 1 | 2 | 3 |\n|---|---|---|---|---|---|\n");
+  const auto row = [&](const char* what, auto value) {
+    std::printf("| %s", what);
+    for (int k : {max_passes + 1, 0, 1, 2, 3}) std::printf(" | %.2f", value(errors[std::size_t(k)]));
+    std::printf(" |\n");
+  };
+  row("rate, all N", [&](const std::vector<double>& e) { return fitted_rate(Ns, e); });
+  if (powers.size() > 1)
+    row("rate, powers of 2", [&](const std::vector<double>& e) {
+      std::vector<double> p;
+      for (std::size_t k = 0; k < Ns.size(); ++k)
+        if ((Ns[k] & (Ns[k] - 1)) == 0) p.push_back(e[k]);
+      return fitted_rate(powers, p);
+    });
+  row("max/min of error·N²", [&](const std::vector<double>& e) {
+    double lo = 1e300, hi = 0;
+    for (std::size_t k = 0; k < Ns.size(); ++k) {
+      const double v = e[k] * double(Ns[k]) * double(Ns[k]);
+      lo = std::min(lo, v), hi = std::max(hi, v);
+    }
+    return hi / lo;
+  });
+}
