@@ -150,7 +150,7 @@ void print_solver_extras(const fictus::BasicSolution<dim>& s) {
     std::printf("no nested start (%s)\n", s.nested_start->skipped.c_str());
   if (s.contact_fit)
     std::printf(
-        "points fitted to the contact boundary: %d more solve(s), %.2f s; the ends then moved by %.3f s (spacings)\n",
+        "points fitted to the contact boundary: %d more solve(s), %.2f s; the ends then moved by %.3f spacings\n",
         s.contact_fit->passes, s.contact_fit->seconds,
         s.contact_fit->moved.empty() ? 0.0 : s.contact_fit->moved.back());
   if (s.flux_balance)

@@ -249,11 +249,12 @@ int run_sweep_in(const std::string& text, const SweepArguments& args, const Opti
     if (!s.newton.converged && !first_failure) first_failure = std::pair{v, describe_newton_failure(s)};
     record(family, v, s, seconds, csv, rows);
   }
-  std::printf("grid setup and the base problem %.3f s; then %.4f s per problem (%s), %.1f problems per second\n", setup,
-              total / family.values.size(),
+  std::printf("grid setup and the base problem %.3f s; then %.4f s per problem (%s%s), %.1f problems per second\n",
+              setup, total / family.values.size(),
               family.changes_load  ? "new u0 and Newton"
               : family.moves_curve ? "new boundary rows, Schur blocks and Newton"
                                    : "Newton only",
+              first.options.fit_contact > 0 ? "; then the contact fit's rows, blocks and Newton" : "",
               family.values.size() / total);
   if (!args.out.empty()) {
     nlohmann::json j{{"version", FICTUS_VERSION},

@@ -26,7 +26,7 @@ parser.add_argument("--problem", help="a problem file (default: the paper's prob
 parser.add_argument("--variants", default="nonsmooth,smooth")
 args = parser.parse_args()
 
-PHASES = ["nested_start", "coarse_solve", "load", "u0", "geometry", "kink_correction", "flux_balance", "green_table", "schur", "newton",
+PHASES = ["nested_start", "coarse_solve", "load", "u0", "fit_contact", "geometry", "kink_correction", "flux_balance", "green_table", "schur", "newton",
           "final_solve", "check", "errors", "quantities", "total"]
 
 

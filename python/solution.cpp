@@ -137,7 +137,7 @@ py::dict contact(const BasicSolution<dim>& s) {
     for (int a = 0; a < 2; ++a)
       lines.mutable_at(py::ssize_t(k), py::ssize_t(a)) = s.contact_boundary_lines[k][std::size_t(a)];
   d["boundary_lines"] = lines;  // 3-D: the rows of consecutive ends
-  d["fit"] = py::none();         // solver.fit_contact: the solves placed to the contact boundary
+  d["fit"] = py::none();        // solver.fit_contact: the solves placed to the contact boundary
   if (const auto& f = s.contact_fit) {
     py::dict fit;
     fit["passes"] = f->passes;

@@ -161,8 +161,24 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
   part_layout_ = part_layout(parts);
   junctions_ = junctions(parts, part_layout_);
   const std::vector<std::pair<double, int>>& joins = junctions_;
+  // A junction of the contact fit (the Signorini part on both sides) within a quarter spacing of another
+  // break is left out: no sliver of an arc between them.
   std::vector<double> breaks;
-  for (const auto& [t, part] : joins) breaks.push_back(t);
+  std::vector<double> fitted;  // the contact fit's
+  for (std::size_t k = 0; k < joins.size(); ++k) {
+    const int before = joins[(k + joins.size() - 1) % joins.size()].second, after = joins[k].second;
+    const bool contact_only = PartConditions<2>::condition_of(before) == PartConditions<2>::condition_of(after);
+    (contact_only ? fitted : breaks).push_back(joins[k].first);
+  }
+  for (double t : fitted) {
+    bool near = false;
+    for (double b : breaks) {
+      const double d = std::abs(arc_length.s_of_t(t) - arc_length.s_of_t(b));
+      near = near || std::min(d, L - d) < 0.25 * L / m;
+    }
+    if (!near) breaks.push_back(t);
+  }
+  std::sort(breaks.begin(), breaks.end());
   // The corners too (non-smooth), where they are few: one within a quarter spacing of a junction is
   // left to the junction (no sliver of an arc between them).
   if (const std::vector<double> corners = gamma.corners();

@@ -868,6 +868,42 @@ void quantities_step(const State<dim>& st, const BoundaryDiscretization<dim>& bo
   estimate_warning_line<dim>(sol);
 }
 
+/// The largest distance of a point of `found` from the nearest of `before` (0 when either is empty).
+template <int dim>
+double farthest_from(const std::vector<Point<dim>>& found, const std::vector<Point<dim>>& before) {
+  double farthest = 0;
+  for (const Point<dim>& e : found) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Point<dim>& p : before) nearest = std::min(nearest, norm(e - p));
+    if (!before.empty()) farthest = std::max(farthest, nearest);
+  }
+  return farthest;
+}
+
+/// The phases from `first` on, but those a solve makes once (the coarse solve, the load, u₀ and the Green's
+/// table), become
+/// the one phase `name` (added to an earlier one of that name); returns their seconds.
+double merge_phases(Timings& timings, std::size_t first, const std::string& name) {
+  std::vector<std::pair<std::string, double>>& phases = timings.phases;
+  double seconds = 0;
+  for (std::size_t k = first; k < phases.size();) {
+    const std::string& phase = phases[k].first;
+    if (phase == "coarse_solve" || phase == "nested_start" || phase == "load" || phase == "u0" ||
+        phase == "green_table") {
+      ++k;
+      continue;
+    }
+    seconds += phases[k].second;
+    phases.erase(phases.begin() + std::ptrdiff_t(k));
+  }
+  const auto earlier = std::find_if(phases.begin(), phases.end(), [&name](const auto& p) { return p.first == name; });
+  if (earlier == phases.end())
+    phases.emplace_back(name, seconds);
+  else
+    earlier->second += seconds;
+  return seconds;
+}
+
 }  // namespace
 
 template <int dim>
@@ -887,10 +923,11 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
   const BasicContactData<dim>* current = &data;
   std::vector<Point<dim>> placed_for;  // the located ends the points were placed for
   // The first solve's setup is the solver's (a new obstacle or load reuses it); the fitted ones are made
-  // for this solve only.
-  std::unique_ptr<BoundarySetup<dim>> fitted_setup;
-  for (int pass = 0;; ++pass) {
-    const std::size_t pass_begins = sol.timings.phases.size();
+  // for this solve only. The solve before a fitted one, and its setup, are kept to fall back to.
+  std::unique_ptr<BoundarySetup<dim>> fitted_setup, before_setup;
+  std::optional<BasicSolution<dim>> before;
+  const auto solve_pass = [&](int pass, bool last) -> BoundarySetup<dim>& {
+    sol.far_field.reset();
     if (pass > 0) fitted_setup = new_boundary_setup<dim>(st, fitted, options, clock);
     BoundarySetup<dim>& setup =
         pass > 0 ? *fitted_setup : boundary_setup<dim>(st, data, options, clock, sol.reused_curve);  // 1–2
@@ -905,7 +942,6 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
     load_and_u0<dim>(st, clock, sol.fast_solves);  // 0
     st.execution.throw_if_interrupted();
     const bool made = !setup.schur;
-    const bool last = pass >= options.fit_contact;
     schur_blocks<dim>(st, setup, options, clock, keep || !last);  // 2b–3
     if (made) sol.fast_solves += setup.fast_solves;
     load_terms<dim>(st, setup);
@@ -915,66 +951,74 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
     junction_warning<dim>(boundary, *current, sol);
     sol.delta = boundary.delta();
     sol.flux_balance = boundary.flux_balance(setup.shift);
-    newton<dim>(st, setup, options, start, sol);  // 5
+    SolverOptions pass_options = options;
+    pass_options.condition_number = options.condition_number && last;  // of the final matrix only
+    newton<dim>(st, setup, pass_options, start, sol);                  // 5
     clock.mark("newton");
     st.execution.throw_if_interrupted();
-    if (pass > 0) {
-      // How far the ends now located lie from those the points were placed for.
+    return setup;
+  };
+  for (int pass = 0;; ++pass) {
+    const std::size_t pass_begins = sol.timings.phases.size();
+    const bool last = pass >= options.fit_contact;
+    std::string failure;  // a fitted solve that failed: the one before stands
+    BoundarySetup<dim>* made = nullptr;
+    if (pass == 0) {
+      made = &solve_pass(pass, last);
+    } else {
+      try {
+        made = &solve_pass(pass, last);
+        if (!sol.newton.converged) failure = "Newton did not converge";
+      } catch (const std::invalid_argument& e) {
+        failure = e.what();
+      }
+    }
+    if (!failure.empty()) {
+      Timings timings = sol.timings;
+      sol = std::move(*before);
+      sol.timings = std::move(timings);
+      sol.warnings.push_back("solver.fit_contact: the solve fitted to the contact boundary (pass " +
+                             std::to_string(pass) + ") failed (" + failure +
+                             "); the results are those of the solve before");
+      --sol.contact_fit->passes;  // the fitted solves whose results stand
+      fitted_setup = std::move(before_setup);
+      current = &data;
+      break;
+    }
+    BoundarySetup<dim>& setup = *made;
+    const bool fit_next = !last && sol.newton.converged;
+    if (pass > 0 || fit_next) {  // the located ends, from Newton's readings (the field's, to round-off)
       sol.trace.assign(sol.newton.trace.data(), sol.newton.trace.data() + sol.newton.trace.size());
       sol.normal_derivative.assign(sol.newton.normal_derivative.data(),
                                    sol.newton.normal_derivative.data() + sol.newton.normal_derivative.size());
+      // Distributed: rank 0's readings, so that every rank places the next points alike.
+      const Distribution& distribution = st.execution.distribution();
+      distribution.broadcast(sol.trace.data(), sol.trace.size());
+      distribution.broadcast(sol.normal_derivative.data(), sol.normal_derivative.size());
       resolve_contact<dim>(sol);
-      double moved = 0;
-      for (const Point<dim>& e : sol.contact_boundary) {
-        double nearest = std::numeric_limits<double>::infinity();
-        for (const Point<dim>& p : placed_for) nearest = std::min(nearest, norm(e - p));
-        moved = std::max(moved, nearest);
-      }
-      sol.contact_fit->moved.push_back(moved / sol.spacing());
+    }
+    if (pass > 0) {
+      sol.contact_fit->moved.push_back(farthest_from(sol.contact_boundary, placed_for) / sol.spacing());
       sol.contact_fit->newton_steps.push_back(sol.newton.iterations);
     }
-    if (!last && sol.newton.converged) {
-      if (pass == 0) {
-        sol.trace.assign(sol.newton.trace.data(), sol.newton.trace.data() + sol.newton.trace.size());
-        sol.normal_derivative.assign(sol.newton.normal_derivative.data(),
-                                     sol.newton.normal_derivative.data() + sol.newton.normal_derivative.size());
-        resolve_contact<dim>(sol);
-      }
-      std::function<double(const Point<dim>&)> side = contact_side<dim>(sol);
-      if (side) {
-        if (!sol.contact_fit) sol.contact_fit.emplace(), sol.contact_fit->newton_steps.push_back(sol.newton.iterations);
-        ++sol.contact_fit->passes;
-        placed_for = sol.contact_boundary;
-        fitted = data;
-        fitted.conditions.contact_side = side;
-        current = &fitted;
-        if (!keep) setup.schur.reset(), setup.exact.reset();  // the points move: new rows and blocks
-        fitted_setup.reset();
-        // This pass's phases (but the coarse solve and u₀, made once) become one: fit_contact.
-        std::vector<std::pair<std::string, double>>& phases = sol.timings.phases;
-        double seconds = 0;
-        for (std::size_t k = pass_begins; k < phases.size();) {
-          const std::string& name = phases[k].first;
-          if (name == "coarse_solve" || name == "nested_start" || name == "load" || name == "u0") {
-            ++k;
-            continue;
-          }
-          seconds += phases[k].second;
-          phases.erase(phases.begin() + std::ptrdiff_t(k));
-        }
-        sol.contact_fit->seconds += seconds;
-        const auto earlier =
-            std::find_if(phases.begin(), phases.end(), [](const auto& p) { return p.first == "fit_contact"; });
-        if (earlier == phases.end())
-          phases.emplace_back("fit_contact", seconds);
-        else
-          earlier->second += seconds;
-        continue;
-      }
+    if (std::function<double(const Point<dim>&)> side = fit_next ? contact_side<dim>(sol) : nullptr) {
+      if (!sol.contact_fit) sol.contact_fit.emplace(), sol.contact_fit->newton_steps.push_back(sol.newton.iterations);
+      ++sol.contact_fit->passes;
+      sol.contact_fit->seconds += merge_phases(sol.timings, pass_begins, "fit_contact");
+      if (!keep) setup.schur.reset(), setup.exact.reset();  // the points move: new rows and blocks
+      before = sol;
+      before_setup = std::move(fitted_setup);  // (none after the first solve: the solver's own)
+      placed_for = sol.contact_boundary;
+      fitted = data;
+      fitted.conditions.contact_side = std::move(side);
+      current = &fitted;
+      continue;
     }
     if (!keep) setup.schur.reset(), setup.exact.reset();  // S_B, S_C and the kept LU: freed before the field
     break;
   }
+  if (!keep) st.green.reset();  // (kept for a fitted solve that did not come)
+  before.reset();
   BoundarySetup<dim>& setup = fitted_setup ? *fitted_setup : *st.setup;
   const BoundaryDiscretization<dim>& boundary = *setup.boundary;
   if (compute_field) {  // 6
@@ -1006,6 +1050,11 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
         "formulation.variant: γ has corners: solved with the non-smooth variant (the smooth one needs a continuous "
         "normal)");
   if (!boundary.spacing().warning.empty()) sol.warnings.push_back(boundary.spacing().warning);
+  // Each line once (the fitted solves say again what the first said).
+  std::vector<std::string> lines;
+  for (std::string& w : sol.warnings)
+    if (std::find(lines.begin(), lines.end(), w) == lines.end()) lines.push_back(std::move(w));
+  sol.warnings = std::move(lines);
   if (!keep) st.setup.reset();
   return sol;
 }
