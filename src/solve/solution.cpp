@@ -365,9 +365,10 @@ std::function<double(const Point<dim>&)> contact_side(const BasicSolution<dim>& 
   const double spacing = s.spacing();
   auto side = std::make_shared<Side>(
       Side{located_segments(s), s.points(), {}, Buckets<dim>(spacing), Buckets<dim>(spacing), 1.5 * spacing});
-  for (int i = 0; i < s.n_points(); ++i) {
+  for (int i = 0; i < s.n_points(); ++i) {  // the Signorini points (a located end lies between two)
     side->active.push_back(char(s.in_contact(i)));
-    side->point_cells.add(side->point_cells.cell(s.points()[std::size_t(i)]), i);
+    if (s.condition(i) == PointCondition::signorini)
+      side->point_cells.add(side->point_cells.cell(s.points()[std::size_t(i)]), i);
   }
   // A segment goes into every cell its box, widened by the reach, touches.
   for (std::size_t k = 0; k < side->segments.size(); ++k) {

@@ -237,7 +237,8 @@ void resolve_contact(BasicSolution<dim>& solution);
 /// The contact side of a solution's located contact boundary, for placing the points of the next solve
 /// (PartConditions::contact_side, solver.fit_contact): 1 at a point x of γ on the contact side, else 0.
 /// Within 1.5·s of the boundary, the side of its nearest segment (in 2-D: of the nearest located end,
-/// along the curve from the free point to the active one); farther away, the status of the nearest point.
+/// along the chord from the free point to the active one); farther away, the status of the nearest point
+/// of the Signorini part.
 /// Empty where the solution has no located end (nothing to fit).
 template <int dim>
 std::function<double(const Point<dim>&)> contact_side(const BasicSolution<dim>& solution);
