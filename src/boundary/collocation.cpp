@@ -12,6 +12,10 @@ namespace fictus {
 
 namespace {
 
+/// Arcs over which a snap's shift fades (make_collocation's snaps): measured on the 2-D references, 2 gave
+/// the lowest errors of 1, 2, 3, 4 and 6 (bench/results/2026-11-30-contact-snap.md).
+constexpr int snap_reach = 2;
+
 /// The arcs in the placement measure: m equal ones from (phase − ½)·W/m on; or, with breaks, each piece
 /// between consecutive breaks cut into equal arcs, the pieces given their counts one at a time to the
 /// piece whose arcs are longest (at least one each). Each arc as [begin, end) in the measure, and the
@@ -69,10 +73,70 @@ std::vector<PlacedArc> placed_arcs(const ArcLengthTable& measure, int m, double 
   return arcs;
 }
 
+/// Moves the arcs' borders so that one ends at each snap (a parameter of γ), each snap taking the
+/// nearest free border; the shift fades linearly over snap_reach arcs on either side (the breaks and
+/// the other snaps hold their borders), so the arcs stay equal away from the snaps and change by at most
+/// s/(2·snap_reach) from one to the next near them. False (the arcs untouched) where a snap finds no
+/// border of its own in its order along γ or an arc would shrink below a quarter of the spacing.
+bool snap_borders(const ArcLengthTable& measure, std::vector<PlacedArc>& arcs, const std::vector<double>& snaps) {
+  const double total = measure.length();
+  const int m = int(arcs.size());
+  const double mean = total / m;
+  std::vector<double> border(static_cast<std::size_t>(m)), shift(static_cast<std::size_t>(m), 0.0),
+      t_at(static_cast<std::size_t>(m), std::numeric_limits<double>::quiet_NaN());
+  std::vector<char> anchor(static_cast<std::size_t>(m), 0);
+  for (int i = 0; i < m; ++i) {
+    border[std::size_t(i)] = arcs[std::size_t(i)].begin;
+    if (!std::isnan(arcs[std::size_t(i)].t_begin))
+      anchor[std::size_t(i)] = 1, t_at[std::size_t(i)] = arcs[std::size_t(i)].t_begin;
+  }
+  const auto cyclic = [total](double d) { return d - total * std::round(d / total); };
+  for (double t : snaps) {
+    const double w = t <= 0 ? 0.0 : measure.s_of_t(t);
+    const int j = int(std::floor(cyclic(w - border[0]) / mean + 0.5 + m)) % m;  // arcs ≈ equal: a guess
+    int best = -1;
+    for (int k = -2; k <= 2; ++k) {
+      const int i = ((j + k) % m + m) % m;
+      if (!anchor[std::size_t(i)] &&
+          (best < 0 || std::abs(cyclic(w - border[std::size_t(i)])) < std::abs(cyclic(w - border[std::size_t(best)]))))
+        best = i;
+    }
+    if (best < 0 || std::abs(cyclic(w - border[std::size_t(best)])) > 0.75 * mean) return false;
+    anchor[std::size_t(best)] = 1, shift[std::size_t(best)] = cyclic(w - border[std::size_t(best)]);
+    t_at[std::size_t(best)] = t;
+  }
+  std::vector<int> anchors;
+  for (int i = 0; i < m; ++i)
+    if (anchor[std::size_t(i)]) anchors.push_back(i);
+  for (std::size_t a = 0; a < anchors.size(); ++a) {  // between consecutive anchors (cyclically)
+    const int from = anchors[a], gap = (a + 1 < anchors.size() ? anchors[a + 1] : anchors[0] + m) - from;
+    const double d0 = shift[std::size_t(from)], d1 = shift[std::size_t((from + gap) % m)];
+    for (int k = 1; k < gap; ++k)
+      shift[std::size_t((from + k) % m)] = gap <= 2 * snap_reach
+                                               ? d0 + (d1 - d0) * k / gap
+                                               : d0 * std::max(0.0, 1.0 - double(k) / snap_reach) +
+                                                     d1 * std::max(0.0, 1.0 - double(gap - k) / snap_reach);
+  }
+  std::vector<PlacedArc> moved(arcs.size());
+  for (int i = 0; i < m; ++i) {
+    const int next = (i + 1) % m;
+    const double begin = border[std::size_t(i)] + shift[std::size_t(i)],
+                 end = border[std::size_t(next)] + (next == 0 ? total : 0.0) + shift[std::size_t(next)];
+    if (end - begin < 0.25 * mean) return false;
+    moved[std::size_t(i)] = {0.5 * (begin + end), begin, end, t_at[std::size_t(i)],
+                             std::isnan(t_at[std::size_t(next)]) || t_at[std::size_t(next)] > 0
+                                 ? t_at[std::size_t(next)]
+                                 : 2 * std::numbers::pi};  // an arc ending at t = 0
+  }
+  arcs = std::move(moved);
+  return true;
+}
+
 }  // namespace
 
 Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase,
-                             const ArcLengthTable* placement, const std::vector<double>& breaks) {
+                             const ArcLengthTable* placement, const std::vector<double>& breaks,
+                             const std::vector<double>& snaps) {
   if (m < 1) throw std::invalid_argument("make_collocation: need m >= 1, got " + std::to_string(m));
   Collocation c;
   c.m = m;
@@ -98,10 +162,15 @@ Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_lengt
     return w <= 0 ? 0.0 : measure.t_of_s(w);
   };
   std::vector<PlacedArc> arcs = placed_arcs(measure, m, phase, breaks);
+  if (!snaps.empty() && !snap_borders(measure, arcs, snaps)) {  // then arcs end at them as at breaks
+    std::vector<double> all = breaks;
+    all.insert(all.end(), snaps.begin(), snaps.end());
+    arcs = placed_arcs(measure, m, phase, all);
+  }
   // Point 0 is the first from t = 0 on (an arc may wrap past 0).
   std::stable_sort(arcs.begin(), arcs.end(),
                    [&wrap](const PlacedArc& a, const PlacedArc& b) { return wrap(a.centre) < wrap(b.centre); });
-  const bool equal = !placement && breaks.empty();
+  const bool equal = !placement && breaks.empty() && snaps.empty();
   for (int i = 0; i < m; ++i) {
     const PlacedArc& a = arcs[std::size_t(i)];
     const double w = a.centre;

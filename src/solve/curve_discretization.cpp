@@ -22,8 +22,33 @@ CurveDiscretization::CurveDiscretization(std::shared_ptr<const Curve> gamma, con
   if (!gamma_) throw std::invalid_argument("geometry: no curve given");
   SolverOptions resolved = options;
   resolved.variant = resolved_variant(options.variant, gamma_->smooth());
-  make_geometry(grid, resolved, parts);
+  make_shape(grid, resolved);
+  place_points(resolved, parts);
   make_trace_rows(grid, resolved, c);
+}
+
+CurveDiscretization::CurveDiscretization(const CurveDiscretization& base, const SolverOptions& options, double c,
+                                         const PartConditions<2>& parts)
+    : execution_(base.execution_),
+      gamma_(base.gamma_),
+      Gamma_(base.Gamma_),
+      delta_(base.delta_),
+      spacing_(base.spacing_),
+      samples_(base.samples_),
+      arc_length_(base.arc_length_),
+      placement_(base.placement_),
+      gamma_geometry_(base.gamma_geometry_),
+      Gamma_geometry_(base.Gamma_geometry_) {
+  SolverOptions resolved = options;
+  resolved.variant = resolved_variant(options.variant, gamma_->smooth());
+  place_points(resolved, parts);
+  make_trace_rows(gamma_geometry_->grid(), resolved, c);
+}
+
+std::unique_ptr<BoundaryDiscretization<2>> CurveDiscretization::placed_for(const PartConditions<2>& parts,
+                                                                           const SolverOptions& options, double c,
+                                                                           const MarkPhase&) const {
+  return std::unique_ptr<BoundaryDiscretization<2>>(new CurveDiscretization(*this, options, c, parts));
 }
 
 namespace {
@@ -81,10 +106,8 @@ OffsetRoom curve_offset_room(std::shared_ptr<const Curve> gamma, const Box2& box
 
 std::vector<int> CurveDiscretization::part_layout(const PartConditions<2>& parts) const {
   if (!parts.placed()) return {};
-  const int samples = std::max(4096, 16 * spacing_.m);
-  std::vector<int> layout(static_cast<std::size_t>(samples));
-  for (int k = 0; k < samples; ++k)
-    layout[std::size_t(k)] = parts.label(gamma_->position(2 * std::numbers::pi * (k + 0.5) / samples));
+  std::vector<int> layout(samples_->size());
+  for (std::size_t k = 0; k < layout.size(); ++k) layout[k] = parts.label((*samples_)[k]);
   return layout;
 }
 
@@ -118,7 +141,7 @@ std::vector<std::pair<double, int>> CurveDiscretization::junctions(const PartCon
   return out;
 }
 
-void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options, const PartConditions<2>& parts) {
+void CurveDiscretization::make_shape(const Grid2& grid, const SolverOptions& options) {
   const Curve& gamma = *gamma_;
   const double h = grid.h(), width = grid.box().width(0);
   check_simple(gamma, "geometry");
@@ -138,10 +161,9 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
           c.distance, c.at.x, c.at.y);
     throw std::invalid_argument(text);
   }
-  gamma_geometry_ = std::make_unique<CurveGridIntersection>(gamma, grid, "geometry");
-
-  const ArcLengthTable arc_length(gamma);
-  const double L = arc_length.length();
+  gamma_geometry_ = std::make_shared<const CurveGridIntersection>(gamma, grid, "geometry");
+  arc_length_ = std::make_shared<const ArcLengthTable>(gamma);
+  const double L = arc_length_->length();
   if (options.variant == Variant::smooth && !gamma.smooth())
     throw std::invalid_argument(
         "formulation.variant: the smooth variant needs a curve with a continuous normal "
@@ -155,6 +177,29 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
                      [L, spacing_cells](double k) { return default_multipliers(L, k, spacing_cells); },
                      options.variant == Variant::smooth ? curve_offset_room(gamma_, grid.box()) : OffsetRoom()};
   spacing_ = plan_spacing(input, options);
+  const int samples = std::max(4096, 16 * spacing_.m);
+  auto at = std::make_shared<std::vector<Point2>>(std::size_t(samples));
+  for (int k = 0; k < samples; ++k) (*at)[std::size_t(k)] = gamma.position(2 * std::numbers::pi * (k + 0.5) / samples);
+  samples_ = std::move(at);
+  if (options.variant == Variant::nonsmooth) {
+    Gamma_ = gamma_;
+    return;
+  }
+  delta_ = spacing_.delta;
+  // Points placed so that the arcs of Γ behind them are equal where γ is convex (there Γ's arcs are
+  // stretched by 1 + δκ): the longest arc of Γ, which sets the ripple of the controls, is as short as m
+  // allows (docs/math.md, "Placement of the points").
+  placement_ = std::make_shared<const ArcLengthTable>(offset_placement(gamma, delta_));
+  Gamma_ = std::make_shared<OffsetCurve>(gamma_, delta_);
+  check_simple(*Gamma_, "formulation.offset");  // the plan's room says so; checked again on Γ itself
+  check_inside_box(*Gamma_, grid.box(), 2 * h, "formulation.offset");
+  Gamma_geometry_ = std::make_shared<const CurveGridIntersection>(*Gamma_, grid, "formulation.offset");
+}
+
+void CurveDiscretization::place_points(const SolverOptions& options, const PartConditions<2>& parts) {
+  const Curve& gamma = *gamma_;
+  const ArcLengthTable& arc_length = *arc_length_;
+  const double L = arc_length.length();
   const int m = spacing_.m;
   // Mixed conditions: the arcs end where the parts meet (and at the corners, which the phase would
   // otherwise keep the points away from), so that each point's arc lies in one part.
@@ -164,7 +209,7 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
   // A junction of the contact fit (the Signorini part on both sides) within a quarter spacing of another
   // break is left out: no sliver of an arc between them.
   std::vector<double> breaks;
-  std::vector<double> fitted;  // the contact fit's
+  std::vector<double> fitted, snaps;  // the contact fit's, and those kept
   for (std::size_t k = 0; k < joins.size(); ++k) {
     const int before = joins[(k + joins.size() - 1) % joins.size()].second, after = joins[k].second;
     const bool contact_only = PartConditions<2>::condition_of(before) == PartConditions<2>::condition_of(after);
@@ -172,17 +217,18 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
   }
   for (double t : fitted) {
     bool near = false;
-    for (double b : breaks) {
-      const double d = std::abs(arc_length.s_of_t(t) - arc_length.s_of_t(b));
-      near = near || std::min(d, L - d) < 0.25 * L / m;
-    }
-    if (!near) breaks.push_back(t);
+    for (const std::vector<double>* kept : {&breaks, &snaps})
+      for (double b : *kept) {
+        const double d = std::abs(arc_length.s_of_t(t) - arc_length.s_of_t(b));
+        near = near || std::min(d, L - d) < 0.25 * L / m;
+      }
+    if (!near) snaps.push_back(t);
   }
   std::sort(breaks.begin(), breaks.end());
   // The corners too (non-smooth), where they are few: one within a quarter spacing of a junction is
   // left to the junction (no sliver of an arc between them).
   if (const std::vector<double> corners = gamma.corners();
-      !breaks.empty() && options.variant == Variant::nonsmooth && int(corners.size()) <= m / 4)
+      !(breaks.empty() && snaps.empty()) && options.variant == Variant::nonsmooth && int(corners.size()) <= m / 4)
     for (double t : corners) {
       bool near = false;
       for (const auto& [junction, part] : joins) {
@@ -202,23 +248,12 @@ void CurveDiscretization::make_geometry(const Grid2& grid, SolverOptions options
           PartConditions<2>::condition_of((it == joins.begin() ? joins.back() : *std::prev(it)).second);
     }
   };
-  if (options.variant == Variant::nonsmooth) {
-    collocation_ = make_collocation(gamma, arc_length, m, phase_off_corners(gamma, arc_length, m), nullptr, breaks);
-    set_point_parts();
-    Gamma_ = gamma_;
-    return;
-  }
-  delta_ = spacing_.delta;
-  // Points placed so that the arcs of Γ behind them are equal where γ is convex (there Γ's arcs are
-  // stretched by 1 + δκ): the longest arc of Γ, which sets the ripple of the controls, is as short as m
-  // allows (docs/math.md, "Placement of the points").
-  const ArcLengthTable placement = offset_placement(gamma, delta_);
-  collocation_ = make_collocation(gamma, arc_length, m, 0.5, &placement, breaks);
+  if (options.variant == Variant::nonsmooth)
+    collocation_ =
+        make_collocation(gamma, arc_length, m, phase_off_corners(gamma, arc_length, m), nullptr, breaks, snaps);
+  else
+    collocation_ = make_collocation(gamma, arc_length, m, 0.5, placement_.get(), breaks, snaps);
   set_point_parts();
-  Gamma_ = std::make_shared<OffsetCurve>(gamma_, delta_);
-  check_simple(*Gamma_, "formulation.offset");  // the plan's room says so; checked again on Γ itself
-  check_inside_box(*Gamma_, grid.box(), 2 * h, "formulation.offset");
-  Gamma_geometry_ = std::make_unique<CurveGridIntersection>(*Gamma_, grid, "formulation.offset");
 }
 
 void CurveDiscretization::make_trace_rows(const Grid2& grid, const SolverOptions& options, double c) {

@@ -226,6 +226,20 @@ std::unique_ptr<BoundarySetup<dim>> new_boundary_setup(const State<dim>& st, con
   return setup;
 }
 
+/// Steps 1–2 for the points placed for data.conditions, on the shape of `base` (the contact fit: made for
+/// this solve only).
+template <int dim>
+std::unique_ptr<BoundarySetup<dim>> placed_setup(const BoundarySetup<dim>& base, const BasicContactData<dim>& data,
+                                                 const SolverOptions& options, double c, PhaseClock& clock) {
+  auto setup = std::make_unique<BoundarySetup<dim>>();
+  setup->gamma = data.gamma;
+  setup->options = options;
+  const MarkPhase mark = [&clock](const std::string& phase) { clock.mark(phase); };
+  setup->boundary = base.boundary->placed_for(data.conditions, options, c, mark);
+  if constexpr (dim == 2) clock.mark("geometry");
+  return setup;
+}
+
 /// Step 0: the load vector and u₀ = A⁻¹f (A⁺f for a singular A), once per load.
 template <int dim>
 void load_and_u0(State<dim>& st, PhaseClock& clock, std::size_t& fast_solves) {
@@ -928,7 +942,7 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
   std::optional<BasicSolution<dim>> before;
   const auto solve_pass = [&](int pass, bool last) -> BoundarySetup<dim>& {
     sol.far_field.reset();
-    if (pass > 0) fitted_setup = new_boundary_setup<dim>(st, fitted, options, clock);
+    if (pass > 0) fitted_setup = placed_setup<dim>(*st.setup, fitted, options, st.c, clock);
     BoundarySetup<dim>& setup =
         pass > 0 ? *fitted_setup : boundary_setup<dim>(st, data, options, clock, sol.reused_curve);  // 1–2
     obstacle_and_conditions<dim>(*setup.boundary, *current, st.c, sol);                              // 4

@@ -74,8 +74,29 @@ SurfaceDiscretization::SurfaceDiscretization(std::shared_ptr<const Surface> gamm
                                              const MarkPhase& mark, const PartConditions<3>& parts)
     : grid_(grid), gamma_(std::move(gamma)), execution_(execution), c_(c), balance_wanted_(options.flux_balance) {
   if (!gamma_) throw std::invalid_argument("geometry: no surface given");
-  make_geometry(options, parts);
+  make_shape(options);
+  place_points(options, parts);
   make_trace_rows(options, mark);
+}
+
+SurfaceDiscretization::SurfaceDiscretization(const SurfaceDiscretization& base, const SolverOptions& options,
+                                             const MarkPhase& mark, const PartConditions<3>& parts)
+    : grid_(base.grid_),
+      gamma_(base.gamma_),
+      execution_(base.execution_),
+      c_(base.c_),
+      balance_wanted_(base.balance_wanted_),
+      plan_(base.plan_),
+      delta_(base.delta_),
+      unsplit_(base.unsplit_) {
+  place_points(options, parts);
+  make_trace_rows(options, mark);
+}
+
+std::unique_ptr<BoundaryDiscretization<3>> SurfaceDiscretization::placed_for(const PartConditions<3>& parts,
+                                                                             const SolverOptions& options, double,
+                                                                             const MarkPhase& mark) const {
+  return std::unique_ptr<BoundaryDiscretization<3>>(new SurfaceDiscretization(*this, options, mark, parts));
 }
 
 SurfaceDiscretization::~SurfaceDiscretization() = default;
@@ -88,7 +109,7 @@ std::vector<int> SurfaceDiscretization::part_layout(const PartConditions<3>& par
   return layout;
 }
 
-void SurfaceDiscretization::make_geometry(const SolverOptions& options, const PartConditions<3>& parts) {
+void SurfaceDiscretization::make_shape(const SolverOptions& options) {
   const Surface& gamma = *gamma_;
   const double h = grid_.h();
   check_inside_box(gamma, grid_, 0, "geometry");  // before any work
@@ -105,8 +126,17 @@ void SurfaceDiscretization::make_geometry(const SolverOptions& options, const Pa
       {3, area, h, box.width(0), [area, variant](double k) { return default_patches(area, k, variant); }, room},
       options);
   execution_.throw_if_interrupted();
-  gamma_patches_ = gamma.patches(plan_.m, h);
+  unsplit_ = std::make_shared<const PatchedSurface>(gamma.patches(plan_.m, h));
   execution_.throw_if_interrupted();
+  if (options.variant == Variant::smooth) {
+    delta_ = plan_.delta;
+    check_inside_box(gamma, grid_, delta_, "formulation.offset");
+  }
+}
+
+void SurfaceDiscretization::place_points(const SolverOptions& options, const PartConditions<3>& parts) {
+  const Surface& gamma = *gamma_;
+  gamma_patches_ = *unsplit_;
   part_layout_ = part_layout(parts);
   if (!part_layout_.empty() &&
       std::any_of(part_layout_.begin(), part_layout_.end(), [&](int c) { return c != part_layout_[0]; })) {
@@ -139,8 +169,6 @@ void SurfaceDiscretization::make_geometry(const SolverOptions& options, const Pa
   }
   Gamma_patches_ = gamma_patches_;
   if (options.variant == Variant::smooth) {
-    delta_ = plan_.delta;
-    check_inside_box(gamma, grid_, delta_, "formulation.offset");
     Gamma_patches_.triangles = offset_triangles(gamma_patches_.triangles, gamma, delta_);
     for (int p = 0; p < plan_.m; ++p)
       Gamma_patches_.point[p] = gamma_patches_.point[p] + delta_ * gamma_patches_.normal[p];

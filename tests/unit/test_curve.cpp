@@ -130,6 +130,55 @@ TEST(Collocation, ArcsEndAtTheBreaks) {
   EXPECT_THROW(fictus::make_collocation(e, table, 2, 0.5, nullptr, breaks), std::invalid_argument);
 }
 
+TEST(Collocation, SnapsMoveTheNearestBordersAndKeepTheOtherArcs) {
+  // The contact fit's ends: an arc ends at each snap (one past t = 0 on the wrap, one beside a break), the
+  // arcs more than a few away from every snap are those without snaps, and neighbouring arcs differ by at
+  // most a quarter of the spacing (the shift, at most s/2, fades over two arcs).
+  const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2, 0.3);
+  const fictus::ArcLengthTable table(e);
+  const int m = 60;
+  const std::vector<double> breaks = {2.5};
+  const std::vector<double> snaps = {0.93, 2.62, 6.2};
+  const fictus::Collocation plain = fictus::make_collocation(e, table, m, 0.5, nullptr, breaks);
+  const fictus::Collocation c = fictus::make_collocation(e, table, m, 0.5, nullptr, breaks, snaps);
+  ASSERT_EQ(c.m, m);
+  const double L = table.length(), s = L / m;
+  double total = 0;
+  for (int i = 0; i < m; ++i) {
+    total += c.arc[i];
+    EXPECT_NEAR(c.arc_end[i], c.arc_begin[(i + 1) % m], 1e-12) << i;
+    EXPECT_GT(c.arc[i], 0.5 * s) << i;
+    EXPECT_LT(std::abs(c.arc[i] - c.arc[(i + 1) % m]), 0.25 * s + 1e-12) << i;
+  }
+  EXPECT_NEAR(total, L, 1e-12);
+  for (double t : {breaks[0], snaps[0], snaps[1], snaps[2]}) {
+    int ends = 0;
+    for (int i = 0; i < m; ++i) ends += std::abs(c.arc_end[i] - t) < 1e-14;
+    EXPECT_EQ(ends, 1) << "end " << t;
+  }
+  int kept = 0;
+  for (int i = 0; i < m; ++i) {
+    double nearest = L;
+    for (double t : snaps) {
+      const double d = std::abs(c.s[i] - table.s_of_t(t));
+      nearest = std::min(nearest, std::min(d, L - d));
+    }
+    if (nearest > 3.5 * s) {
+      EXPECT_NEAR(c.arc[i], plain.arc[i], 1e-12) << i;
+      ++kept;
+    }
+  }
+  EXPECT_GT(kept, m / 2);
+  // Two snaps closer than an arc: the arcs still end at both.
+  const std::vector<double> close = {1.0, 1.0 + 0.3 * s / table.length() * 2 * pi};
+  const fictus::Collocation d = fictus::make_collocation(e, table, m, 0.5, nullptr, {}, close);
+  for (double t : close) {
+    int ends = 0;
+    for (int i = 0; i < m; ++i) ends += std::abs(d.arc_end[i] - t) < 1e-14;
+    EXPECT_EQ(ends, 1) << "close end " << t;
+  }
+}
+
 TEST(Collocation, DefaultRuleKeepsTheSpacingInCells) {
   const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2);
   const double L = fictus::ArcLengthTable(e).length();

@@ -29,9 +29,13 @@ struct Collocation {
 /// measure's (i + phase)·W/m. With `breaks` (parameters of γ, e.g. where the conditions' parts meet), an
 /// arc ends at each break: the pieces between consecutive breaks get arcs equal within each piece, as
 /// many as keep the longest arc shortest (at least one a piece; `phase` is then unused). Throws
-/// std::invalid_argument naming formulation.multipliers when m is below the number of pieces.
+/// std::invalid_argument naming formulation.multipliers when m is below the number of pieces. With `snaps`
+/// (the contact fit's ends), the arcs so placed then move so that an arc ends at each snap: the nearest
+/// border moves there and the shift fades over a few arcs on either side, so the arcs stay nearly
+/// equal; where that cannot be done the snaps are taken as breaks.
 Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase = 0.5,
-                             const ArcLengthTable* placement = nullptr, const std::vector<double>& breaks = {});
+                             const ArcLengthTable* placement = nullptr, const std::vector<double>& breaks = {},
+                             const std::vector<double>& snaps = {});
 
 /// The smooth variant's placement measure for Γ at distance δ: speed |p′(t)|·max(1, 1 + δκ(t)), the
 /// speed of the offset curve where γ is convex and of γ itself where it is concave.

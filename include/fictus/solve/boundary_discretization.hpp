@@ -94,6 +94,12 @@ class BoundaryDiscretization {
   const std::vector<PointCondition>& point_parts() const { return point_parts_; }
   /// Whether `parts` divide γ as the parts the points were placed for (then the setup can be kept).
   virtual bool same_parts(const PartConditions<dim>& parts) const { return part_layout(parts) == part_layout_; }
+  /// The same boundary with its points placed for `parts` (the contact fit's: docs/math.md, "Fitting the
+  /// points to the contact set"), sharing what does not depend on the points (the shape's checks and
+  /// grid intersections, m and δ). `options` and c as for this one; `mark` as the constructor's.
+  virtual std::unique_ptr<BoundaryDiscretization<dim>> placed_for(const PartConditions<dim>& parts,
+                                                                  const SolverOptions& options, double c,
+                                                                  const MarkPhase& mark) const = 0;
 
  protected:
   /// The label (PartConditions::label) of each of γ's fine pieces (2-D: samples of the curve; 3-D: the

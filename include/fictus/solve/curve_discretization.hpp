@@ -50,12 +50,22 @@ class CurveDiscretization final : public BoundaryDiscretization<2> {
                            const Data& data) const override;
   void describe(SolutionBoundary<2>& out) const override;
 
+  /// The same curve with its points placed for `parts` (the contact fit's); the grid intersections of γ
+  /// and Γ, m, δ and the arc-length tables are shared, not made again.
+  std::unique_ptr<BoundaryDiscretization<2>> placed_for(const PartConditions<2>& parts, const SolverOptions& options,
+                                                        double c, const MarkPhase& mark) const override;
+
   const Collocation& collocation() const { return collocation_; }
   const std::shared_ptr<const Curve>& gamma() const { return gamma_; }
   const std::shared_ptr<const Curve>& Gamma() const { return Gamma_; }
 
  private:
-  void make_geometry(const Grid2& grid, SolverOptions options, const PartConditions<2>& parts);
+  CurveDiscretization(const CurveDiscretization& base, const SolverOptions& options, double c,
+                      const PartConditions<2>& parts);
+  /// Step 1 without the points: γ's checks and grid intersection, m, δ, Γ and its grid intersection.
+  void make_shape(const Grid2& grid, const SolverOptions& options);
+  /// The points for `parts`, their arcs ending at its junctions.
+  void place_points(const SolverOptions& options, const PartConditions<2>& parts);
   /// The labels at K = max(4096, 16m) samples of γ, at t = 2π(k + ½)/K.
   std::vector<int> part_layout(const PartConditions<2>& parts) const override;
   /// The parameters where the pieces meet, each with the label of the piece that follows it, from the
@@ -71,7 +81,9 @@ class CurveDiscretization final : public BoundaryDiscretization<2> {
   Collocation collocation_;
   double delta_ = 0;
   SpacingPlan spacing_;
-  std::unique_ptr<CurveGridIntersection> gamma_geometry_, Gamma_geometry_;
+  std::shared_ptr<const std::vector<Point2>> samples_;            // part_layout's points of γ
+  std::shared_ptr<const ArcLengthTable> arc_length_, placement_;  // placement_: smooth variant only
+  std::shared_ptr<const CurveGridIntersection> gamma_geometry_, Gamma_geometry_;
   SparseRows B_gamma_, C_gamma_, B_Gamma_, loads_;
   DirectTerms direct_;
   std::unique_ptr<KinkCorrection> kink_;

@@ -74,9 +74,18 @@ class SurfaceDiscretization final : public BoundaryDiscretization<3> {
   PointErrors point_errors(const std::vector<double>& trace, const std::vector<double>& normal_derivative,
                            const Data& data) const override;
   void describe(SolutionBoundary<3>& out) const override;
+  /// The same surface with its patches made for `parts` (the contact fit's); m, δ and the triangulation of
+  /// γ before it is cut into patches are shared, not made again.
+  std::unique_ptr<BoundaryDiscretization<3>> placed_for(const PartConditions<3>& parts, const SolverOptions& options,
+                                                        double c, const MarkPhase& mark) const override;
 
  private:
-  void make_geometry(const SolverOptions& options, const PartConditions<3>& parts);
+  SurfaceDiscretization(const SurfaceDiscretization& base, const SolverOptions& options, const MarkPhase& mark,
+                        const PartConditions<3>& parts);
+  /// Step 1 without the patches: γ inside the box, m, δ, γ's triangulation.
+  void make_shape(const SolverOptions& options);
+  /// The patches for `parts` (each in one part), their points and Γ's triangles.
+  void place_points(const SolverOptions& options, const PartConditions<3>& parts);
   /// The labels at the centroids of γ's triangles.
   std::vector<int> part_layout(const PartConditions<3>& parts) const override;
   void make_trace_rows(const SolverOptions& options, const MarkPhase& mark);
@@ -88,6 +97,7 @@ class SurfaceDiscretization final : public BoundaryDiscretization<3> {
   bool balance_wanted_;
   SpacingPlan plan_;
   double delta_ = 0;
+  std::shared_ptr<const PatchedSurface> unsplit_;  // γ.patches(m, h), before the parts cut it
   PatchedSurface gamma_patches_, Gamma_patches_;
   SparseRows B_gamma_, C_gamma_, B_Gamma_, loads_;
   DirectTerms direct_;
