@@ -117,9 +117,10 @@ bool snap_borders(const ArcLengthTable& measure, std::vector<PlacedArc>& arcs, c
                                                : d0 * std::max(0.0, 1.0 - double(k) / snap_reach) +
                                                      d1 * std::max(0.0, 1.0 - double(gap - k) / snap_reach);
   }
-  std::vector<PlacedArc> moved(arcs.size());
+  std::vector<PlacedArc> moved(arcs);  // an arc whose borders stay is kept bit for bit (its rows too)
   for (int i = 0; i < m; ++i) {
     const int next = (i + 1) % m;
+    if (shift[std::size_t(i)] == 0 && shift[std::size_t(next)] == 0) continue;
     const double begin = border[std::size_t(i)] + shift[std::size_t(i)],
                  end = border[std::size_t(next)] + (next == 0 ? total : 0.0) + shift[std::size_t(next)];
     if (end - begin < 0.25 * mean) return false;

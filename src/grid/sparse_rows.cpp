@@ -39,6 +39,27 @@ std::vector<double> SparseRows::row_sums() const {
   return sums;
 }
 
+SparseRows select_rows(const SparseRows& rows, const std::vector<int>& which) {
+  SparseRows out;
+  for (int r : which) {
+    out.entries.insert(out.entries.end(), rows.entries.begin() + std::ptrdiff_t(rows.row_begin[std::size_t(r)]),
+                       rows.entries.begin() + std::ptrdiff_t(rows.row_begin[std::size_t(r) + 1]));
+    out.row_begin.push_back(out.entries.size());
+  }
+  return out;
+}
+
+bool same_row(const SparseRows& a, const SparseRows& b, int r) {
+  const std::size_t n = a.row_begin[std::size_t(r) + 1] - a.row_begin[std::size_t(r)];
+  if (n != b.row_begin[std::size_t(r) + 1] - b.row_begin[std::size_t(r)]) return false;
+  for (std::size_t k = 0; k < n; ++k) {
+    const SparseRows::Entry &x = a.entries[a.row_begin[std::size_t(r)] + k],
+                            &y = b.entries[b.row_begin[std::size_t(r)] + k];
+    if (x.index != y.index || x.value != y.value) return false;
+  }
+  return true;
+}
+
 SparseRows add_rows(const SparseRows& a, const SparseRows& b) {
   SparseRows out;
   for (int r = 0; r < a.n_rows(); ++r) {

@@ -273,12 +273,34 @@ void load_and_u0(State<dim>& st, PhaseClock& clock, std::size_t& fast_solves) {
   clock.mark("u0");
 }
 
+/// The points whose rows (B_γ, C_γ, loads) differ between two boundaries with as many points, when the
+/// blocks of `before` can be updated for them: dense blocks with exact entries and no direct terms, and
+/// at most half the points changed; else nullopt.
+template <int dim>
+std::optional<std::vector<int>> changed_points(const BoundarySetup<dim>* before, const BoundaryDiscretization<dim>& b,
+                                               const SolverOptions& options) {
+  if (!before || !before->schur || before->exact || !dynamic_cast<const ExplicitSchur*>(before->schur.get()) ||
+      options.inner != InnerSolver::green || b.far_field(options).order != 0 || !b.direct().empty())
+    return std::nullopt;
+  const BoundaryDiscretization<dim>& a = *before->boundary;
+  const int m = b.n_points();
+  if (a.n_points() != m || !a.direct().empty()) return std::nullopt;
+  std::vector<int> changed;
+  for (int i = 0; i < m; ++i)
+    if (!same_row(a.B_gamma(), b.B_gamma(), i) || !same_row(a.C_gamma(), b.C_gamma(), i) ||
+        !same_row(a.loads(), b.loads(), i))
+      changed.push_back(i);
+  if (2 * changed.size() > std::size_t(m)) return std::nullopt;
+  return changed;
+}
+
 /// Steps 2b–3: the boundary's grid-level setup and the Schur blocks, explicit from the Green's table
 /// (its far field interpolated where the boundary allows it) or implicit. With `keep` false the
-/// Green's table is freed once the blocks are made.
+/// Green's table is freed once the blocks are made. With `before` (the contact fit's previous solve),
+/// dense blocks are those of `before` with the entries of the moved points made again.
 template <int dim>
-void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions& options, PhaseClock& clock,
-                  bool keep) {
+void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions& options, PhaseClock& clock, bool keep,
+                  const BoundarySetup<dim>* before = nullptr) {
   if (setup.schur) return;
   BoundaryDiscretization<dim>& b = *setup.boundary;
   const MarkPhase mark = [&clock](const std::string& phase) { clock.mark(phase); };
@@ -315,6 +337,12 @@ void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
                                                  b.direct(), h_options, inner);
     setup.storage = h->storage();
     setup.schur = std::move(h);
+  } else if (const std::optional<std::vector<int>> changed = changed_points<dim>(before, b, options)) {
+    auto dense_blocks = std::make_unique<ExplicitSchur>(static_cast<const ExplicitSchur&>(*before->schur), *changed,
+                                                        *st.green, b.B_gamma(), b.C_gamma(), b.loads(), st.execution);
+    dense_blocks->share(distribution);
+    setup.schur = std::move(dense_blocks);
+    setup.storage = before->storage;
   } else {
     FarFieldReport report;
     auto dense_blocks = std::make_unique<ExplicitSchur>(*st.green, b.B_gamma(), b.C_gamma(), b.loads(), st.execution,
@@ -956,7 +984,10 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
     load_and_u0<dim>(st, clock, sol.fast_solves);  // 0
     st.execution.throw_if_interrupted();
     const bool made = !setup.schur;
-    schur_blocks<dim>(st, setup, options, clock, keep || !last);  // 2b–3
+    // The solve before's blocks (a fitted solve updates them where the points moved), then freed.
+    BoundarySetup<dim>* previous = pass == 0 ? nullptr : pass == 1 ? st.setup.get() : before_setup.get();
+    schur_blocks<dim>(st, setup, options, clock, keep || !last, previous);  // 2b–3
+    if (previous && !keep) previous->schur.reset(), previous->exact.reset();
     if (made) sol.fast_solves += setup.fast_solves;
     load_terms<dim>(st, setup);
     const BoundaryDiscretization<dim>& boundary = *setup.boundary;
@@ -997,6 +1028,9 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
       --sol.contact_fit->passes;  // the fitted solves whose results stand
       fitted_setup = std::move(before_setup);
       current = &data;
+      if (!keep)  // (the failed solve may have stopped before it freed the blocks before it)
+        for (BoundarySetup<dim>* s : {st.setup.get(), fitted_setup.get()})
+          if (s) s->schur.reset(), s->exact.reset();
       break;
     }
     BoundarySetup<dim>& setup = *made;
@@ -1019,7 +1053,6 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
       if (!sol.contact_fit) sol.contact_fit.emplace(), sol.contact_fit->newton_steps.push_back(sol.newton.iterations);
       ++sol.contact_fit->passes;
       sol.contact_fit->seconds += merge_phases(sol.timings, pass_begins, "fit_contact");
-      if (!keep) setup.schur.reset(), setup.exact.reset();  // the points move: new rows and blocks
       before = sol;
       before_setup = std::move(fitted_setup);  // (none after the first solve: the solver's own)
       placed_for = sol.contact_boundary;

@@ -216,6 +216,36 @@ template ExplicitSchur::ExplicitSchur(const GreenTable<2>&, const SparseRows&, c
 template ExplicitSchur::ExplicitSchur(const GreenTable<3>&, const SparseRows&, const SparseRows&, const SparseRows&,
                                       const Execution&, const DirectTerms&, const FarField&, FarFieldReport*);
 
+template <int dim>
+ExplicitSchur::ExplicitSchur(const ExplicitSchur& before, const std::vector<int>& changed, const GreenTable<dim>& green,
+                             const SparseRows& B_gamma, const SparseRows& C_gamma, const SparseRows& loads,
+                             const Execution& execution)
+    : S_B_(before.S_B_), S_C_(before.S_C_) {
+  if (changed.empty()) return;
+  const SparseRows B = select_rows(B_gamma, changed), C = select_rows(C_gamma, changed),
+                   L = select_rows(loads, changed);
+  std::vector<Eigen::MatrixXd> rows = green_blocks(green, {&B, &C}, loads, execution);
+  std::vector<Eigen::MatrixXd> columns = green_blocks(green, {&B_gamma, &C_gamma}, L, execution);
+  if (green.partial())
+    for (std::vector<Eigen::MatrixXd>* blocks : {&rows, &columns})
+      for (Eigen::MatrixXd& block : *blocks) execution.distribution().sum(block.data(), std::size_t(block.size()));
+  for (std::size_t k = 0; k < changed.size(); ++k) {
+    const Eigen::Index i = changed[k];
+    S_B_.col(i) = columns[0].col(Eigen::Index(k));
+    S_C_.col(i) = columns[1].col(Eigen::Index(k));
+  }
+  for (std::size_t k = 0; k < changed.size(); ++k) {
+    const Eigen::Index i = changed[k];
+    S_B_.row(i) = rows[0].row(Eigen::Index(k));
+    S_C_.row(i) = rows[1].row(Eigen::Index(k));
+  }
+}
+
+template ExplicitSchur::ExplicitSchur(const ExplicitSchur&, const std::vector<int>&, const GreenTable<2>&,
+                                      const SparseRows&, const SparseRows&, const SparseRows&, const Execution&);
+template ExplicitSchur::ExplicitSchur(const ExplicitSchur&, const std::vector<int>&, const GreenTable<3>&,
+                                      const SparseRows&, const SparseRows&, const SparseRows&, const Execution&);
+
 void ExplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const {
   sb = S_B_ * lambda;
   sc = S_C_ * lambda;

@@ -6,11 +6,13 @@
 #include <array>
 #include <ostream>
 
+#include "fictus/boundary/curve.hpp"
 #include "fictus/boundary/omega_quadrature.hpp"
 #include "fictus/boundary/surface.hpp"
 #include "fictus/boundary/surface_integrals.hpp"
 #include "fictus/boundary/trace_operators.hpp"
 #include "fictus/grid/fast_solver.hpp"
+#include "fictus/solve/curve_discretization.hpp"
 #include "fictus/solve/fictitious_domain_solver.hpp"
 #include "fictus/solve/hierarchical_schur.hpp"
 #include "fictus/solve/schur_complement.hpp"
@@ -261,6 +263,36 @@ TEST(GreenBlocks, EmptyRowsGiveEmptyBlocks) {
   const fictus::SparseRows one = fictus::point_value_rows(grid, {fictus::Point3{0.5, 0.5, 0.5}});
   EXPECT_EQ(fictus::green_block(green, none, one, fictus::Execution{}, {6, 2.0, 2}).size(), 0);
   EXPECT_EQ(fictus::green_block(green, one, none, fictus::Execution{}, {6, 2.0, 2}).size(), 0);
+}
+
+TEST(GreenBlocks, ContactFitUpdatesTheMovedPointsOnly) {
+  // The contact fit places the points again for a contact side: only the points near its ends move, and
+  // the blocks updated in their rows and columns equal the blocks assembled afresh.
+  const fictus::Grid2 grid(fictus::Box2{{0, 0}, {1, 1}}, 256);
+  const fictus::Execution execution(2);
+  fictus::SolverOptions options;
+  options.variant = fictus::Variant::smooth;
+  const auto gamma = std::make_shared<const fictus::Ellipse>(fictus::Point2{0.5, 0.5}, 0.35, 0.2, 0.4);
+  const fictus::CurveDiscretization a(gamma, grid, options, 1.0, execution);
+  fictus::PartConditions<2> parts;
+  parts.contact_side = [](const fictus::Point2& x) { return x.x + 0.3 * x.y > 0.61 ? 1.0 : 0.0; };
+  const std::unique_ptr<fictus::BoundaryDiscretization<2>> b = a.placed_for(parts, options, 1.0, {});
+  ASSERT_EQ(b->n_points(), a.n_points());
+  const int m = a.n_points();
+  std::vector<int> changed;
+  for (int i = 0; i < m; ++i)
+    if (!fictus::same_row(a.B_gamma(), b->B_gamma(), i) || !fictus::same_row(a.C_gamma(), b->C_gamma(), i) ||
+        !fictus::same_row(a.loads(), b->loads(), i))
+      changed.push_back(i);
+  EXPECT_GE(changed.size(), 2u);   // two ends, a border moved at each
+  EXPECT_LE(changed.size(), 12u);  // and its shift fades over two arcs on either side
+  const fictus::GreenTable<2> green(grid, 1.0, execution);
+  const fictus::ExplicitSchur before(green, a.B_gamma(), a.C_gamma(), a.loads(), execution);
+  const fictus::ExplicitSchur fresh(green, b->B_gamma(), b->C_gamma(), b->loads(), execution);
+  const fictus::ExplicitSchur updated(before, changed, green, b->B_gamma(), b->C_gamma(), b->loads(), execution);
+  EXPECT_LE(relative_max_difference(updated.S_B(), fresh.S_B()), 1e-15);
+  EXPECT_LE(relative_max_difference(updated.S_C(), fresh.S_C()), 1e-15);
+  EXPECT_GT(relative_max_difference(before.S_B(), fresh.S_B()), 1e-6);  // the points did move
 }
 
 }  // namespace

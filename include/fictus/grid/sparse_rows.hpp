@@ -32,6 +32,12 @@ struct SparseRows {
   std::vector<double> row_sums() const;
 };
 
+/// The rows `which` of `rows`, in that order.
+SparseRows select_rows(const SparseRows& rows, const std::vector<int>& which);
+
+/// Whether row r of a and row r of b hold the same entries (nodes and values, bit for bit, in order).
+bool same_row(const SparseRows& a, const SparseRows& b, int r);
+
 /// Row-wise sum a + b of two sets of rows with the same number of rows (entries of a node merged).
 SparseRows add_rows(const SparseRows& a, const SparseRows& b);
 

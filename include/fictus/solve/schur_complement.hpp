@@ -198,6 +198,14 @@ class ExplicitSchur final : public SchurComplement {
   ExplicitSchur(const GreenTable<dim>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
                 const SparseRows& loads, const Execution& execution = Execution{}, const DirectTerms& direct = {},
                 const FarField& far_field = {}, FarFieldReport* report = nullptr);
+  /// The blocks of `before` with the rows and columns of the points `changed` made again from the Green's
+  /// table (the contact fit moves the points near the contact ends only: the others keep their rows and
+  /// so their entries). Exact entries only (no far field) and no direct terms; a distributed run sums
+  /// the ranks' parts as the assembly above does.
+  template <int dim>
+  ExplicitSchur(const ExplicitSchur& before, const std::vector<int>& changed, const GreenTable<dim>& green,
+                const SparseRows& B_gamma, const SparseRows& C_gamma, const SparseRows& loads,
+                const Execution& execution = Execution{});
   /// From given blocks (tests).
   ExplicitSchur(Eigen::MatrixXd S_B, Eigen::MatrixXd S_C) : S_B_(std::move(S_B)), S_C_(std::move(S_C)) {}
   ExplicitSchur(const ExplicitSchur&) = delete;  // factorization_ refers to the blocks
