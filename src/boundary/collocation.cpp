@@ -13,7 +13,7 @@ namespace fictus {
 namespace {
 
 /// Arcs over which a snap's shift fades (make_collocation's snaps): measured on the 2-D references, 2 gave
-/// the lowest errors of 1, 2, 3, 4 and 6 (bench/results/2026-11-30-contact-snap.md).
+/// the lowest errors of 1, 2, 3, 4 and 6 (bench/results/2026-11-29-contact-snap.md).
 constexpr int snap_reach = 2;
 
 /// The arcs in the placement measure: m equal ones from (phase − ½)·W/m on; or, with breaks, each piece
@@ -74,10 +74,12 @@ std::vector<PlacedArc> placed_arcs(const ArcLengthTable& measure, int m, double 
 }
 
 /// Moves the arcs' borders so that one ends at each snap (a parameter of γ), each snap taking the
-/// nearest free border; the shift fades linearly over snap_reach arcs on either side (the breaks and
-/// the other snaps hold their borders), so the arcs stay equal away from the snaps and change by at most
-/// s/(2·snap_reach) from one to the next near them. False (the arcs untouched) where a snap finds no
-/// border of its own in its order along γ or an arc would shrink below a quarter of the spacing.
+/// nearest free border (at most s/2 away unless another snap or a break holds it; at most 3s/4); the
+/// shift d fades linearly over snap_reach arcs on either side (the breaks and the other snaps hold their
+/// borders), so the arcs stay as they were away from the snaps and, near a snap with no other within
+/// 2·snap_reach arcs, change by |d|/snap_reach from one to the next. False (the arcs untouched) where a
+/// snap finds no border of its own or an arc would shrink below a quarter of the spacing (snaps out of
+/// their order along γ make an arc negative).
 bool snap_borders(const ArcLengthTable& measure, std::vector<PlacedArc>& arcs, const std::vector<double>& snaps) {
   const double total = measure.length();
   const int m = int(arcs.size());
@@ -91,11 +93,15 @@ bool snap_borders(const ArcLengthTable& measure, std::vector<PlacedArc>& arcs, c
       anchor[std::size_t(i)] = 1, t_at[std::size_t(i)] = arcs[std::size_t(i)].t_begin;
   }
   const auto cyclic = [total](double d) { return d - total * std::round(d / total); };
+  std::vector<double> from_first(static_cast<std::size_t>(m));  // the borders from border 0 on: increasing
+  for (int i = 0; i < m; ++i) from_first[std::size_t(i)] = border[std::size_t(i)] - border[0];
   for (double t : snaps) {
     const double w = t <= 0 ? 0.0 : measure.s_of_t(t);
-    const int j = int(std::floor(cyclic(w - border[0]) / mean + 0.5 + m)) % m;  // arcs ≈ equal: a guess
-    int best = -1;
-    for (int k = -2; k <= 2; ++k) {
+    double offset = std::fmod(w - border[0], total);
+    if (offset < 0) offset += total;
+    const int j = int(std::upper_bound(from_first.begin(), from_first.end(), offset) - from_first.begin()) - 1;
+    int best = -1;  // the nearest free one of the borders j − 1 … j + 2 (j, j + 1 enclose the snap)
+    for (int k = -1; k <= 2; ++k) {
       const int i = ((j + k) % m + m) % m;
       if (!anchor[std::size_t(i)] &&
           (best < 0 || std::abs(cyclic(w - border[std::size_t(i)])) < std::abs(cyclic(w - border[std::size_t(best)]))))

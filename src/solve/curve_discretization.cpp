@@ -41,6 +41,8 @@ CurveDiscretization::CurveDiscretization(const CurveDiscretization& base, const 
       Gamma_geometry_(base.Gamma_geometry_) {
   SolverOptions resolved = options;
   resolved.variant = resolved_variant(options.variant, gamma_->smooth());
+  if ((resolved.variant == Variant::smooth) != bool(placement_))
+    throw std::logic_error("CurveDiscretization::placed_for: the variant differs from the shape's");
   place_points(resolved, parts);
   make_trace_rows(gamma_geometry_->grid(), resolved, c);
 }

@@ -297,14 +297,25 @@ std::optional<std::vector<int>> changed_points(const BoundarySetup<dim>* before,
 /// Steps 2b–3: the boundary's grid-level setup and the Schur blocks, explicit from the Green's table
 /// (its far field interpolated where the boundary allows it) or implicit. With `keep` false the
 /// Green's table is freed once the blocks are made. With `before` (the contact fit's previous solve),
-/// dense blocks are those of `before` with the entries of the moved points made again.
+/// dense blocks are those of `before` with the entries of the moved points made again; `before`'s blocks
+/// are freed (or moved into the new ones) first unless `keep_before`.
 template <int dim>
 void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions& options, PhaseClock& clock, bool keep,
-                  const BoundarySetup<dim>* before = nullptr) {
+                  BoundarySetup<dim>* before = nullptr, bool keep_before = true) {
   if (setup.schur) return;
   BoundaryDiscretization<dim>& b = *setup.boundary;
   const MarkPhase mark = [&clock](const std::string& phase) { clock.mark(phase); };
   setup.fast_solves += b.finish_setup(*st.fast, mark);
+  const std::optional<std::vector<int>> changed = changed_points<dim>(before, b, options);
+  Eigen::MatrixXd before_B, before_C;  // the blocks to update
+  if (changed) {
+    auto& blocks = static_cast<ExplicitSchur&>(*before->schur);
+    if (keep_before)
+      before_B = blocks.S_B(), before_C = blocks.S_C();
+    else
+      blocks.release(before_B, before_C);
+  }
+  if (before && !keep_before) before->schur.reset(), before->exact.reset();  // (with its LU)
   const GmresOptions gmres = detail::gmres_options(options, b.n_points(), st.execution);
   const Distribution& distribution = st.execution.distribution();
   if (options.inner == InnerSolver::krylov) {
@@ -337,9 +348,9 @@ void schur_blocks(State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
                                                  b.direct(), h_options, inner);
     setup.storage = h->storage();
     setup.schur = std::move(h);
-  } else if (const std::optional<std::vector<int>> changed = changed_points<dim>(before, b, options)) {
-    auto dense_blocks = std::make_unique<ExplicitSchur>(static_cast<const ExplicitSchur&>(*before->schur), *changed,
-                                                        *st.green, b.B_gamma(), b.C_gamma(), b.loads(), st.execution);
+  } else if (changed) {
+    auto dense_blocks = std::make_unique<ExplicitSchur>(std::move(before_B), std::move(before_C), *changed, *st.green,
+                                                        b.B_gamma(), b.C_gamma(), b.loads(), st.execution);
     dense_blocks->share(distribution);
     setup.schur = std::move(dense_blocks);
     setup.storage = before->storage;
@@ -986,8 +997,7 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
     const bool made = !setup.schur;
     // The solve before's blocks (a fitted solve updates them where the points moved), then freed.
     BoundarySetup<dim>* previous = pass == 0 ? nullptr : pass == 1 ? st.setup.get() : before_setup.get();
-    schur_blocks<dim>(st, setup, options, clock, keep || !last, previous);  // 2b–3
-    if (previous && !keep) previous->schur.reset(), previous->exact.reset();
+    schur_blocks<dim>(st, setup, options, clock, keep || !last, previous, keep);  // 2b–3
     if (made) sol.fast_solves += setup.fast_solves;
     load_terms<dim>(st, setup);
     const BoundaryDiscretization<dim>& boundary = *setup.boundary;

@@ -217,10 +217,10 @@ template ExplicitSchur::ExplicitSchur(const GreenTable<3>&, const SparseRows&, c
                                       const Execution&, const DirectTerms&, const FarField&, FarFieldReport*);
 
 template <int dim>
-ExplicitSchur::ExplicitSchur(const ExplicitSchur& before, const std::vector<int>& changed, const GreenTable<dim>& green,
-                             const SparseRows& B_gamma, const SparseRows& C_gamma, const SparseRows& loads,
-                             const Execution& execution)
-    : S_B_(before.S_B_), S_C_(before.S_C_) {
+ExplicitSchur::ExplicitSchur(Eigen::MatrixXd S_B, Eigen::MatrixXd S_C, const std::vector<int>& changed,
+                             const GreenTable<dim>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
+                             const SparseRows& loads, const Execution& execution)
+    : S_B_(std::move(S_B)), S_C_(std::move(S_C)) {
   if (changed.empty()) return;
   const SparseRows B = select_rows(B_gamma, changed), C = select_rows(C_gamma, changed),
                    L = select_rows(loads, changed);
@@ -241,9 +241,9 @@ ExplicitSchur::ExplicitSchur(const ExplicitSchur& before, const std::vector<int>
   }
 }
 
-template ExplicitSchur::ExplicitSchur(const ExplicitSchur&, const std::vector<int>&, const GreenTable<2>&,
+template ExplicitSchur::ExplicitSchur(Eigen::MatrixXd, Eigen::MatrixXd, const std::vector<int>&, const GreenTable<2>&,
                                       const SparseRows&, const SparseRows&, const SparseRows&, const Execution&);
-template ExplicitSchur::ExplicitSchur(const ExplicitSchur&, const std::vector<int>&, const GreenTable<3>&,
+template ExplicitSchur::ExplicitSchur(Eigen::MatrixXd, Eigen::MatrixXd, const std::vector<int>&, const GreenTable<3>&,
                                       const SparseRows&, const SparseRows&, const SparseRows&, const Execution&);
 
 void ExplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Eigen::VectorXd& sc) const {

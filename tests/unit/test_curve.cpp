@@ -133,7 +133,8 @@ TEST(Collocation, ArcsEndAtTheBreaks) {
 TEST(Collocation, SnapsMoveTheNearestBordersAndKeepTheOtherArcs) {
   // The contact fit's ends: an arc ends at each snap (one past t = 0 on the wrap, one beside a break), the
   // arcs more than a few away from every snap are those without snaps, and neighbouring arcs differ by at
-  // most a quarter of the spacing (the shift, at most s/2, fades over two arcs).
+  // most a quarter of the spacing here (each shift, at most s/2 where the nearest border is free, fades
+  // over two arcs).
   const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2, 0.3);
   const fictus::ArcLengthTable table(e);
   const int m = 60;

@@ -198,12 +198,12 @@ class ExplicitSchur final : public SchurComplement {
   ExplicitSchur(const GreenTable<dim>& green, const SparseRows& B_gamma, const SparseRows& C_gamma,
                 const SparseRows& loads, const Execution& execution = Execution{}, const DirectTerms& direct = {},
                 const FarField& far_field = {}, FarFieldReport* report = nullptr);
-  /// The blocks of `before` with the rows and columns of the points `changed` made again from the Green's
-  /// table (the contact fit moves the points near the contact ends only: the others keep their rows and
-  /// so their entries). Exact entries only (no far field) and no direct terms; a distributed run sums
-  /// the ranks' parts as the assembly above does.
+  /// The blocks S_B, S_C of an earlier assembly with the rows and columns of the points `changed` made
+  /// again from the Green's table (the contact fit moves the points near the contact ends only: the
+  /// others keep their rows and so their entries). Exact entries only (no far field) and no direct
+  /// terms; a distributed run sums the ranks' parts as the assembly above does.
   template <int dim>
-  ExplicitSchur(const ExplicitSchur& before, const std::vector<int>& changed, const GreenTable<dim>& green,
+  ExplicitSchur(Eigen::MatrixXd S_B, Eigen::MatrixXd S_C, const std::vector<int>& changed, const GreenTable<dim>& green,
                 const SparseRows& B_gamma, const SparseRows& C_gamma, const SparseRows& loads,
                 const Execution& execution = Execution{});
   /// From given blocks (tests).
@@ -218,6 +218,9 @@ class ExplicitSchur final : public SchurComplement {
   std::optional<double> condition_number(const ActiveSet& active) const override;
   const Eigen::MatrixXd& S_B() const { return S_B_; }
   const Eigen::MatrixXd& S_C() const { return S_C_; }
+  /// Hands the blocks over (to the next fitted solve's update, without a copy); the object is to be
+  /// destroyed next.
+  void release(Eigen::MatrixXd& S_B, Eigen::MatrixXd& S_C) { S_B.swap(S_B_), S_C.swap(S_C_); }
   /// S_𝒜: row i of S_B (i ∈ 𝒜) or of S_C, bordered by `mode` when given.
   Eigen::MatrixXd newton_matrix(const ActiveSet& active, const ConstantMode* mode = nullptr) const;
   /// y = S_𝒜 x without forming S_𝒜.
