@@ -10,6 +10,11 @@
 
 namespace fictus {
 
+bool PlacedArc::same(const PlacedArc& o) const {
+  const auto equal = [](double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); };
+  return centre == o.centre && begin == o.begin && end == o.end && equal(t_begin, o.t_begin) && equal(t_end, o.t_end);
+}
+
 namespace {
 
 /// Arcs over which a snap's shift fades (make_collocation's snaps): measured on the 2-D references, 2 gave
@@ -20,10 +25,6 @@ constexpr int snap_reach = 2;
 /// between consecutive breaks cut into equal arcs, the pieces given their counts one at a time to the
 /// piece whose arcs are longest (at least one each). Each arc as [begin, end) in the measure, and the
 /// parameter at a break exactly where an arc starts or ends there (NaN elsewhere).
-struct PlacedArc {
-  double centre, begin, end, t_begin, t_end;
-};
-
 std::vector<PlacedArc> placed_arcs(const ArcLengthTable& measure, int m, double phase,
                                    const std::vector<double>& breaks) {
   const double total = measure.length(), none = std::numeric_limits<double>::quiet_NaN();
@@ -143,7 +144,7 @@ bool snap_borders(const ArcLengthTable& measure, std::vector<PlacedArc>& arcs, c
 
 Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase,
                              const ArcLengthTable* placement, const std::vector<double>& breaks,
-                             const std::vector<double>& snaps) {
+                             const std::vector<double>& snaps, const Collocation* reuse) {
   if (m < 1) throw std::invalid_argument("make_collocation: need m >= 1, got " + std::to_string(m));
   Collocation c;
   c.m = m;
@@ -178,23 +179,41 @@ Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_lengt
   std::stable_sort(arcs.begin(), arcs.end(),
                    [&wrap](const PlacedArc& a, const PlacedArc& b) { return wrap(a.centre) < wrap(b.centre); });
   const bool equal = !placement && breaks.empty() && snaps.empty();
+  c.equal_arcs = equal;
+  if (reuse && (reuse->m != m || reuse->placed.size() != std::size_t(m))) reuse = nullptr;
+  std::size_t from = 0;  // where the search of `reuse`'s arcs (in the same order) goes on
   for (int i = 0; i < m; ++i) {
     const PlacedArc& a = arcs[std::size_t(i)];
     const double w = a.centre;
-    c.t[i] = t_at(w);
-    c.arc_begin[i] = !std::isnan(a.t_begin) ? a.t_begin : std::abs(a.begin) < 1e-14 * total ? 0.0 : t_at(a.begin);
-    c.arc_end[i] = !std::isnan(a.t_end) ? a.t_end : std::abs(a.end - total) < 1e-14 * total ? two_pi : t_at(a.end);
-    c.point[i] = curve.position(c.t[i]);
-    c.normal[i] = curve.outward_normal(c.t[i]);
+    std::size_t k = from;  // the same arc in `reuse`, if there is one
+    if (reuse) {
+      while (k < std::size_t(m) && wrap(reuse->placed[k].centre) < wrap(w)) ++k;
+      if (k < std::size_t(m) && !reuse->placed[k].same(a)) k = std::size_t(m);
+    }
+    if (reuse && k < std::size_t(m)) {
+      from = k + 1;
+      c.t[i] = reuse->t[k], c.arc_begin[i] = reuse->arc_begin[k], c.arc_end[i] = reuse->arc_end[k];
+      c.point[i] = reuse->point[k], c.normal[i] = reuse->normal[k];
+    } else {
+      c.t[i] = t_at(w);
+      c.arc_begin[i] = !std::isnan(a.t_begin) ? a.t_begin : std::abs(a.begin) < 1e-14 * total ? 0.0 : t_at(a.begin);
+      c.arc_end[i] = !std::isnan(a.t_end) ? a.t_end : std::abs(a.end - total) < 1e-14 * total ? two_pi : t_at(a.end);
+      c.point[i] = curve.position(c.t[i]);
+      c.normal[i] = curve.outward_normal(c.t[i]);
+      k = std::size_t(m);
+    }
     if (equal) {
       c.s[i] = w;
       c.arc[i] = c.spacing;
+    } else if (k < std::size_t(m) && !reuse->equal_arcs) {
+      c.s[i] = reuse->s[k], c.arc[i] = reuse->arc[k];
     } else {
       c.s[i] = arc_length.s_of_t(c.t[i]);
-      const double from = arc_length.s_of_t(c.arc_begin[i]), to = arc_length.s_of_t(c.arc_end[i]);
-      c.arc[i] = to >= from ? to - from : to + c.length - from;
+      const double begin = arc_length.s_of_t(c.arc_begin[i]), end = arc_length.s_of_t(c.arc_end[i]);
+      c.arc[i] = end >= begin ? end - begin : end + c.length - begin;
     }
   }
+  c.placed = std::move(arcs);
   return c;
 }
 

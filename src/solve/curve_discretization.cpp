@@ -23,7 +23,7 @@ CurveDiscretization::CurveDiscretization(std::shared_ptr<const Curve> gamma, con
   SolverOptions resolved = options;
   resolved.variant = resolved_variant(options.variant, gamma_->smooth());
   make_shape(grid, resolved);
-  place_points(resolved, parts);
+  place_points(resolved, parts, nullptr);
   make_trace_rows(grid, resolved, c);
 }
 
@@ -34,7 +34,7 @@ CurveDiscretization::CurveDiscretization(const CurveDiscretization& base, const 
       Gamma_(base.Gamma_),
       delta_(base.delta_),
       spacing_(base.spacing_),
-      samples_(base.samples_),
+      samples_(parts.placed() ? base.layout_samples() : base.samples_),
       arc_length_(base.arc_length_),
       placement_(base.placement_),
       gamma_geometry_(base.gamma_geometry_),
@@ -43,7 +43,7 @@ CurveDiscretization::CurveDiscretization(const CurveDiscretization& base, const 
   resolved.variant = resolved_variant(options.variant, gamma_->smooth());
   if ((resolved.variant == Variant::smooth) != bool(placement_))
     throw std::logic_error("CurveDiscretization::placed_for: the variant differs from the shape's");
-  place_points(resolved, parts);
+  place_points(resolved, parts, &base.collocation_);
   make_trace_rows(gamma_geometry_->grid(), resolved, c);
 }
 
@@ -108,9 +108,21 @@ OffsetRoom curve_offset_room(std::shared_ptr<const Curve> gamma, const Box2& box
 
 std::vector<int> CurveDiscretization::part_layout(const PartConditions<2>& parts) const {
   if (!parts.placed()) return {};
-  std::vector<int> layout(samples_->size());
-  for (std::size_t k = 0; k < layout.size(); ++k) layout[k] = parts.label((*samples_)[k]);
+  const std::vector<Point2>& samples = *layout_samples();
+  std::vector<int> layout(samples.size());
+  for (std::size_t k = 0; k < layout.size(); ++k) layout[k] = parts.label(samples[k]);
   return layout;
+}
+
+const std::shared_ptr<const std::vector<Point2>>& CurveDiscretization::layout_samples() const {
+  if (!samples_) {
+    const int samples = std::max(4096, 16 * spacing_.m);
+    auto at = std::make_shared<std::vector<Point2>>(std::size_t(samples));
+    for (int k = 0; k < samples; ++k)
+      (*at)[std::size_t(k)] = gamma_->position(2 * std::numbers::pi * (k + 0.5) / samples);
+    samples_ = std::move(at);
+  }
+  return samples_;
 }
 
 bool CurveDiscretization::same_parts(const PartConditions<2>& parts) const {
@@ -179,10 +191,6 @@ void CurveDiscretization::make_shape(const Grid2& grid, const SolverOptions& opt
                      [L, spacing_cells](double k) { return default_multipliers(L, k, spacing_cells); },
                      options.variant == Variant::smooth ? curve_offset_room(gamma_, grid.box()) : OffsetRoom()};
   spacing_ = plan_spacing(input, options);
-  const int samples = std::max(4096, 16 * spacing_.m);
-  auto at = std::make_shared<std::vector<Point2>>(std::size_t(samples));
-  for (int k = 0; k < samples; ++k) (*at)[std::size_t(k)] = gamma.position(2 * std::numbers::pi * (k + 0.5) / samples);
-  samples_ = std::move(at);
   if (options.variant == Variant::nonsmooth) {
     Gamma_ = gamma_;
     return;
@@ -198,7 +206,8 @@ void CurveDiscretization::make_shape(const Grid2& grid, const SolverOptions& opt
   Gamma_geometry_ = std::make_shared<const CurveGridIntersection>(*Gamma_, grid, "formulation.offset");
 }
 
-void CurveDiscretization::place_points(const SolverOptions& options, const PartConditions<2>& parts) {
+void CurveDiscretization::place_points(const SolverOptions& options, const PartConditions<2>& parts,
+                                       const Collocation* reuse) {
   const Curve& gamma = *gamma_;
   const ArcLengthTable& arc_length = *arc_length_;
   const double L = arc_length.length();
@@ -252,9 +261,9 @@ void CurveDiscretization::place_points(const SolverOptions& options, const PartC
   };
   if (options.variant == Variant::nonsmooth)
     collocation_ =
-        make_collocation(gamma, arc_length, m, phase_off_corners(gamma, arc_length, m), nullptr, breaks, snaps);
+        make_collocation(gamma, arc_length, m, phase_off_corners(gamma, arc_length, m), nullptr, breaks, snaps, reuse);
   else
-    collocation_ = make_collocation(gamma, arc_length, m, 0.5, placement_.get(), breaks, snaps);
+    collocation_ = make_collocation(gamma, arc_length, m, 0.5, placement_.get(), breaks, snaps, reuse);
   set_point_parts();
 }
 

@@ -75,7 +75,7 @@ SurfaceDiscretization::SurfaceDiscretization(std::shared_ptr<const Surface> gamm
     : grid_(grid), gamma_(std::move(gamma)), execution_(execution), c_(c), balance_wanted_(options.flux_balance) {
   if (!gamma_) throw std::invalid_argument("geometry: no surface given");
   make_shape(options);
-  place_points(options, parts);
+  place_points(options, parts, true);
   make_trace_rows(options, mark);
 }
 
@@ -88,8 +88,11 @@ SurfaceDiscretization::SurfaceDiscretization(const SurfaceDiscretization& base, 
       balance_wanted_(base.balance_wanted_),
       plan_(base.plan_),
       delta_(base.delta_),
-      unsplit_(base.unsplit_) {
-  place_points(options, parts);
+      unsplit_(base.unsplit_),
+      gamma_patches_(base.unsplit_ ? *base.unsplit_
+                     : base.split_ ? base.gamma_->patches(plan_.m, grid_.h())  // (a fitted copy as the base)
+                                   : base.gamma_patches_) {
+  place_points(options, parts, false);
   make_trace_rows(options, mark);
 }
 
@@ -126,7 +129,7 @@ void SurfaceDiscretization::make_shape(const SolverOptions& options) {
       {3, area, h, box.width(0), [area, variant](double k) { return default_patches(area, k, variant); }, room},
       options);
   execution_.throw_if_interrupted();
-  unsplit_ = std::make_shared<const PatchedSurface>(gamma.patches(plan_.m, h));
+  gamma_patches_ = gamma.patches(plan_.m, h);
   execution_.throw_if_interrupted();
   if (options.variant == Variant::smooth) {
     delta_ = plan_.delta;
@@ -134,12 +137,14 @@ void SurfaceDiscretization::make_shape(const SolverOptions& options) {
   }
 }
 
-void SurfaceDiscretization::place_points(const SolverOptions& options, const PartConditions<3>& parts) {
+void SurfaceDiscretization::place_points(const SolverOptions& options, const PartConditions<3>& parts,
+                                         bool keep_unsplit) {
   const Surface& gamma = *gamma_;
-  gamma_patches_ = *unsplit_;
   part_layout_ = part_layout(parts);
   if (!part_layout_.empty() &&
       std::any_of(part_layout_.begin(), part_layout_.end(), [&](int c) { return c != part_layout_[0]; })) {
+    split_ = true;
+    if (keep_unsplit && !unsplit_) unsplit_ = std::make_shared<const PatchedSurface>(gamma_patches_);
     // The patches again, each in one part. A patch's point: the foot on γ of the centroid of its triangle
     // nearest to the patch's centroid (inside the patch, whatever its shape).
     std::vector<int> patch_labels;

@@ -11,6 +11,14 @@
 
 namespace fictus {
 
+/// One arc in the placement measure: its centre and ends, and the parameter where it starts or ends at a
+/// break or a snap exactly (NaN elsewhere).
+struct PlacedArc {
+  double centre, begin, end, t_begin, t_end;
+  /// Bit for bit (NaN equal to NaN): the arcs a later placement can take over without evaluating γ again.
+  bool same(const PlacedArc& o) const;
+};
+
 struct Collocation {
   int m = 0;
   double length = 0.0;   // L = |γ|
@@ -21,6 +29,8 @@ struct Collocation {
   std::vector<double> t;                   // parameter of point i
   std::vector<double> arc_begin, arc_end;  // parameters bounding arc i (arc_begin[0] = 0 with phase ½, no breaks)
   std::vector<Point2> point, normal;       // x_i and the outward unit normal n_i
+  std::vector<PlacedArc> placed;           // arc i in the placement measure (for `reuse`)
+  bool equal_arcs = false;                 // s and arc from the equal arcs, not from γ's arc length
 
   int n_points() const { return m; }
 };
@@ -32,10 +42,12 @@ struct Collocation {
 /// std::invalid_argument naming formulation.multipliers when m is below the number of pieces. With `snaps`
 /// (the contact fit's ends), the arcs so placed then move so that an arc ends at each snap: the nearest
 /// border moves there and the shift fades over a few arcs on either side, so the arcs stay nearly
-/// equal; where that cannot be done the snaps are taken as breaks.
+/// equal; where that cannot be done the snaps are taken as breaks. `reuse`: a collocation made before with
+/// the same curve, tables and m (the contact fit's unsnapped one); the arcs placed exactly as there take
+/// their parameters, points and normals from it instead of inverting the measure again (the same numbers).
 Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase = 0.5,
                              const ArcLengthTable* placement = nullptr, const std::vector<double>& breaks = {},
-                             const std::vector<double>& snaps = {});
+                             const std::vector<double>& snaps = {}, const Collocation* reuse = nullptr);
 
 /// The smooth variant's placement measure for Γ at distance δ: speed |p′(t)|·max(1, 1 + δκ(t)), the
 /// speed of the offset curve where γ is convex and of γ itself where it is concave.

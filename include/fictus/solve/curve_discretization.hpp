@@ -64,9 +64,12 @@ class CurveDiscretization final : public BoundaryDiscretization<2> {
                       const PartConditions<2>& parts);
   /// Step 1 without the points: γ's checks and grid intersection, m, δ, Γ and its grid intersection.
   void make_shape(const Grid2& grid, const SolverOptions& options);
-  /// The points for `parts`, their arcs ending at its junctions.
-  void place_points(const SolverOptions& options, const PartConditions<2>& parts);
-  /// The labels at K = max(4096, 16m) samples of γ, at t = 2π(k + ½)/K.
+  /// The points for `parts`, their arcs ending at its junctions; the arcs placed as in `reuse` (the base's,
+  /// for a fitted copy) are taken from it.
+  void place_points(const SolverOptions& options, const PartConditions<2>& parts, const Collocation* reuse);
+  /// K = max(4096, 16m) samples of γ, at t = 2π(k + ½)/K, made on first use.
+  const std::shared_ptr<const std::vector<Point2>>& layout_samples() const;
+  /// The labels at layout_samples().
   std::vector<int> part_layout(const PartConditions<2>& parts) const override;
   /// The parameters where the pieces meet, each with the label of the piece that follows it, from the
   /// samples' labels (each change bisected to round-off).
@@ -81,7 +84,8 @@ class CurveDiscretization final : public BoundaryDiscretization<2> {
   Collocation collocation_;
   double delta_ = 0;
   SpacingPlan spacing_;
-  std::shared_ptr<const std::vector<Point2>> samples_;            // part_layout's points of γ
+  // part_layout's points of γ, made on first use (mixed conditions or a fit) and shared with the fits
+  mutable std::shared_ptr<const std::vector<Point2>> samples_;
   std::shared_ptr<const ArcLengthTable> arc_length_, placement_;  // placement_: smooth variant only
   std::shared_ptr<const CurveGridIntersection> gamma_geometry_, Gamma_geometry_;
   SparseRows B_gamma_, C_gamma_, B_Gamma_, loads_;

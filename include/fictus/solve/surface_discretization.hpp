@@ -84,8 +84,10 @@ class SurfaceDiscretization final : public BoundaryDiscretization<3> {
                         const PartConditions<3>& parts);
   /// Step 1 without the patches: γ inside the box, m, δ, γ's triangulation.
   void make_shape(const SolverOptions& options);
-  /// The patches for `parts` (each in one part), their points and Γ's triangles.
-  void place_points(const SolverOptions& options, const PartConditions<3>& parts);
+  /// The patches for `parts` (each in one part), their points and Γ's triangles, from gamma_patches_ holding
+  /// γ's triangulation before any cut. Where the parts cut it, a copy of that is kept if `keep_unsplit` (for
+  /// placed_for: the solver's own setup, not a fitted copy, is the base of the fits).
+  void place_points(const SolverOptions& options, const PartConditions<3>& parts, bool keep_unsplit);
   /// The labels at the centroids of γ's triangles.
   std::vector<int> part_layout(const PartConditions<3>& parts) const override;
   void make_trace_rows(const SolverOptions& options, const MarkPhase& mark);
@@ -97,7 +99,10 @@ class SurfaceDiscretization final : public BoundaryDiscretization<3> {
   bool balance_wanted_;
   SpacingPlan plan_;
   double delta_ = 0;
-  std::shared_ptr<const PatchedSurface> unsplit_;  // γ.patches(m, h), before the parts cut it
+  // γ.patches(m, h) before the parts cut it: kept only where they did (split_) and the copy was asked for;
+  // where they did not, gamma_patches_ is it.
+  std::shared_ptr<const PatchedSurface> unsplit_;
+  bool split_ = false;
   PatchedSurface gamma_patches_, Gamma_patches_;
   SparseRows B_gamma_, C_gamma_, B_Gamma_, loads_;
   DirectTerms direct_;
