@@ -161,13 +161,37 @@ std::pair<std::size_t, std::size_t> CurveGridIntersection::pieces_in(double ta, 
   return {std::size_t(first - pieces_.begin()), std::size_t(last - pieces_.begin())};
 }
 
+const CurveGridIntersection::CutRules& CurveGridIntersection::cut_rules(int iy, int q) const {
+  CutRules* rules;
+  {
+    const std::lock_guard<std::mutex> lock(rules_mutex_);
+    std::unique_ptr<CutRules>& slot = rules_[q];
+    if (!slot) slot = std::make_unique<CutRules>(grid_.ny());
+    rules = slot.get();
+  }
+  std::call_once(rules->made[std::size_t(iy)], [&] {  // (kept only once complete: a throw leaves it unmade)
+    std::vector<QuadraturePoint> points;
+    std::vector<std::size_t> begin;
+    for (std::size_t c = row_begin_[iy]; c < row_begin_[iy + 1]; ++c) {
+      begin.push_back(points.size());
+      cut_cell_rule(cut_cells_[c], q, points);
+    }
+    begin.push_back(points.size());
+    rules->points[std::size_t(iy)] = std::move(points);
+    rules->begin[std::size_t(iy)] = std::move(begin);
+  });
+  return *rules;
+}
+
 void CurveGridIntersection::row_rule(int iy, int q, std::vector<CellQuadraturePoint>& out) const {
   out.clear();
   const GaussRule& rule = gauss_legendre(q);
   const double h = grid_.h();
   std::size_t next_cut = row_begin_[iy];
   const std::size_t end_cut = row_begin_[iy + 1];
-  std::vector<QuadraturePoint> cut_points;
+  const CutRules& cut = cut_rules(iy, q);
+  const std::vector<QuadraturePoint>& cut_points = cut.points[std::size_t(iy)];
+  const std::vector<std::size_t>& cut_begin = cut.begin[std::size_t(iy)];
   // Node flags of the row's two grid lines, walked left to right with the crossing lists.
   const auto& lower = row_crossings_[iy];
   const auto& upper = row_crossings_[iy + 1];
@@ -184,9 +208,9 @@ void CurveGridIntersection::row_rule(int iy, int q, std::vector<CellQuadraturePo
   for (int ix = 0; ix < grid_.nx(); ++ix) {
     const bool right_lower = inside_lower(ix + 1), right_upper = inside_upper(ix + 1);
     if (next_cut < end_cut && cut_cells_[next_cut].ix == ix) {
-      cut_points.clear();
-      cut_cell_rule(cut_cells_[next_cut], q, cut_points);
-      for (const QuadraturePoint& p : cut_points) out.push_back({ix, p.x, p.y, p.weight});
+      const std::size_t k = next_cut - row_begin_[iy];
+      for (std::size_t j = cut_begin[k]; j < cut_begin[k + 1]; ++j)
+        out.push_back({ix, cut_points[j].x, cut_points[j].y, cut_points[j].weight});
       ++next_cut;
     } else if (left_lower && left_upper && right_lower && right_upper) {
       for (int b = 0; b < q; ++b)

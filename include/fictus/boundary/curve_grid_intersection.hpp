@@ -5,6 +5,9 @@
 // follow the TRUE curve (not a polygon) in cut cells.
 #include <array>
 #include <cstddef>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 #include "fictus/boundary/curve.hpp"
@@ -58,7 +61,9 @@ class CurveGridIntersection {
   void cut_cell_rule(const CutCell& cell, int q, std::vector<QuadraturePoint>& out) const;
 
   /// Quadrature points of ω ∩ (cell row iy), cells in increasing ix: q×q Gauss on cells inside ω,
-  /// the curve-following rule on cut cells. `out` is cleared first.
+  /// the curve-following rule on cut cells. `out` is cleared first. The cut cells' rules of each row and q
+  /// are made on the first call and kept (a sweep's or a fit's later solves integrate over the same ω);
+  /// calls from several threads at once are safe.
   void row_rule(int iy, int q, std::vector<CellQuadraturePoint>& out) const;
 
  private:
@@ -69,6 +74,16 @@ class CurveGridIntersection {
   std::vector<std::size_t> row_begin_;
   std::vector<std::vector<double>> row_crossings_;  // per grid row j: sorted x of crossings
   std::vector<std::vector<double>> col_crossings_;  // per grid column i: sorted y of crossings
+  /// row_rule's cut-cell rules for one q, each row's made once by the first thread that asks.
+  struct CutRules {
+    explicit CutRules(int rows) : made(std::size_t(rows)), points(std::size_t(rows)), begin(std::size_t(rows)) {}
+    std::vector<std::once_flag> made;
+    std::vector<std::vector<QuadraturePoint>> points;  // per row: its cut cells' points, cell after cell
+    std::vector<std::vector<std::size_t>> begin;       // per row: where each cut cell's points begin, and the end
+  };
+  const CutRules& cut_rules(int iy, int q) const;
+  mutable std::mutex rules_mutex_;
+  mutable std::map<int, std::unique_ptr<CutRules>> rules_;  // by q
 };
 
 /// ∫_ω F over ω (F returns K values, integrated together): q×q Gauss on cells inside ω, the
