@@ -190,6 +190,7 @@ Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_lengt
       while (k < std::size_t(m) && wrap(reuse->placed[k].centre) < wrap(w)) ++k;
       if (k < std::size_t(m) && !reuse->placed[k].same(a)) k = std::size_t(m);
     }
+    if (reuse) c.reused.push_back(k < std::size_t(m) ? int(k) : -1);
     if (reuse && k < std::size_t(m)) {
       from = k + 1;
       c.t[i] = reuse->t[k], c.arc_begin[i] = reuse->arc_begin[k], c.arc_end[i] = reuse->arc_end[k];

@@ -1,6 +1,7 @@
 #include "fictus/grid/sparse_rows.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace fictus {
 
@@ -46,6 +47,21 @@ SparseRows select_rows(const SparseRows& rows, const std::vector<int>& which) {
                        rows.entries.begin() + std::ptrdiff_t(rows.row_begin[std::size_t(r) + 1]));
     out.row_begin.push_back(out.entries.size());
   }
+  return out;
+}
+
+SparseRows merge_rows(const SparseRows& kept, const std::vector<int>& from, const SparseRows& made) {
+  SparseRows out;
+  std::size_t next = 0;  // made's next row
+  for (int r : from) {
+    const SparseRows& source = r >= 0 ? kept : made;
+    const std::size_t row = r >= 0 ? std::size_t(r) : next++;
+    if (row + 1 >= source.row_begin.size()) throw std::logic_error("merge_rows: too few rows");
+    out.entries.insert(out.entries.end(), source.entries.begin() + std::ptrdiff_t(source.row_begin[row]),
+                       source.entries.begin() + std::ptrdiff_t(source.row_begin[row + 1]));
+    out.row_begin.push_back(out.entries.size());
+  }
+  if (next + 1 != made.row_begin.size()) throw std::logic_error("merge_rows: rows of `made` left over");
   return out;
 }
 

@@ -24,7 +24,7 @@ CurveDiscretization::CurveDiscretization(std::shared_ptr<const Curve> gamma, con
   resolved.variant = resolved_variant(options.variant, gamma_->smooth());
   make_shape(grid, resolved);
   place_points(resolved, parts, nullptr);
-  make_trace_rows(grid, resolved, c);
+  make_trace_rows(grid, resolved, c, nullptr);
 }
 
 CurveDiscretization::CurveDiscretization(const CurveDiscretization& base, const SolverOptions& options, double c,
@@ -44,7 +44,7 @@ CurveDiscretization::CurveDiscretization(const CurveDiscretization& base, const 
   if ((resolved.variant == Variant::smooth) != bool(placement_))
     throw std::logic_error("CurveDiscretization::placed_for: the variant differs from the shape's");
   place_points(resolved, parts, &base.collocation_);
-  make_trace_rows(gamma_geometry_->grid(), resolved, c);
+  make_trace_rows(gamma_geometry_->grid(), resolved, c, &base);
 }
 
 std::unique_ptr<BoundaryDiscretization<2>> CurveDiscretization::placed_for(const PartConditions<2>& parts,
@@ -267,10 +267,20 @@ void CurveDiscretization::place_points(const SolverOptions& options, const PartC
   set_point_parts();
 }
 
-void CurveDiscretization::make_trace_rows(const Grid2& grid, const SolverOptions& options, double c) {
+void CurveDiscretization::make_trace_rows(const Grid2& grid, const SolverOptions& options, double c,
+                                          const CurveDiscretization* base) {
   const Collocation& points = collocation_;
   B_gamma_ = point_value_rows(grid, points.point);
-  B_Gamma_ = arc_integral_rows(Gamma_geometry_ ? *Gamma_geometry_ : *gamma_geometry_, points.arc_begin, points.arc_end);
+  const CurveGridIntersection& Gamma = Gamma_geometry_ ? *Gamma_geometry_ : *gamma_geometry_;
+  if (base && !points.reused.empty()) {  // the arcs placed as the base's keep its rows (the same numbers)
+    std::vector<double> begin, end;
+    for (int i = 0; i < points.m; ++i)
+      if (points.reused[std::size_t(i)] < 0)
+        begin.push_back(points.arc_begin[std::size_t(i)]), end.push_back(points.arc_end[std::size_t(i)]);
+    B_Gamma_ = merge_rows(base->B_Gamma_, points.reused, arc_integral_rows(Gamma, begin, end));
+  } else {
+    B_Gamma_ = arc_integral_rows(Gamma, points.arc_begin, points.arc_end);
+  }
   loads_ = B_Gamma_;
   if (options.normal_derivative == NormalDerivative::shifted) {
     C_gamma_ = normal_derivative_rows(grid, points.point, points.normal, options.normal_shift * grid.h());

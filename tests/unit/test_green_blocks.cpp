@@ -296,4 +296,52 @@ TEST(GreenBlocks, ContactFitUpdatesTheMovedPointsOnly) {
   EXPECT_GT(relative_max_difference(before.S_B(), fresh.S_B()), 1e-6);  // the points did move
 }
 
+TEST(GreenBlocks, ContactFitTakesOverTheUnmovedPointsBitForBit) {
+  // A fitted placement takes the arcs placed as before (parameters, points, B_Γ rows) from the solve
+  // before instead of making them again: the same numbers as a discretization made for the same parts from
+  // scratch, in every row, for both variants.
+  const fictus::Grid2 grid(fictus::Box2{{0, 0}, {1, 1}}, 256);
+  const fictus::Execution execution(2);
+  const auto gamma = std::make_shared<const fictus::Ellipse>(fictus::Point2{0.5, 0.5}, 0.35, 0.2, 0.4);
+  fictus::PartConditions<2> parts;
+  parts.contact_side = [](const fictus::Point2& x) { return x.x + 0.3 * x.y > 0.61 ? 1.0 : 0.0; };
+  for (const fictus::Variant variant : {fictus::Variant::smooth, fictus::Variant::nonsmooth}) {
+    fictus::SolverOptions options;
+    options.variant = variant;
+    const fictus::CurveDiscretization a(gamma, grid, options, 1.0, execution);
+    const std::unique_ptr<fictus::BoundaryDiscretization<2>> placed = a.placed_for(parts, options, 1.0, {});
+    const fictus::CurveDiscretization scratch(gamma, grid, options, 1.0, execution, parts);
+    const int m = a.n_points();
+    ASSERT_EQ(placed->n_points(), m);
+    ASSERT_EQ(scratch.n_points(), m);
+    int moved = 0;
+    for (int i = 0; i < m; ++i) {
+      EXPECT_EQ(placed->points()[std::size_t(i)].x, scratch.points()[std::size_t(i)].x) << i;
+      EXPECT_EQ(placed->points()[std::size_t(i)].y, scratch.points()[std::size_t(i)].y) << i;
+      EXPECT_TRUE(fictus::same_row(placed->B_gamma(), scratch.B_gamma(), i)) << i;
+      EXPECT_TRUE(fictus::same_row(placed->C_gamma(), scratch.C_gamma(), i)) << i;
+      EXPECT_TRUE(fictus::same_row(placed->loads(), scratch.loads(), i)) << i;
+      if (!fictus::same_row(a.loads(), placed->loads(), i)) ++moved;
+    }
+    EXPECT_GE(moved, 2);      // the fit did move points
+    EXPECT_LE(moved, m / 2);  // and took the others over
+  }
+}
+
+TEST(SparseRows, MergeTakesKeptAndMadeRowsInTurn) {
+  fictus::SparseRows kept, made;
+  kept.entries = {{1, 1, 0, 0, 1.0}, {2, 2, 0, 0, 2.0}, {3, 3, 0, 0, 3.0}};
+  kept.row_begin = {0, 1, 3};
+  made.entries = {{7, 7, 0, 0, 7.0}};
+  made.row_begin = {0, 1, 1};
+  const fictus::SparseRows out = fictus::merge_rows(kept, {1, -1, 0, -1}, made);
+  ASSERT_EQ(out.n_rows(), 4);
+  EXPECT_EQ(out.row_begin, (std::vector<std::size_t>{0, 2, 3, 4, 4}));
+  EXPECT_EQ(out.entries[0].value, 2.0);
+  EXPECT_EQ(out.entries[2].value, 7.0);
+  EXPECT_EQ(out.entries[3].value, 1.0);
+  EXPECT_THROW(fictus::merge_rows(kept, {1, -1}, made), std::logic_error);  // a made row left over
+  EXPECT_THROW(fictus::merge_rows(kept, {-1, -1, -1}, made), std::logic_error);
+}
+
 }  // namespace

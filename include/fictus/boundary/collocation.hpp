@@ -30,6 +30,7 @@ struct Collocation {
   std::vector<double> arc_begin, arc_end;  // parameters bounding arc i (arc_begin[0] = 0 with phase ½, no breaks)
   std::vector<Point2> point, normal;       // x_i and the outward unit normal n_i
   std::vector<PlacedArc> placed;           // arc i in the placement measure (for `reuse`)
+  std::vector<int> reused;                 // point i's index in make_collocation's `reuse`, or −1 (with one)
   bool equal_arcs = false;                 // s and arc from the equal arcs, not from γ's arc length
 
   int n_points() const { return m; }

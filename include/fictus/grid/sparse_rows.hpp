@@ -35,6 +35,10 @@ struct SparseRows {
 /// The rows `which` of `rows`, in that order.
 SparseRows select_rows(const SparseRows& rows, const std::vector<int>& which);
 
+/// Rows taken from `kept` where from[r] >= 0 (its row from[r]) and from `made` in order elsewhere (made has
+/// one row for each r with from[r] < 0).
+SparseRows merge_rows(const SparseRows& kept, const std::vector<int>& from, const SparseRows& made);
+
 /// Whether row r of a and row r of b hold the same entries (nodes and values, bit for bit, in order).
 bool same_row(const SparseRows& a, const SparseRows& b, int r);
 

@@ -77,7 +77,8 @@ class CurveDiscretization final : public BoundaryDiscretization<2> {
   /// The samples' parts and the junctions (to 1e-12 in the parameter) as when the points were placed.
   bool same_parts(const PartConditions<2>& parts) const override;
   std::vector<std::pair<double, int>> junctions_;
-  void make_trace_rows(const Grid2& grid, const SolverOptions& options, double c);
+  /// B_γ, C_γ, B_Γ (and the kink correction's terms); B_Γ's rows of the points placed as `base`'s are its.
+  void make_trace_rows(const Grid2& grid, const SolverOptions& options, double c, const CurveDiscretization* base);
 
   const Execution& execution_;
   std::shared_ptr<const Curve> gamma_, Gamma_;
