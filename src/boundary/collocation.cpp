@@ -188,7 +188,7 @@ Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_lengt
     std::size_t k = from;  // the same arc in `reuse`, if there is one
     if (reuse) {
       while (k < std::size_t(m) && wrap(reuse->placed[k].centre) < wrap(w)) ++k;
-      if (k < std::size_t(m) && !reuse->placed[k].same(a)) k = std::size_t(m);
+      if (k < std::size_t(m) && !reuse->placed[k].same(a)) from = k, k = std::size_t(m);  // (later arcs lie on)
     }
     if (reuse) c.reused.push_back(k < std::size_t(m) ? int(k) : -1);
     if (reuse && k < std::size_t(m)) {

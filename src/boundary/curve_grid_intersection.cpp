@@ -162,25 +162,22 @@ std::pair<std::size_t, std::size_t> CurveGridIntersection::pieces_in(double ta, 
 }
 
 const CurveGridIntersection::CutRules& CurveGridIntersection::cut_rules(int iy, int q) const {
-  CutRules* rules;
   {
     const std::lock_guard<std::mutex> lock(rules_mutex_);
-    std::unique_ptr<CutRules>& slot = rules_[q];
-    if (!slot) slot = std::make_unique<CutRules>(grid_.ny());
-    rules = slot.get();
+    std::vector<std::unique_ptr<const CutRules>>& rows = rules_[q];
+    if (rows.empty()) rows.resize(std::size_t(grid_.ny()));
+    if (const CutRules* made = rows[std::size_t(iy)].get()) return *made;
   }
-  std::call_once(rules->made[std::size_t(iy)], [&] {  // (kept only once complete: a throw leaves it unmade)
-    std::vector<QuadraturePoint> points;
-    std::vector<std::size_t> begin;
-    for (std::size_t c = row_begin_[iy]; c < row_begin_[iy + 1]; ++c) {
-      begin.push_back(points.size());
-      cut_cell_rule(cut_cells_[c], q, points);
-    }
-    begin.push_back(points.size());
-    rules->points[std::size_t(iy)] = std::move(points);
-    rules->begin[std::size_t(iy)] = std::move(begin);
-  });
-  return *rules;
+  auto made = std::make_unique<CutRules>();
+  for (std::size_t c = row_begin_[iy]; c < row_begin_[iy + 1]; ++c) {
+    made->begin.push_back(made->points.size());
+    cut_cell_rule(cut_cells_[c], q, made->points);
+  }
+  made->begin.push_back(made->points.size());
+  const std::lock_guard<std::mutex> lock(rules_mutex_);
+  std::unique_ptr<const CutRules>& slot = rules_[q][std::size_t(iy)];
+  if (!slot) slot = std::move(made);  // (another thread may have made the same row meanwhile)
+  return *slot;
 }
 
 void CurveGridIntersection::row_rule(int iy, int q, std::vector<CellQuadraturePoint>& out) const {
@@ -190,8 +187,8 @@ void CurveGridIntersection::row_rule(int iy, int q, std::vector<CellQuadraturePo
   std::size_t next_cut = row_begin_[iy];
   const std::size_t end_cut = row_begin_[iy + 1];
   const CutRules& cut = cut_rules(iy, q);
-  const std::vector<QuadraturePoint>& cut_points = cut.points[std::size_t(iy)];
-  const std::vector<std::size_t>& cut_begin = cut.begin[std::size_t(iy)];
+  const std::vector<QuadraturePoint>& cut_points = cut.points;
+  const std::vector<std::size_t>& cut_begin = cut.begin;
   // Node flags of the row's two grid lines, walked left to right with the crossing lists.
   const auto& lower = row_crossings_[iy];
   const auto& upper = row_crossings_[iy + 1];

@@ -130,6 +130,42 @@ TEST(Collocation, ArcsEndAtTheBreaks) {
   EXPECT_THROW(fictus::make_collocation(e, table, 2, 0.5, nullptr, breaks), std::invalid_argument);
 }
 
+TEST(Collocation, ReuseTakesOverTheArcsPlacedAsBeforeBitForBit) {
+  // The contact fit's placements take the arcs placed as in the solve before from it: the same numbers as a
+  // placement made without it, in every field, with snaps on the wrap past t = 0 and beside a break, in
+  // arc length (the non-smooth variant: s from the equal arcs before, from γ now) and in a placement measure.
+  const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2, 0.3);
+  const fictus::ArcLengthTable table(e);
+  const fictus::ArcLengthTable placement = fictus::offset_placement(e, 0.05);
+  const int m = 60;
+  for (const fictus::ArcLengthTable* measure : {static_cast<const fictus::ArcLengthTable*>(nullptr), &placement})
+    for (const std::vector<double>& breaks : {std::vector<double>{}, std::vector<double>{2.5}}) {
+      const std::vector<double> snaps = {0.93, 2.62, 6.27};
+      const fictus::Collocation before = fictus::make_collocation(e, table, m, 0.5, measure, breaks);
+      const fictus::Collocation scratch = fictus::make_collocation(e, table, m, 0.5, measure, breaks, snaps);
+      const fictus::Collocation reused = fictus::make_collocation(e, table, m, 0.5, measure, breaks, snaps, &before);
+      ASSERT_EQ(int(reused.reused.size()), m);
+      EXPECT_TRUE(scratch.reused.empty());
+      int taken = 0;
+      for (int i = 0; i < m; ++i) {
+        const std::size_t k = std::size_t(i);
+        EXPECT_EQ(reused.t[k], scratch.t[k]) << i;
+        EXPECT_EQ(reused.s[k], scratch.s[k]) << i;
+        EXPECT_EQ(reused.arc[k], scratch.arc[k]) << i;
+        EXPECT_EQ(reused.arc_begin[k], scratch.arc_begin[k]) << i;
+        EXPECT_EQ(reused.arc_end[k], scratch.arc_end[k]) << i;
+        EXPECT_EQ(reused.point[k].x, scratch.point[k].x) << i;
+        EXPECT_EQ(reused.normal[k].y, scratch.normal[k].y) << i;
+        if (const int j = reused.reused[k]; j >= 0) {
+          ++taken;
+          EXPECT_EQ(reused.t[k], before.t[std::size_t(j)]) << i;  // the arc it was taken from
+        }
+      }
+      EXPECT_GE(taken, m / 2);  // the arcs far from the snaps were taken over
+      EXPECT_LE(taken, m - 6);  // and the moved ones made again (at least two per snap)
+    }
+}
+
 TEST(Collocation, SnapsMoveTheNearestBordersAndKeepTheOtherArcs) {
   // The contact fit's ends: an arc ends at each snap (one past t = 0 on the wrap, one beside a break), the
   // arcs more than a few away from every snap are those without snaps, and neighbouring arcs differ by at

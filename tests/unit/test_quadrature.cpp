@@ -1,8 +1,10 @@
 // Quadrature over ω and along γ that follows the true curve in cut cells.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "fictus/boundary/curve_grid_intersection.hpp"
 
@@ -39,6 +41,35 @@ TEST_P(DomainQuadrature, AreaMomentsAndPerimeterOfEllipse) {
 INSTANTIATE_TEST_SUITE_P(Grids, DomainQuadrature,
                          ::testing::Values(Case{16, 0.0}, Case{64, 0.0}, Case{128, 0.0}, Case{50, 0.7},
                                            Case{256, 2.1}));
+
+TEST(CurveGridIntersection, KeptCutCellRulesGiveTheRulesMadeAfresh) {
+  // row_rule keeps each row's cut-cell rules per q once made (in parallel, 2 threads): later calls, and
+  // calls for another q in between, give the points a fresh intersection makes, bit for bit.
+  const fictus::Ellipse e({0.5, 0.47}, 0.4, 0.2, 0.7);
+  const fictus::Grid2 grid(fictus::Box2{}, 96);
+  const fictus::CurveGridIntersection kept(e, grid);
+  const fictus::Execution two(2);
+  const auto f = [](int, int, double x, double y) { return std::array<double, 2>{1.0, std::sin(3 * x) * y}; };
+  const auto first = fictus::integrate_over_domain<2>(kept, 2, f, two);
+  const auto other_q = fictus::integrate_over_domain<2>(kept, 3, f, two);
+  for (int round = 0; round < 2; ++round) {
+    const fictus::CurveGridIntersection fresh(e, grid);
+    for (int iy = 0; iy < grid.ny(); ++iy) {
+      std::vector<fictus::CellQuadraturePoint> a, b;
+      kept.row_rule(iy, round == 0 ? 2 : 3, a);
+      fresh.row_rule(iy, round == 0 ? 2 : 3, b);
+      ASSERT_EQ(a.size(), b.size()) << iy;
+      for (std::size_t k = 0; k < a.size(); ++k) {
+        EXPECT_EQ(a[k].ix, b[k].ix);
+        EXPECT_EQ(a[k].x, b[k].x);
+        EXPECT_EQ(a[k].y, b[k].y);
+        EXPECT_EQ(a[k].weight, b[k].weight);
+      }
+    }
+  }
+  EXPECT_NEAR(first[0], other_q[0], 1e-12);  // the area, by both rules
+  EXPECT_NEAR(first[0], std::numbers::pi * 0.4 * 0.2, 1e-12);
+}
 
 TEST(CurveGridIntersection, InsideTestMatchesEllipseEquation) {
   const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2, 0.4);

@@ -74,16 +74,16 @@ class CurveGridIntersection {
   std::vector<std::size_t> row_begin_;
   std::vector<std::vector<double>> row_crossings_;  // per grid row j: sorted x of crossings
   std::vector<std::vector<double>> col_crossings_;  // per grid column i: sorted y of crossings
-  /// row_rule's cut-cell rules for one q, each row's made once by the first thread that asks.
+  /// row_rule's rules of one row's cut cells for one q: its cut cells' points, cell after cell, and where
+  /// each cell's points begin (and the end).
   struct CutRules {
-    explicit CutRules(int rows) : made(std::size_t(rows)), points(std::size_t(rows)), begin(std::size_t(rows)) {}
-    std::vector<std::once_flag> made;
-    std::vector<std::vector<QuadraturePoint>> points;  // per row: its cut cells' points, cell after cell
-    std::vector<std::vector<std::size_t>> begin;       // per row: where each cut cell's points begin, and the end
+    std::vector<QuadraturePoint> points;
+    std::vector<std::size_t> begin;
   };
+  /// Made outside the lock by the thread that asks first, kept once complete (a throw keeps nothing).
   const CutRules& cut_rules(int iy, int q) const;
   mutable std::mutex rules_mutex_;
-  mutable std::map<int, std::unique_ptr<CutRules>> rules_;  // by q
+  mutable std::map<int, std::vector<std::unique_ptr<const CutRules>>> rules_;  // by q, then by row
 };
 
 /// ∫_ω F over ω (F returns K values, integrated together): q×q Gauss on cells inside ω, the

@@ -67,7 +67,8 @@ class CurveDiscretization final : public BoundaryDiscretization<2> {
   /// The points for `parts`, their arcs ending at its junctions; the arcs placed as in `reuse` (the base's,
   /// for a fitted copy) are taken from it.
   void place_points(const SolverOptions& options, const PartConditions<2>& parts, const Collocation* reuse);
-  /// K = max(4096, 16m) samples of γ, at t = 2π(k + ½)/K, made on first use.
+  /// K = max(4096, 16m) samples of γ, at t = 2π(k + ½)/K, made on first use (by the solve's thread: not
+  /// for calls from several threads at once).
   const std::shared_ptr<const std::vector<Point2>>& layout_samples() const;
   /// The labels at layout_samples().
   std::vector<int> part_layout(const PartConditions<2>& parts) const override;
