@@ -5,6 +5,9 @@
 // points are placed part by part so that their arcs end at the exact ends. Least-squares rates over the
 // powers of two and over all N, and the spread of error·N² (1 for clean second order).
 // Usage: fictus_bench_contact_fit REFERENCE smooth|nonsmooth N... (accuracy only; times are one run each).
+//        fictus_bench_contact_fit REFERENCE shifted N...: the smooth variant's error with the contact set
+//        fixed to the reference's intervals with each end moved along γ by δ spacings s = L/m (δ > 0: the
+//        contact set grows), for δ = −0.5 … 0.1: how much an error of the located ends costs.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -33,6 +36,76 @@ bool in_reference_contact(const std::vector<double>& ends, double theta) {
   return false;
 }
 
+/// The reference's contact intervals (polar angles about `centre`, [ends[2k], ends[2k+1]] in contact) with
+/// each end moved along γ by `shift` in arc length, outwards (the contact set grows) for shift > 0.
+std::vector<double> shifted_ends(const std::vector<double>& ends, const fictus::Point2& centre,
+                                 const fictus::Curve& curve, double shift) {
+  const fictus::ArcLengthTable table(curve);
+  const double L = table.length(), pi = std::numbers::pi;
+  const auto angle_at = [&](double t) { return angle_about(centre, curve.position(t)); };
+  const auto off = [pi](double a, double b) { return std::remainder(a - b, 2 * pi); };  // a − b in (−π, π]
+  constexpr int samples = 20000;
+  std::vector<double> moved;
+  for (std::size_t k = 0; k < ends.size(); ++k) {
+    // The parameter where γ's polar angle passes the end (γ is star-shaped about the centre).
+    double lo = 0, hi = 0;
+    for (int i = 0; i < samples; ++i) {
+      const double a = 2 * pi * i / samples, b = 2 * pi * (i + 1) / samples;
+      if (off(angle_at(a), ends[k]) <= 0 && off(angle_at(b), ends[k]) > 0) lo = a, hi = b;
+    }
+    for (int it = 0; it < 60; ++it) (off(angle_at(0.5 * (lo + hi)), ends[k]) <= 0 ? lo : hi) = 0.5 * (lo + hi);
+    const double along = k % 2 == 0 ? -shift : shift;  // a start moves back, an end on
+    const double s = std::fmod(table.s_of_t(0.5 * (lo + hi)) + along + L, L);
+    moved.push_back(angle_at(table.t_of_s(s)));
+  }
+  return moved;
+}
+
+/// The problem with the contact set fixed to the intervals `ends` (u = g there, ∂u/∂n = 0 elsewhere; the
+/// tips' g depends on x, y only).
+fictus::Problem fixed_contact(const fictus::Problem& problem, const fictus::Point2& centre,
+                              const std::vector<double>& ends) {
+  fictus::Problem fixed = problem;
+  const auto g = problem.g_along_curve;
+  fixed.conditions.dirichlet = [=](const fictus::Point2& x) {
+    return in_reference_contact(ends, angle_about(centre, x)) ? 1.0 : 0.0;
+  };
+  fixed.conditions.neumann = [=](const fictus::Point2& x) {
+    return in_reference_contact(ends, angle_about(centre, x)) ? 0.0 : 1.0;
+  };
+  fixed.conditions.u = [g](const fictus::Point2& x) { return g(x.x, x.y, 0.0); };
+  return fixed;
+}
+
+/// The shifted mode: one row per N.
+void shifted(const reference::Reference& ref, const std::string& file, const std::vector<int>& Ns) {
+  const std::vector<double> shifts = {-0.5, -0.3, -0.2, -0.15, -0.1, -0.05, -0.02, 0.0, 0.02, 0.05, 0.1};
+  std::printf("| N | m |");
+  for (double d : shifts) std::printf(" δ = %+.2f |", d);
+  std::printf("\n|---|---|");
+  for (std::size_t k = 0; k < shifts.size(); ++k) std::printf("---|");
+  std::printf("\n");
+  for (int N : Ns) {
+    fictus::ProblemSpec spec = fictus::read_problem_file(file);
+    spec.problem.N = N;
+    spec.options.variant = fictus::Variant::smooth;
+    spec.options.condition_number = false;
+    spec.options.error_estimate = false;
+    spec.options.threads = 2;
+    spec.options.fit_contact = 0;
+    const fictus::Solution plain = fictus::solve(spec.problem, spec.options);
+    const double spacing = plain.collocation.length / plain.collocation.m;
+    std::printf("| %d | %d |", N, plain.collocation.m);
+    for (double d : shifts) {
+      const std::vector<double> ends = shifted_ends(ref.ends, ref.center, *spec.problem.gamma, d * spacing);
+      const fictus::Solution s = fictus::solve(fixed_contact(spec.problem, ref.center, ends), spec.options);
+      std::printf(" %.2e |", reference::compare(ref, s).level.l2_omega);
+      std::fflush(stdout);
+    }
+    std::printf("\n");
+  }
+}
+
 double fitted_rate(const std::vector<int>& N, const std::vector<double>& e) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
   const double n = double(N.size());
@@ -54,6 +127,12 @@ int main(int argc, char** argv) {
   const fictus::Variant variant =
       std::string(argv[2]) == "nonsmooth" ? fictus::Variant::nonsmooth : fictus::Variant::smooth;
   const reference::Reference ref = reference::load(dir, name);
+  if (std::string(argv[2]) == "shifted") {
+    std::vector<int> Ns;
+    for (int a = 3; a < argc; ++a) Ns.push_back(std::stoi(argv[a]));
+    shifted(ref, dir + name + ".toml", Ns);
+    return 0;
+  }
   constexpr int max_passes = 3;
   std::vector<int> Ns;
   std::vector<std::vector<double>> errors(max_passes + 2);  // passes 0 … 3, then the exact ends
@@ -85,21 +164,11 @@ int main(int argc, char** argv) {
       }
       m = s.collocation.m;
     }
-    // The contact set fixed to the reference's intervals (the tips' g depends on x, y only).
-    fictus::Problem fixed = spec.problem;
-    const auto g = spec.problem.g_along_curve;
-    const fictus::Point2 centre = ref.center;
-    const std::vector<double> reference_ends = ref.ends;
-    fixed.conditions.dirichlet = [=](const fictus::Point2& x) {
-      return in_reference_contact(reference_ends, angle_about(centre, x)) ? 1.0 : 0.0;
-    };
-    fixed.conditions.neumann = [=](const fictus::Point2& x) {
-      return in_reference_contact(reference_ends, angle_about(centre, x)) ? 0.0 : 1.0;
-    };
-    fixed.conditions.u = [g](const fictus::Point2& x) { return g(x.x, x.y, 0.0); };
+    // The contact set fixed to the reference's intervals.
     fictus::SolverOptions o = spec.options;
     o.fit_contact = 0;
-    errors[max_passes + 1].push_back(reference::compare(ref, fictus::solve(fixed, o)).level.l2_omega);
+    errors[max_passes + 1].push_back(
+        reference::compare(ref, fictus::solve(fixed_contact(spec.problem, ref.center, ref.ends), o)).level.l2_omega);
     std::printf("| %d | %d | %.2e | %.2e | %.2e | %.2e | %.2e | %s | %s |\n", N, m, errors[max_passes + 1].back(),
                 errors[0].back(), errors[1].back(), errors[2].back(), errors[3].back(), ends.c_str(), seconds.c_str());
     std::fflush(stdout);

@@ -220,20 +220,23 @@ void CurveDiscretization::place_points(const SolverOptions& options, const PartC
   // A junction of the contact fit (the Signorini part on both sides) within a quarter spacing of another
   // break is left out: no sliver of an arc between them.
   std::vector<double> breaks;
-  std::vector<double> fitted, snaps;  // the contact fit's, and those kept
+  std::vector<Snap> fitted, snaps;  // the contact fit's, and those kept
   for (std::size_t k = 0; k < joins.size(); ++k) {
     const int before = joins[(k + joins.size() - 1) % joins.size()].second, after = joins[k].second;
-    const bool contact_only = PartConditions<2>::condition_of(before) == PartConditions<2>::condition_of(after);
-    (contact_only ? fitted : breaks).push_back(joins[k].first);
+    if (PartConditions<2>::condition_of(before) != PartConditions<2>::condition_of(after))
+      breaks.push_back(joins[k].first);
+    else
+      fitted.push_back({joins[k].first, after == PartConditions<2>::contact_label ? 1 : -1});
   }
-  for (double t : fitted) {
+  for (const Snap& snap : fitted) {
     bool near = false;
-    for (const std::vector<double>* kept : {&breaks, &snaps})
-      for (double b : *kept) {
-        const double d = std::abs(arc_length.s_of_t(t) - arc_length.s_of_t(b));
-        near = near || std::min(d, L - d) < 0.25 * L / m;
-      }
-    if (!near) snaps.push_back(t);
+    const auto close = [&](double b) {
+      const double d = std::abs(arc_length.s_of_t(snap.t) - arc_length.s_of_t(b));
+      return std::min(d, L - d) < 0.25 * L / m;
+    };
+    for (double b : breaks) near = near || close(b);
+    for (const Snap& kept : snaps) near = near || close(kept.t);
+    if (!near) snaps.push_back(snap);
   }
   std::sort(breaks.begin(), breaks.end());
   // The corners too (non-smooth), where they are few: one within a quarter spacing of a junction is

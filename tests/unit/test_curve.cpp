@@ -140,7 +140,7 @@ TEST(Collocation, ReuseTakesOverTheArcsPlacedAsBeforeBitForBit) {
   const int m = 60;
   for (const fictus::ArcLengthTable* measure : {static_cast<const fictus::ArcLengthTable*>(nullptr), &placement})
     for (const std::vector<double>& breaks : {std::vector<double>{}, std::vector<double>{2.5}}) {
-      const std::vector<double> snaps = {0.93, 2.62, 6.27};
+      const std::vector<fictus::Snap> snaps = {{0.93, 1}, {2.62, -1}, {6.27, 0}};
       const fictus::Collocation before = fictus::make_collocation(e, table, m, 0.5, measure, breaks);
       const fictus::Collocation scratch = fictus::make_collocation(e, table, m, 0.5, measure, breaks, snaps);
       const fictus::Collocation reused = fictus::make_collocation(e, table, m, 0.5, measure, breaks, snaps, &before);
@@ -175,7 +175,7 @@ TEST(Collocation, SnapsMoveTheNearestBordersAndKeepTheOtherArcs) {
   const fictus::ArcLengthTable table(e);
   const int m = 60;
   const std::vector<double> breaks = {2.5};
-  const std::vector<double> snaps = {0.93, 2.62, 6.2};
+  const std::vector<fictus::Snap> snaps = {{0.93}, {2.62}, {6.2}};
   const fictus::Collocation plain = fictus::make_collocation(e, table, m, 0.5, nullptr, breaks);
   const fictus::Collocation c = fictus::make_collocation(e, table, m, 0.5, nullptr, breaks, snaps);
   ASSERT_EQ(c.m, m);
@@ -188,7 +188,7 @@ TEST(Collocation, SnapsMoveTheNearestBordersAndKeepTheOtherArcs) {
     EXPECT_LT(std::abs(c.arc[i] - c.arc[(i + 1) % m]), 0.25 * s + 1e-12) << i;
   }
   EXPECT_NEAR(total, L, 1e-12);
-  for (double t : {breaks[0], snaps[0], snaps[1], snaps[2]}) {
+  for (double t : {breaks[0], snaps[0].t, snaps[1].t, snaps[2].t}) {
     int ends = 0;
     for (int i = 0; i < m; ++i) ends += std::abs(c.arc_end[i] - t) < 1e-14;
     EXPECT_EQ(ends, 1) << "end " << t;
@@ -196,8 +196,8 @@ TEST(Collocation, SnapsMoveTheNearestBordersAndKeepTheOtherArcs) {
   int kept = 0;
   for (int i = 0; i < m; ++i) {
     double nearest = L;
-    for (double t : snaps) {
-      const double d = std::abs(c.s[i] - table.s_of_t(t));
+    for (const fictus::Snap& snap : snaps) {
+      const double d = std::abs(c.s[i] - table.s_of_t(snap.t));
       nearest = std::min(nearest, std::min(d, L - d));
     }
     if (nearest > 3.5 * s) {
@@ -207,13 +207,41 @@ TEST(Collocation, SnapsMoveTheNearestBordersAndKeepTheOtherArcs) {
   }
   EXPECT_GT(kept, m / 2);
   // Two snaps closer than an arc: the arcs still end at both.
-  const std::vector<double> close = {1.0, 1.0 + 0.3 * s / table.length() * 2 * pi};
+  const std::vector<fictus::Snap> close = {{1.0}, {1.0 + 0.3 * s / table.length() * 2 * pi}};
   const fictus::Collocation d = fictus::make_collocation(e, table, m, 0.5, nullptr, {}, close);
-  for (double t : close) {
+  for (const fictus::Snap& snap : close) {
     int ends = 0;
-    for (int i = 0; i < m; ++i) ends += std::abs(d.arc_end[i] - t) < 1e-14;
-    EXPECT_EQ(ends, 1) << "close end " << t;
+    for (int i = 0; i < m; ++i) ends += std::abs(d.arc_end[i] - snap.t) < 1e-14;
+    EXPECT_EQ(ends, 1) << "close end " << snap.t;
   }
+}
+
+TEST(Collocation, SnapsWithASideEndAnArcJustInsideTheContact) {
+  // A located end whose contact lies towards larger t (side +1) or smaller t (−1): an arc ends a twentieth
+  // of the spacing into the contact (the discrete contact reaches that much past an arc border), one with
+  // no side at the end itself; the arcs stay within a quarter spacing and a little of equal.
+  const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2, 0.3);
+  const fictus::ArcLengthTable table(e);
+  const int m = 60;
+  const double L = table.length(), s = L / m;
+  for (const double where : {0.1, 0.3, 0.5, 0.7, 0.9})  // the end's place in its arc, in spacings
+    for (const int side : {1, -1, 0}) {
+      const double t = table.t_of_s((17 + where) * s);  // arc 17 of the equal arcs (phase ½: borders at i·s)
+      const fictus::Collocation c = fictus::make_collocation(e, table, m, 0.5, nullptr, {}, {{t, side}});
+      const double target = (17 + where + 0.05 * side) * s;
+      int ends = 0;
+      for (int i = 0; i < m; ++i) {
+        ends += std::abs(table.s_of_t(c.arc_end[i]) - target) < 1e-12 * L;
+        EXPECT_GT(c.arc[i], (0.75 - 0.05) * s - 1e-12) << i;
+        EXPECT_LT(c.arc[i], (1.25 + 0.05) * s + 1e-12) << i;
+      }
+      EXPECT_EQ(ends, 1) << where << " " << side;
+      if (side == 0) {
+        int exact = 0;
+        for (int i = 0; i < m; ++i) exact += c.arc_end[i] == t;
+        EXPECT_EQ(exact, 1) << where;
+      }
+    }
 }
 
 TEST(Collocation, DefaultRuleKeepsTheSpacingInCells) {

@@ -19,6 +19,13 @@ struct PlacedArc {
   bool same(const PlacedArc& o) const;
 };
 
+/// A contact end the arcs are to end at (make_collocation's snaps): γ's parameter there and the side the
+/// contact lies on, +1 towards larger t, −1 towards smaller t, 0 unknown.
+struct Snap {
+  double t = 0.0;
+  int contact_side = 0;
+};
+
 struct Collocation {
   int m = 0;
   double length = 0.0;   // L = |γ|
@@ -41,14 +48,15 @@ struct Collocation {
 /// arc ends at each break: the pieces between consecutive breaks get arcs equal within each piece, as
 /// many as keep the longest arc shortest (at least one a piece; `phase` is then unused). Throws
 /// std::invalid_argument naming formulation.multipliers when m is below the number of pieces. With `snaps`
-/// (the contact fit's ends), the arcs so placed then move so that an arc ends at each snap: the nearest
-/// border moves there and the shift fades over a few arcs on either side, so the arcs stay nearly
-/// equal; where that cannot be done the snaps are taken as breaks. `reuse`: a collocation made before with
+/// (the contact fit's ends), the arcs so placed then move so that an arc ends at each snap, or, where its
+/// contact side is known, a twentieth of the spacing into its contact: the nearest border moves there and
+/// the shift fades over a few arcs on either side, so the arcs stay nearly equal; where that cannot be
+/// done the arcs end there as at breaks. `reuse`: a collocation made before with
 /// the same curve, tables and m (the contact fit's unsnapped one); the arcs placed exactly as there take
 /// their parameters, points and normals from it instead of inverting the measure again (the same numbers).
 Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase = 0.5,
                              const ArcLengthTable* placement = nullptr, const std::vector<double>& breaks = {},
-                             const std::vector<double>& snaps = {}, const Collocation* reuse = nullptr);
+                             const std::vector<Snap>& snaps = {}, const Collocation* reuse = nullptr);
 
 /// The smooth variant's placement measure for Γ at distance δ: speed |p′(t)|·max(1, 1 + δκ(t)), the
 /// speed of the offset curve where γ is convex and of γ itself where it is concave.
