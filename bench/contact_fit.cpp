@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,7 @@ std::vector<double> shifted_ends(const std::vector<double>& ends, const fictus::
       const double a = 2 * pi * i / samples, b = 2 * pi * (i + 1) / samples;
       if (off(angle_at(a), ends[k]) <= 0 && off(angle_at(b), ends[k]) > 0) lo = a, hi = b;
     }
+    if (hi == 0) throw std::runtime_error("shifted: gamma's polar angle about the centre never passes an end");
     for (int it = 0; it < 60; ++it) (off(angle_at(0.5 * (lo + hi)), ends[k]) <= 0 ? lo : hi) = 0.5 * (lo + hi);
     const double along = k % 2 == 0 ? -shift : shift;  // a start moves back, an end on
     const double s = std::fmod(table.s_of_t(0.5 * (lo + hi)) + along + L, L);

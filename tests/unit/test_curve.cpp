@@ -218,30 +218,39 @@ TEST(Collocation, SnapsMoveTheNearestBordersAndKeepTheOtherArcs) {
 
 TEST(Collocation, SnapsWithASideEndAnArcJustInsideTheContact) {
   // A located end whose contact lies towards larger t (side +1) or smaller t (−1): an arc ends a twentieth
-  // of the spacing into the contact (the discrete contact reaches that much past an arc border), one with
-  // no side at the end itself; the arcs stay within a quarter spacing and a little of equal.
+  // of the spacing (in the placement measure) into the contact, one with no side at the end itself; the
+  // arcs stay within about a quarter spacing of equal. In arc length and in a placement measure, in the
+  // middle of γ and on either side of t = 0 (the target wraps past it).
   const fictus::Ellipse e({0.5, 0.5}, 0.4, 0.2, 0.3);
   const fictus::ArcLengthTable table(e);
+  const fictus::ArcLengthTable placement = fictus::offset_placement(e, 0.05);
   const int m = 60;
-  const double L = table.length(), s = L / m;
-  for (const double where : {0.1, 0.3, 0.5, 0.7, 0.9})  // the end's place in its arc, in spacings
-    for (const int side : {1, -1, 0}) {
-      const double t = table.t_of_s((17 + where) * s);  // arc 17 of the equal arcs (phase ½: borders at i·s)
-      const fictus::Collocation c = fictus::make_collocation(e, table, m, 0.5, nullptr, {}, {{t, side}});
-      const double target = (17 + where + 0.05 * side) * s;
-      int ends = 0;
-      for (int i = 0; i < m; ++i) {
-        ends += std::abs(table.s_of_t(c.arc_end[i]) - target) < 1e-12 * L;
-        EXPECT_GT(c.arc[i], (0.75 - 0.05) * s - 1e-12) << i;
-        EXPECT_LT(c.arc[i], (1.25 + 0.05) * s + 1e-12) << i;
+  for (const fictus::ArcLengthTable* measure : {&table, &placement}) {
+    const double W = measure->length(), s = W / m;
+    for (const double at : {17.1, 17.3, 17.5, 17.7, 17.9, 0.02, m - 0.02})  // in spacings of the measure
+      for (const int side : {1, -1, 0}) {
+        const double t = measure->t_of_s(at * s);
+        const fictus::Collocation c =
+            fictus::make_collocation(e, table, m, 0.5, measure == &table ? nullptr : measure, {}, {{t, side}});
+        const double target = at + 0.05 * side;  // in spacings, taken cyclically
+        int ends = 0;
+        for (int i = 0; i < m; ++i) {
+          const double w = measure->s_of_t(c.arc_end[std::size_t(i)]) / s;
+          ends += std::abs(std::remainder(w - target, double(m))) < 1e-10;
+          const double arc =
+              (measure->s_of_t(c.arc_end[std::size_t(i)]) - measure->s_of_t(c.arc_begin[std::size_t(i)]));
+          const double length = (arc < 0 ? arc + W : arc) / s;  // an arc may wrap past t = 0
+          EXPECT_GT(length, 0.725 - 1e-9) << i;
+          EXPECT_LT(length, 1.275 + 1e-9) << i;
+        }
+        EXPECT_EQ(ends, 1) << at << " " << side;
+        if (side == 0) {
+          int exact = 0;
+          for (int i = 0; i < m; ++i) exact += c.arc_end[std::size_t(i)] == t;
+          EXPECT_EQ(exact, 1) << at;
+        }
       }
-      EXPECT_EQ(ends, 1) << where << " " << side;
-      if (side == 0) {
-        int exact = 0;
-        for (int i = 0; i < m; ++i) exact += c.arc_end[i] == t;
-        EXPECT_EQ(exact, 1) << where;
-      }
-    }
+  }
 }
 
 TEST(Collocation, DefaultRuleKeepsTheSpacingInCells) {

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <numbers>
 #include <ostream>
 
 #include "fictus/boundary/curve.hpp"
@@ -325,6 +327,49 @@ TEST(GreenBlocks, ContactFitTakesOverTheUnmovedPointsBitForBit) {
     }
     EXPECT_GE(moved, 2);      // the fit did move points
     EXPECT_LE(moved, m / 2);  // and took the others over
+  }
+}
+
+TEST(GreenBlocks, ContactFitEndsTheArcsJustInsideTheContact) {
+  // Each end of the contact side: the arc border nearest to it lies on the contact side (the side that
+  // contact_side marks), a few hundredths of a spacing in (s/20 in the placement measure).
+  const fictus::Grid2 grid(fictus::Box2{{0, 0}, {1, 1}}, 256);
+  const fictus::Execution execution(2);
+  const auto gamma = std::make_shared<const fictus::Ellipse>(fictus::Point2{0.5, 0.5}, 0.35, 0.2, 0.4);
+  const fictus::ArcLengthTable table(*gamma);
+  fictus::PartConditions<2> parts;
+  const auto contact = [](const fictus::Point2& x) { return x.x + 0.3 * x.y > 0.61; };
+  parts.contact_side = [&contact](const fictus::Point2& x) { return contact(x) ? 1.0 : 0.0; };
+  std::vector<double> ends;  // where γ crosses into or out of the contact side
+  constexpr int samples = 4096;
+  const double two_pi = 2 * std::numbers::pi;
+  for (int k = 0; k < samples; ++k) {
+    double lo = two_pi * k / samples, hi = two_pi * (k + 1) / samples;
+    const bool at_lo = contact(gamma->position(lo));
+    if (at_lo == contact(gamma->position(hi))) continue;
+    for (int it = 0; it < 60; ++it) (contact(gamma->position(0.5 * (lo + hi))) == at_lo ? lo : hi) = 0.5 * (lo + hi);
+    ends.push_back(0.5 * (lo + hi));
+  }
+  ASSERT_EQ(ends.size(), 2u);
+  for (const fictus::Variant variant : {fictus::Variant::smooth, fictus::Variant::nonsmooth}) {
+    fictus::SolverOptions options;
+    options.variant = variant;
+    const fictus::CurveDiscretization a(gamma, grid, options, 1.0, execution);
+    const std::unique_ptr<fictus::BoundaryDiscretization<2>> placed = a.placed_for(parts, options, 1.0, {});
+    const auto* fitted = dynamic_cast<const fictus::CurveDiscretization*>(placed.get());
+    ASSERT_NE(fitted, nullptr);
+    const fictus::Collocation& c = fitted->collocation();
+    const double L = table.length(), s = L / c.m;
+    for (double t : ends) {
+      double nearest = L, border = 0;
+      for (int i = 0; i < c.m; ++i) {
+        const double d = std::remainder(table.s_of_t(c.arc_end[std::size_t(i)]) - table.s_of_t(t), L);
+        if (std::abs(d) < std::abs(nearest)) nearest = d, border = c.arc_end[std::size_t(i)];
+      }
+      EXPECT_TRUE(contact(gamma->position(border))) << fictus::to_string(variant) << ", end at t = " << t;
+      EXPECT_GT(std::abs(nearest), 0.02 * s) << fictus::to_string(variant);
+      EXPECT_LT(std::abs(nearest), 0.1 * s) << fictus::to_string(variant);
+    }
   }
 }
 

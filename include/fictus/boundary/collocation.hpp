@@ -49,11 +49,11 @@ struct Collocation {
 /// many as keep the longest arc shortest (at least one a piece; `phase` is then unused). Throws
 /// std::invalid_argument naming formulation.multipliers when m is below the number of pieces. With `snaps`
 /// (the contact fit's ends), the arcs so placed then move so that an arc ends at each snap, or, where its
-/// contact side is known, a twentieth of the spacing into its contact: the nearest border moves there and
-/// the shift fades over a few arcs on either side, so the arcs stay nearly equal; where that cannot be
-/// done the arcs end there as at breaks. `reuse`: a collocation made before with
-/// the same curve, tables and m (the contact fit's unsnapped one); the arcs placed exactly as there take
-/// their parameters, points and normals from it instead of inverting the measure again (the same numbers).
+/// contact side is known, a twentieth of the spacing (in `placement`) into its contact: the nearest border moves there
+/// and the shift fades over a few arcs on either side, so the arcs stay nearly equal; where that cannot be done the
+/// arcs end there as at breaks. `reuse`: a collocation made before with the same curve, tables and m (the contact fit's
+/// unsnapped one); the arcs placed exactly as there take their parameters, points and normals from it instead of
+/// inverting the measure again (the same numbers).
 Collocation make_collocation(const Curve& curve, const ArcLengthTable& arc_length, int m, double phase = 0.5,
                              const ArcLengthTable* placement = nullptr, const std::vector<double>& breaks = {},
                              const std::vector<Snap>& snaps = {}, const Collocation* reuse = nullptr);
