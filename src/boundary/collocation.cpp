@@ -25,8 +25,8 @@ constexpr int snap_reach = 2;
 /// snaps with a side). With an arc border exactly at a contact end the discrete problem acts as if its
 /// contact reached further: with the contact set fixed to the fitted-mesh references' own, the error is
 /// least with each end moved 0.05–0.1 s into the contact (1.4–6.5× below the error at the exact ends, at every
-/// N). Of 0.03, 0.05, 0.075 and 0.1 in the fitted solves, 0.05 gave the lowest errors
-/// (bench/results/2026-12-06-contact-inset.md).
+/// N). Of 0, 0.03, 0.05, 0.075 and 0.1 in the fitted solves, 0.05 gave the lowest errors with the fewest bad
+/// runs (bench/results/2026-12-06-contact-inset.md).
 constexpr double snap_inset = 0.05;
 
 /// The arcs in the placement measure: m equal ones from (phase − ½)·W/m on; or, with breaks, each piece
