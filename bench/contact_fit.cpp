@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -21,6 +22,14 @@
 #include "reference_comparison.hpp"
 
 namespace {
+
+/// Options from the environment, for trials: FIT (passes), OFFSET (δ/s), VARIANT=nonsmooth.
+void overrides(fictus::SolverOptions& o) {
+  if (const char* e = std::getenv("FIT")) o.fit_contact = std::atoi(e);
+  if (const char* e = std::getenv("OFFSET")) o.offset = std::atof(e);
+  if (const char* e = std::getenv("VARIANT"); e && std::string(e) == "nonsmooth")
+    o.variant = fictus::Variant::nonsmooth;
+}
 
 /// The polar angle of x about c, in [0, 2π).
 double angle_about(const fictus::Point2& c, const fictus::Point2& x) {
@@ -108,6 +117,59 @@ void shifted(const reference::Reference& ref, const std::string& file, const std
   }
 }
 
+/// ‖a − b‖ over ω by a polar rule about the reference's centre (its own rule has n_θ = 128, n_ρ = 16): n_θ
+/// angles at the midpoints, n_ρ Gauss points in ρ ∈ (0, 1), weights (2π/n_θ)·w_k·ρ_k·r_b(θ_j)².
+/// `difference(x, n)` is a − b at x, the rule's n-th point.
+template <class Difference>
+double polar_l2(const reference::Reference& r, int n_theta, int n_rho, Difference&& difference) {
+  const fictus::GaussRule& rule = fictus::gauss_legendre(n_rho);
+  double sum = 0;
+  for (int j = 0; j < n_theta; ++j) {
+    const double theta = reference::two_pi * (j + 0.5) / n_theta, rb = r.radius(theta);
+    for (int k = 0; k < n_rho; ++k) {
+      const double rho = rule.nodes[std::size_t(k)];
+      const double w = reference::two_pi / n_theta * rule.weights[std::size_t(k)] * rho * rb * rb;
+      const fictus::Point2 x = r.center + rho * rb * fictus::Point2{std::cos(theta), std::sin(theta)};
+      sum += w * std::pow(difference(x, std::size_t(j) * std::size_t(n_rho) + std::size_t(k)), 2);
+    }
+  }
+  return std::sqrt(sum);
+}
+
+/// The quadrature mode: each N's relative L²(ω) error three ways, against the reference on its own rule,
+/// against a fictus solve at N_fine on that rule, and against the same on a rule 64 times finer (2048
+/// angles, 64 Gauss points in ρ). If the reference's rule undersamples the error near the contact ends,
+/// the first two swing together from one N to the next and the third does not.
+void quadrature(const reference::Reference& ref, const std::string& file, int fine_N, const std::vector<int>& Ns) {
+  const auto solve_at = [&file](int N) {
+    fictus::ProblemSpec spec = fictus::read_problem_file(file);
+    spec.problem.N = N;
+    spec.options.variant = fictus::Variant::smooth;
+    spec.options.condition_number = false;
+    spec.options.error_estimate = false;
+    spec.options.threads = 2;
+    overrides(spec.options);
+    return fictus::solve(spec.problem, spec.options);
+  };
+  const fictus::Solution fine = solve_at(fine_N);
+  const auto at = [](const fictus::Solution& s, const fictus::Point2& x) {
+    return fictus::sample_q1(s.grid, s.u, s.grid.cell_x(x.x), s.grid.cell_y(x.y), x.x, x.y).value;
+  };
+  const double to_reference = reference::compare(ref, fine).level.l2_omega;
+  std::printf("fictus at N = %d against the reference (its rule): %.2e\n\n", fine_N, to_reference);
+  std::printf("| N | against the reference | against N = %d, the reference's rule | the same, 64× finer rule |\n",
+              fine_N);
+  std::printf("|---|---|---|---|\n");
+  for (int N : Ns) {
+    const fictus::Solution s = solve_at(N);
+    const auto difference = [&](const fictus::Point2& x, std::size_t) { return at(s, x) - at(fine, x); };
+    std::printf("| %d | %.2e | %.2e | %.2e |\n", N, reference::compare(ref, s).level.l2_omega,
+                polar_l2(ref, ref.n_theta, ref.n_rho, difference) / ref.l2_omega,
+                polar_l2(ref, 16 * ref.n_theta, 4 * ref.n_rho, difference) / ref.l2_omega);
+    std::fflush(stdout);
+  }
+}
+
 double fitted_rate(const std::vector<int>& N, const std::vector<double>& e) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
   const double n = double(N.size());
@@ -135,6 +197,12 @@ int main(int argc, char** argv) {
     shifted(ref, dir + name + ".toml", Ns);
     return 0;
   }
+  if (std::string(argv[2]) == "quadrature") {
+    std::vector<int> Ns;
+    for (int a = 4; a < argc; ++a) Ns.push_back(std::stoi(argv[a]));
+    quadrature(ref, dir + name + ".toml", std::stoi(argv[3]), Ns);
+    return 0;
+  }
   constexpr int max_passes = 3;
   std::vector<int> Ns;
   std::vector<std::vector<double>> errors(max_passes + 2);  // passes 0 … 3, then the exact ends
@@ -148,6 +216,7 @@ int main(int argc, char** argv) {
     spec.options.condition_number = false;
     spec.options.error_estimate = false;
     spec.options.threads = 2;
+    if (const char* e = std::getenv("OFFSET")) spec.options.offset = std::atof(e);
     Ns.push_back(N);
     std::string ends, seconds;
     int m = 0;

@@ -53,7 +53,7 @@ struct Run {
 
 Run run(int N, fictus::Variant variant, fictus::InnerSolver inner, int threads,
         fictus::NormalDerivative traces = fictus::NormalDerivative::reconstructed, bool default_m = false) {
-  // The paper's m and δ = L/m, or fictus's defaults (s = 8h smooth, 12h non-smooth; δ = 1.5·s).
+  // The paper's m and δ = L/m, or fictus's defaults (s = 8h smooth, 12h non-smooth; δ = 2·s).
   fictus::SolverOptions o = fictus::paper_options(N, variant);
   if (default_m) o.multipliers = 0, o.offset = fictus::SolverOptions{}.offset;
   o.normal_derivative = traces;
@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
         "Krylov tolerance 1e-12; times in seconds, one run each\n\n";
 
   // 0. Trace rules and m rule in one run: the paper's shifted C_γ against the reconstructed traces
-  //    (same m), and the default m (s = 8h or 12h, δ = 1.5s) against the paper's m; median of 3.
+  //    (same m), and the default m (s = 8h or 12h, δ = 2s) against the paper's m; median of 3.
   md << "## Trace rules and m rule (same run, median of 3, " << threads << " threads)\n\n"
      << "| h | variant | traces | m | total |";
   for (const char* p : phase_names) md << ' ' << p << " |";

@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
   std::ostringstream report;
   if (before_after) {
     report << "# Before and after: earlier defaults (shifted C_γ, m ∝ N^0.85, δ = s) vs current (reconstructed "
-              "traces, s = 8h smooth / 12h non-smooth, δ = 1.5s)\n\nRelative errors; contact ends: largest distance of "
+              "traces, s = 8h smooth / 12h non-smooth, δ = 2s)\n\nRelative errors; contact ends: largest distance of "
               "a reference end "
               "to fictus's, in spacings s.\n";
     for (int p = 0; p < 6; ++p)

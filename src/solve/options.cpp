@@ -211,10 +211,11 @@ void formulation_specs(std::vector<OptionSpec>& specs) {
     m.aliases = {"m"};
     specs.push_back(m);
   }
-  specs.push_back(number("formulation", "offset", &SolverOptions::offset, 0.0, false, 100.0, false,
-                         "smooth variant: δ/s, the distance of Γ from γ in units of the point spacing s; 0 = the "
-                         "default rule δ = 1.5·s, made to fit (with a warning) where the box or γ leave Γ less room; "
-                         "Γ needs δ >= 4h"));
+  specs.push_back(
+      number("formulation", "offset", &SolverOptions::offset, 0.0, false, 100.0, false,
+             "smooth variant: δ/s, the distance of Γ from γ in units of the point spacing s; 0 = the "
+             "default rule δ = 2·s on a curve, 1.5·s on a surface, made to fit (with a warning) where the box or γ "
+             "leave Γ less room; Γ needs δ >= 4h"));
   specs.push_back(number("formulation", "rho", &SolverOptions::rho, 0.0, true, 1e12, false,
                          "ρ of the projection max{0, ∂u/∂n − ρ(u − g)}"));
   specs.push_back(choice(std::string("formulation"), std::string("normal_derivative"),

@@ -103,26 +103,27 @@ SpacingPlan plan_spacing(const SpacingInput& in, const SolverOptions& options) {
                  std::max(lower / plan.spacing, 1e-3), upper / plan.spacing));
     return plan;
   }
-  // The default rule, δ = 1.5·s, moved to the nearest δ that fits; the default m follows so that
-  // δ/s stays 1.5 where s >= 2h allows.
-  plan.offset = default_offset;
-  plan.delta = delta_of(default_offset);
+  // The default rule, δ = default_offset·s, moved to the nearest δ that fits; the default m follows so
+  // that δ/s stays the default's where s >= 2h allows.
+  const double standard = default_offset(in.dim);
+  plan.offset = standard;
+  plan.delta = delta_of(standard);
   if (lower <= plan.delta && plan.delta <= upper) return plan;
   const double wanted = plan.delta, wanted_cells = plan.spacing / h;
   plan.delta = std::max(lower, std::min(plan.delta, upper * (1 - 1e-9)));  // inside the room, not on its edge
   if (!given_m && plan.delta < wanted) {
-    plan.m = int(std::clamp<long>(multipliers_for_spacing(in.dim, in.measure, plan.delta / default_offset), plan.m,
+    plan.m = int(std::clamp<long>(multipliers_for_spacing(in.dim, in.measure, plan.delta / standard), plan.m,
                                   std::max<long>(plan.m, most)));
     plan.spacing = multiplier_spacing(in.dim, in.measure, plan.m);
   }
   plan.offset = plan.delta / plan.spacing;
   const int keeps = given_m ? 0 : smallest_fitting_N(in.box_width, N, [&](double k) {
-    const double d = delta_for(in.dim, in.measure, in.default_m(k), default_offset);
+    const double d = delta_for(in.dim, in.measure, in.default_m(k), standard);
     return lowest_delta(options, k) <= d && d <= in.room(k);
   });
   plan.warning =
-      format("formulation.offset: the default Γ (δ = 1.5 s = %.3g h, s = %.3g h) does not fit at N = %.0f; using ",
-             wanted / h, wanted_cells, double(N)) +
+      format("formulation.offset: the default Γ (δ = %.3g s = %.3g h, s = %.3g h) does not fit at N = %.0f; using ",
+             standard, wanted / h, wanted_cells, double(N)) +
       format(
           "δ = %.3g h and m = %.0f (s = %.3g h): nearer and finer than the default rule, less accurate "
           "(docs/math.md, \"Rules for m and δ\")",

@@ -48,12 +48,12 @@ TEST(SpacingRule, TheDefaultRuleWhereItFits) {
   const SpacingInput in = circle(0.3, 256);
   const SpacingPlan plan = fictus::plan_spacing(in, SolverOptions{});
   EXPECT_EQ(plan.m, in.default_m(in.h));
-  EXPECT_DOUBLE_EQ(plan.offset, 1.5);
-  EXPECT_DOUBLE_EQ(plan.delta, 1.5 * in.measure / plan.m);
+  EXPECT_DOUBLE_EQ(plan.offset, 2.0);  // on a curve (1.5 on a surface)
+  EXPECT_DOUBLE_EQ(plan.delta, 2.0 * in.measure / plan.m);
   EXPECT_EQ(plan.warning, "");
 }
 
-// A circle of radius 0.3 at N = 64 (the default δ of 12h leaves the box's margin) and a sphere
+// A circle of radius 0.3 at N = 64 (the default δ of 16h leaves the box's margin) and a sphere
 // of radius 0.3 at N = 32 … 56: the default rule shrinks to fit, with a warning naming the N from
 // which it fits unchanged; at that N it does, one below it does not.
 TEST(SpacingRule, CoarseGridsRunWithTheNearestFittingOffset) {
@@ -66,8 +66,9 @@ TEST(SpacingRule, CoarseGridsRunWithTheNearestFittingOffset) {
     EXPECT_LE(plan.delta, in.room(in.h) * (1 + 1e-12));
     EXPECT_GE(plan.delta, 4 * in.h);
     EXPECT_GE(plan.spacing, 2 * in.h * (1 - 1e-12));
-    EXPECT_GT(plan.m, in.default_m(in.h));     // the points move closer
-    EXPECT_NEAR(plan.offset, 1.5, 1.5 * 0.1);  // δ/s stays near the default's
+    EXPECT_GT(plan.m, in.default_m(in.h));                   // the points move closer
+    const double standard = fictus::default_offset(in.dim);  // 2 on a curve, 1.5 on a surface
+    EXPECT_NEAR(plan.offset, standard, standard * 0.1);      // δ/s stays near the default's
     EXPECT_DOUBLE_EQ(plan.offset * plan.spacing, plan.delta);
     const int keeps = number_after(plan.warning, "N >=");
     ASSERT_GT(keeps, N) << plan.warning;

@@ -5,11 +5,12 @@
 // normal. The rules:
 //   m  formulation.multipliers, or the default rule's m (a few cells per spacing; the caller's);
 //      8 <= m and s >= 2h;
-//   δ  formulation.offset·s when the offset is given; the default rule δ = 1.5·s otherwise.
+//   δ  formulation.offset·s when the offset is given; the default rule δ = 2·s on a curve and
+//      δ = 1.5·s on a surface otherwise (default_offset).
 //      Γ needs 4h <= δ (reconstructed traces: the C_γ stencil reaches 2.1h from γ, the cells cut
 //      by Γ 1.4h from Γ) and δ <= room(h) (Γ keeps 2h from ∂Ω and does not fold).
 // On a coarse grid the default rule may not fit: then δ is the nearest value that does, and with
-// the default m the points move closer (m grows, s = δ/1.5, down to s = 2h), with a warning. A
+// the default m the points move closer (m grows, s = δ/default_offset, down to s = 2h), with a warning. A
 // given offset that does not fit, or a grid where nothing fits, is refused with the offsets or the
 // N that would fit, before any grid work.
 #include <functional>
@@ -19,8 +20,12 @@
 
 namespace fictus {
 
-/// The default rule's δ/s.
-inline constexpr double default_offset = 1.5;
+/// The default rule's δ/s. The piecewise-constant controls on Γ leave a ripple whose error in û is
+/// about s·e^{−2πδ/s} (first order, docs/math.md "Rules for m and δ"): on a curve, at the N that 2-D
+/// solves reach (4096 and beyond), δ = 1.5·s let it overtake the second-order error, and δ = 2·s keeps
+/// it below; on a surface, at the N that 3-D solves reach, it stays below the other errors with δ = 1.5·s,
+/// and the larger δ would leave Γ no room on more coarse grids.
+constexpr double default_offset(int dim) { return dim == 2 ? 2.0 : 1.5; }
 
 /// The largest δ for which Γ keeps 2h from ∂Ω and does not fold, at grid spacing h (+∞ when nothing
 /// limits it; below 0 when γ itself is within 2h of ∂Ω).
