@@ -78,22 +78,23 @@ TEST_P(References, ConvergeToTheFittedMeshSolution) {
 INSTANTIATE_TEST_SUITE_P(
     Problems, References,
     ::testing::Values(
-        // The ellipse, smooth: with the contact fit the errors are lower at every N (5.6e-6, 1.3e-6,
-        // 3.6e-7, 1.5e-7 against 8.5e-6, 2.2e-6, 5.3e-7, 1.7e-7 without), but the finest is on the high
-        // side of its scatter (error·N² 0.37, 0.34, 0.38, 0.63), so the rate over these four is 1.75; over
-        // N = 256 … 3072 in 7 steps it is 1.88 (bench/results/2026-11-29-contact-fit.md).
-        ReferenceCase{.name = "ellipse", .variant = fictus::Variant::smooth, .smooth_rate = 1.7},
-        ReferenceCase{"star", fictus::Variant::smooth}, ReferenceCase{"peanut", fictus::Variant::smooth},
+        // The smooth variant over N = 512 … 4096, where the ripple of the controls overtook the
+        // second-order error with Γ at δ = 1.5·s (orders 1.53 on the ellipse and 1.41 on the peanut);
+        // with δ = 2·s, measured 1.87, 2.23 and 2.14 (bench/results/2026-12-06-offset-2d.md).
+        ReferenceCase{.name = "ellipse", .variant = fictus::Variant::smooth, .coarsest = 512},
+        ReferenceCase{.name = "star", .variant = fictus::Variant::smooth, .coarsest = 512},
+        ReferenceCase{.name = "peanut", .variant = fictus::Variant::smooth, .coarsest = 512},
         ReferenceCase{"ellipse", fictus::Variant::nonsmooth}, ReferenceCase{"star", fictus::Variant::nonsmooth},
         ReferenceCase{"peanut", fictus::Variant::nonsmooth},
         // Every contact end where γ's curvature is 10–16 (the tips of a
         // thin ellipse), N = 512 … 4096. Measured: the smooth variant
-        // converges at 2.2 with the contact fit (1.1e-6, 2.5e-7, 4.7e-8,
-        // 1.2e-8; without it 9.4e-7, 1.3e-7, 1.8e-7, 2.4e-8, rate 1.53:
-        // the error swung with where the ends fell between the points,
-        // TipsContactFit below); the non-smooth variant misses the free
-        // zone at one tip (2.9 spacings long) at N = 512 and has an end
-        // 1.2 s off at 1024 (0.70 s once located inside the arcs).
+        // converges at 2.37 with the contact fit and Γ at δ = 2s (7.1e-7,
+        // 1.3e-7, 3.5e-8, 4.7e-9; without the fit, δ = 1.5s: 9.4e-7,
+        // 1.3e-7, 1.8e-7, 2.4e-8, rate 1.53: the error swung with where
+        // the ends fell between the points, TipsContactFit below); the
+        // non-smooth variant misses the free zone at one tip (2.9 spacings
+        // long) at N = 512 and has an end 1.2 s off at 1024 (0.70 s once
+        // located inside the arcs).
         ReferenceCase{.name = "tips", .variant = fictus::Variant::smooth, .coarsest = 512},
         ReferenceCase{.name = "tips", .variant = fictus::Variant::nonsmooth, .coarsest = 512, .ends_from = 2048}),
     [](const auto& info) { return info.param.name + "_" + fictus::to_string(info.param.variant); });
@@ -101,10 +102,11 @@ INSTANTIATE_TEST_SUITE_P(
 // The contact fit (solver.fit_contact, docs/math.md "Fitting the points to the contact set") on the thin
 // ellipse whose four contact ends lie where γ bends hard, smooth variant, N = 1024 … 1536 in steps of 128.
 // Without the fit the active set is whole points, the solve puts each end on a border between two arcs,
-// and the error swings with where the true ends fall between the points: error·N² varies 3.8× over these
-// five grids (measured 0.13 … 0.51). With the default two passes the arcs end just inside the located
-// ends (s/20): error·N² within 1.25× (measured 0.115 … 0.141; 0.23 … 0.27 with the arcs ending at the
-// ends themselves), every end within 0.05 s of the reference's (measured 0.021 s; without: up to 0.15 s),
+// and the error swings with where the true ends fall between the points: error·N² varies 3.1× over these
+// five grids (measured 0.21 … 0.66; 0.13 … 0.51, 3.8×, with Γ at δ = 1.5s). With the default two passes the arcs end
+// just inside the located ends (s/20): error·N² within 1.5× (measured 0.117 … 0.161 with Γ at δ = 2s, 0.115 … 0.141
+// at 1.5s; 0.23 … 0.27 with the arcs ending at the ends themselves), every end within 0.05 s of the reference's
+// (measured 0.025 s; without: up to 0.15 s),
 // the second pass moving them by under 0.05 s, each fitted solve one or two Newton steps.
 TEST(ReferencesContactFit, TipsErrorsNoLongerSwingWithTheEnds) {
   const std::string dir = std::string(FICTUS_SOURCE_DIR) + "/tests/references/";
@@ -151,7 +153,7 @@ TEST(ReferencesContactFit, TipsErrorsNoLongerSwingWithTheEnds) {
   for (double v : scaled[1]) std::cout << ' ' << v;
   std::cout << "; ends within " << worst_end << " s\n";
   EXPECT_GT(spread(scaled[0]), 3.0);  // what the fit removes (the test can see it)
-  EXPECT_LT(spread(scaled[1]), 1.4);
+  EXPECT_LT(spread(scaled[1]), 1.5);
   EXPECT_LT(worst_end, 0.05);
   for (std::size_t k = 0; k < scaled[1].size(); ++k) EXPECT_LT(scaled[1][k], 0.2);
 }
