@@ -8,6 +8,10 @@
 //        fictus_bench_contact_fit REFERENCE shifted N...: the smooth variant's error with the contact set
 //        fixed to the reference's intervals with each end moved along γ by δ spacings s = L/m (δ > 0: the
 //        contact set grows), for δ = −0.5 … 0.1: how much an error of the located ends costs.
+//        fictus_bench_contact_fit REFERENCE quadrature N_FINE N...: each N's error against the reference
+//        and against fictus's own solve at N_FINE, on the reference's rule and on one 64 times finer.
+//        Trials: OFFSET=x (solver.offset), FIT=k (fit_contact), VARIANT=nonsmooth set those options in the
+//        smooth/quadrature modes' solves.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
