@@ -10,13 +10,14 @@
 //        contact set grows), for δ = −0.5 … 0.1: how much an error of the located ends costs.
 //        fictus_bench_contact_fit REFERENCE quadrature N_FINE N...: each N's error against the reference
 //        and against fictus's own solve at N_FINE, on the reference's rule and on one 64 times finer.
-//        Trials: OFFSET=x (solver.offset), FIT=k (fit_contact), VARIANT=nonsmooth set those options in the
-//        smooth/quadrature modes' solves.
+//        Trials: OFFSET=x sets formulation.offset in every mode's solves; in the quadrature mode also
+//        FIT=k (solver.fit_contact) and VARIANT=smooth|nonsmooth. The settings in effect head the output.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -27,12 +28,39 @@
 
 namespace {
 
-/// Options from the environment, for trials: FIT (passes), OFFSET (δ/s), VARIANT=nonsmooth.
+/// A trial's setting from the environment variable `name`, if set: a number, or the run stops.
+std::optional<double> trial_setting(const char* name) {
+  const char* text = std::getenv(name);
+  if (!text) return std::nullopt;
+  char* end = nullptr;
+  const double value = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !std::isfinite(value))
+    throw std::invalid_argument(std::string(name) + ": not a number: '" + text + "'");
+  return value;
+}
+
+/// formulation.offset from OFFSET (every mode).
+void offset_override(fictus::SolverOptions& o) {
+  if (const auto offset = trial_setting("OFFSET")) o.offset = *offset;
+}
+
+/// The quadrature mode's trials: OFFSET, FIT (solver.fit_contact), VARIANT = smooth or nonsmooth.
 void overrides(fictus::SolverOptions& o) {
-  if (const char* e = std::getenv("FIT")) o.fit_contact = std::atoi(e);
-  if (const char* e = std::getenv("OFFSET")) o.offset = std::atof(e);
-  if (const char* e = std::getenv("VARIANT"); e && std::string(e) == "nonsmooth")
-    o.variant = fictus::Variant::nonsmooth;
+  offset_override(o);
+  if (const auto passes = trial_setting("FIT")) o.fit_contact = int(*passes);
+  if (const char* e = std::getenv("VARIANT")) {
+    if (std::string(e) != "smooth" && std::string(e) != "nonsmooth")
+      throw std::invalid_argument("VARIANT: smooth or nonsmooth, not '" + std::string(e) + "'");
+    o.variant = std::string(e) == "nonsmooth" ? fictus::Variant::nonsmooth : fictus::Variant::smooth;
+  }
+}
+
+/// A line naming the trial settings in effect, if any.
+void print_trials() {
+  std::string in_effect;
+  for (const char* name : {"OFFSET", "FIT", "VARIANT"})
+    if (const char* e = std::getenv(name)) in_effect += std::string(" ") + name + "=" + e;
+  if (!in_effect.empty()) std::printf("trial settings:%s\n\n", in_effect.c_str());
 }
 
 /// The polar angle of x about c, in [0, 2π).
@@ -108,6 +136,7 @@ void shifted(const reference::Reference& ref, const std::string& file, const std
     spec.options.error_estimate = false;
     spec.options.threads = 2;
     spec.options.fit_contact = 0;
+    offset_override(spec.options);
     const fictus::Solution plain = fictus::solve(spec.problem, spec.options);
     const double spacing = plain.collocation.length / plain.collocation.m;
     std::printf("| %d | %d |", N, plain.collocation.m);
@@ -119,25 +148,6 @@ void shifted(const reference::Reference& ref, const std::string& file, const std
     }
     std::printf("\n");
   }
-}
-
-/// ‖a − b‖ over ω by a polar rule about the reference's centre (its own rule has n_θ = 128, n_ρ = 16): n_θ
-/// angles at the midpoints, n_ρ Gauss points in ρ ∈ (0, 1), weights (2π/n_θ)·w_k·ρ_k·r_b(θ_j)².
-/// `difference(x, n)` is a − b at x, the rule's n-th point.
-template <class Difference>
-double polar_l2(const reference::Reference& r, int n_theta, int n_rho, Difference&& difference) {
-  const fictus::GaussRule& rule = fictus::gauss_legendre(n_rho);
-  double sum = 0;
-  for (int j = 0; j < n_theta; ++j) {
-    const double theta = reference::two_pi * (j + 0.5) / n_theta, rb = r.radius(theta);
-    for (int k = 0; k < n_rho; ++k) {
-      const double rho = rule.nodes[std::size_t(k)];
-      const double w = reference::two_pi / n_theta * rule.weights[std::size_t(k)] * rho * rb * rb;
-      const fictus::Point2 x = r.center + rho * rb * fictus::Point2{std::cos(theta), std::sin(theta)};
-      sum += w * std::pow(difference(x, std::size_t(j) * std::size_t(n_rho) + std::size_t(k)), 2);
-    }
-  }
-  return std::sqrt(sum);
 }
 
 /// The quadrature mode: each N's relative L²(ω) error three ways, against the reference on its own rule,
@@ -166,10 +176,16 @@ void quadrature(const reference::Reference& ref, const std::string& file, int fi
   std::printf("|---|---|---|---|\n");
   for (int N : Ns) {
     const fictus::Solution s = solve_at(N);
-    const auto difference = [&](const fictus::Point2& x, std::size_t) { return at(s, x) - at(fine, x); };
+    const auto difference = [&](int n_theta, int n_rho) {  // ‖û_N − û_fine‖ on that polar rule
+      double sum = 0;
+      reference::for_each_polar_point(ref, n_theta, n_rho, [&](const fictus::Point2& x, double w, std::size_t) {
+        sum += w * std::pow(at(s, x) - at(fine, x), 2);
+      });
+      return std::sqrt(sum);
+    };
     std::printf("| %d | %.2e | %.2e | %.2e |\n", N, reference::compare(ref, s).level.l2_omega,
-                polar_l2(ref, ref.n_theta, ref.n_rho, difference) / ref.l2_omega,
-                polar_l2(ref, 16 * ref.n_theta, 4 * ref.n_rho, difference) / ref.l2_omega);
+                difference(ref.n_theta, ref.n_rho) / ref.l2_omega,
+                difference(16 * ref.n_theta, 4 * ref.n_rho) / ref.l2_omega);
     std::fflush(stdout);
   }
 }
@@ -184,17 +200,17 @@ double fitted_rate(const std::vector<int>& N, const std::vector<double>& e) {
   return (n * sxy - sx * sy) / (n * sxx - sx * sx);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr, "usage: %s REFERENCE smooth|nonsmooth N...\n", argv[0]);
+    std::fprintf(stderr, "usage: %s REFERENCE smooth|nonsmooth|shifted N... | REFERENCE quadrature N_FINE N...\n",
+                 argv[0]);
     return 1;
   }
   const std::string dir = std::string(FICTUS_SOURCE_DIR) + "/tests/references/", name = argv[1];
   const fictus::Variant variant =
       std::string(argv[2]) == "nonsmooth" ? fictus::Variant::nonsmooth : fictus::Variant::smooth;
   const reference::Reference ref = reference::load(dir, name);
+  print_trials();
   if (std::string(argv[2]) == "shifted") {
     std::vector<int> Ns;
     for (int a = 3; a < argc; ++a) Ns.push_back(std::stoi(argv[a]));
@@ -220,7 +236,7 @@ int main(int argc, char** argv) {
     spec.options.condition_number = false;
     spec.options.error_estimate = false;
     spec.options.threads = 2;
-    if (const char* e = std::getenv("OFFSET")) spec.options.offset = std::atof(e);
+    offset_override(spec.options);
     Ns.push_back(N);
     std::string ends, seconds;
     int m = 0;
@@ -273,4 +289,16 @@ int main(int argc, char** argv) {
     }
     return hi / lo;
   });
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {  // a bad trial setting, a missing reference file, a refused problem
+    std::fprintf(stderr, "%s: %s\n", argv[0], e.what());
+    return 1;
+  }
 }

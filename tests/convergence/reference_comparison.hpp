@@ -61,6 +61,23 @@ inline fictus::Point2 boundary_point(const Reference& r, double theta) {
   return r.center + r.radius(theta) * fictus::Point2{std::cos(theta), std::sin(theta)};
 }
 
+/// The polar rule about r's centre over ω: n_θ angles at the midpoints, n_ρ Gauss points in ρ ∈ (0, 1),
+/// weights (2π/n_θ)·w_k·ρ_k·r_b(θ_j)²; calls visit(x, weight, n) at the n-th point (n = j·n_ρ + k). The
+/// reference's samples lie at its own rule's points (n_θ = r.n_theta, n_ρ = r.n_rho).
+template <class Visit>
+void for_each_polar_point(const Reference& r, int n_theta, int n_rho, Visit&& visit) {
+  const fictus::GaussRule& rule = fictus::gauss_legendre(n_rho);
+  for (int j = 0; j < n_theta; ++j) {
+    const double theta = two_pi * (j + 0.5) / n_theta, rb = r.radius(theta);
+    for (int k = 0; k < n_rho; ++k) {
+      const double rho = rule.nodes[std::size_t(k)];
+      const double w = two_pi / n_theta * rule.weights[std::size_t(k)] * rho * rb * rb;
+      visit(r.center + rho * rb * fictus::Point2{std::cos(theta), std::sin(theta)}, w,
+            std::size_t(j) * std::size_t(n_rho) + std::size_t(k));
+    }
+  }
+}
+
 struct Comparison {
   fictus::LevelResult level;               // relative errors against the reference
   double end_error_spacings = 0;           // largest distance of a reference contact end to fictus's, in s = L/m
@@ -69,20 +86,13 @@ struct Comparison {
 
 inline Comparison compare(const Reference& r, const fictus::Solution& s) {
   const fictus::Grid2& grid = s.grid;
-  // ω: the reference's rule, weights (2π/n_θ)·w_k·ρ_k·r_b(θ_j)².
-  const fictus::GaussRule& rule = fictus::gauss_legendre(r.n_rho);
+  // ω: the reference's rule.
   double e0 = 0, e1 = 0;
-  for (int j = 0; j < r.n_theta; ++j) {
-    const double theta = two_pi * (j + 0.5) / r.n_theta, rb = r.radius(theta);
-    for (int k = 0; k < r.n_rho; ++k) {
-      const double rho = rule.nodes[k], w = two_pi / r.n_theta * rule.weights[k] * rho * rb * rb;
-      const fictus::Point2 x = r.center + rho * rb * fictus::Point2{std::cos(theta), std::sin(theta)};
-      const auto q = fictus::sample_q1(grid, s.u, grid.cell_x(x.x), grid.cell_y(x.y), x.x, x.y);
-      const std::size_t n = std::size_t(j) * r.n_rho + k;
-      e0 += w * std::pow(q.value - r.u[n], 2);
-      e1 += w * (std::pow(q.gradient.x - r.ux[n], 2) + std::pow(q.gradient.y - r.uy[n], 2));
-    }
-  }
+  for_each_polar_point(r, r.n_theta, r.n_rho, [&](const fictus::Point2& x, double w, std::size_t n) {
+    const auto q = fictus::sample_q1(grid, s.u, grid.cell_x(x.x), grid.cell_y(x.y), x.x, x.y);
+    e0 += w * std::pow(q.value - r.u[n], 2);
+    e1 += w * (std::pow(q.gradient.x - r.ux[n], 2) + std::pow(q.gradient.y - r.uy[n], 2));
+  });
   // γ: trapezoid in θ with ds = √(r_b² + r_b′²) dθ.
   const int n = int(r.trace_u.size());
   double eg = 0;

@@ -43,6 +43,7 @@ TEST_P(References, ConvergeToTheFittedMeshSolution) {
     spec.problem.N = N;
     spec.options.variant = c.variant;
     spec.options.condition_number = false;
+    spec.options.error_estimate = false;  // not looked at here
     spec.options.threads = 2;
     const fictus::Solution s = fictus::solve(spec.problem, spec.options);
     ASSERT_TRUE(s.newton.converged) << "N = " << N << ": " << s.newton.failure;
@@ -152,7 +153,7 @@ TEST(ReferencesContactFit, TipsErrorsNoLongerSwingWithTheEnds) {
   std::cout << "; with it:";
   for (double v : scaled[1]) std::cout << ' ' << v;
   std::cout << "; ends within " << worst_end << " s\n";
-  EXPECT_GT(spread(scaled[0]), 3.0);  // what the fit removes (the test can see it)
+  EXPECT_GT(spread(scaled[0]), 2.5);  // what the fit removes (the test can see it): measured 3.1
   EXPECT_LT(spread(scaled[1]), 1.5);
   EXPECT_LT(worst_end, 0.05);
   for (std::size_t k = 0; k < scaled[1].size(); ++k) EXPECT_LT(scaled[1][k], 0.2);

@@ -48,9 +48,14 @@ TEST(SpacingRule, TheDefaultRuleWhereItFits) {
   const SpacingInput in = circle(0.3, 256);
   const SpacingPlan plan = fictus::plan_spacing(in, SolverOptions{});
   EXPECT_EQ(plan.m, in.default_m(in.h));
-  EXPECT_DOUBLE_EQ(plan.offset, 2.0);  // on a curve (1.5 on a surface)
+  EXPECT_DOUBLE_EQ(plan.offset, 2.0);  // on a curve
   EXPECT_DOUBLE_EQ(plan.delta, 2.0 * in.measure / plan.m);
   EXPECT_EQ(plan.warning, "");
+  const SpacingInput surface = sphere(0.3, 256);
+  const SpacingPlan on_surface = fictus::plan_spacing(surface, SolverOptions{});
+  EXPECT_DOUBLE_EQ(on_surface.offset, 1.5);  // on a surface
+  EXPECT_DOUBLE_EQ(on_surface.delta, 1.5 * on_surface.spacing);
+  EXPECT_EQ(on_surface.warning, "");
 }
 
 // A circle of radius 0.3 at N = 64 (the default δ of 16h leaves the box's margin) and a sphere
@@ -62,7 +67,10 @@ TEST(SpacingRule, CoarseGridsRunWithTheNearestFittingOffset) {
     const SpacingInput in = make(0.3, N);
     const SpacingPlan plan = fictus::plan_spacing(in, SolverOptions{});
     ASSERT_NE(plan.warning, "") << "N = " << N;
-    EXPECT_NE(plan.warning.find("formulation.offset: the default Γ"), std::string::npos) << plan.warning;
+    EXPECT_NE(plan.warning.find(in.dim == 2 ? "formulation.offset: the default Γ (δ = 2 s = "
+                                            : "formulation.offset: the default Γ (δ = 1.5 s = "),
+              std::string::npos)
+        << plan.warning;
     EXPECT_LE(plan.delta, in.room(in.h) * (1 + 1e-12));
     EXPECT_GE(plan.delta, 4 * in.h);
     EXPECT_GE(plan.spacing, 2 * in.h * (1 - 1e-12));

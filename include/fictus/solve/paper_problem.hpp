@@ -27,7 +27,7 @@ std::optional<PaperRow> paper_row(Variant variant, int N);
 /// The paper's m for N = 128 … 4096, otherwise its growth extrapolated: m = 34·(N/128)^0.85.
 int paper_multipliers(int N);
 /// Options for the paper's experiment: the paper's m, and at the paper's grids (h = 1/128 … 1/4096) Γ
-/// one spacing outside γ (δ = L/m; the default 1.5 spacings would put Γ within 2h of ∂Ω at h = 1/128);
+/// one spacing outside γ (δ = L/m; the default 2 spacings would put Γ within 2h of ∂Ω at h = 1/128);
 /// at other grids the default rule for δ, which fits itself to the room (spacing_rule.hpp).
 SolverOptions paper_options(int N, Variant variant);
 /// The paper's rates (last row of each table): L²(ω), H¹(ω), L²(γ).
