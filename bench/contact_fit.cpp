@@ -55,6 +55,19 @@ void overrides(fictus::SolverOptions& o) {
   }
 }
 
+/// The problem file at grid N as the bench solves it: the variant given, no condition number and no
+/// estimate, 2 threads, the offset of a trial (OFFSET).
+fictus::ProblemSpec bench_spec(const std::string& file, int N, fictus::Variant variant) {
+  fictus::ProblemSpec spec = fictus::read_problem_file(file);
+  spec.problem.N = N;
+  spec.options.variant = variant;
+  spec.options.condition_number = false;
+  spec.options.error_estimate = false;
+  spec.options.threads = 2;
+  offset_override(spec.options);
+  return spec;
+}
+
 /// A line naming the trial settings in effect, if any.
 void print_trials() {
   std::string in_effect;
@@ -129,14 +142,8 @@ void shifted(const reference::Reference& ref, const std::string& file, const std
   for (std::size_t k = 0; k < shifts.size(); ++k) std::printf("---|");
   std::printf("\n");
   for (int N : Ns) {
-    fictus::ProblemSpec spec = fictus::read_problem_file(file);
-    spec.problem.N = N;
-    spec.options.variant = fictus::Variant::smooth;
-    spec.options.condition_number = false;
-    spec.options.error_estimate = false;
-    spec.options.threads = 2;
+    fictus::ProblemSpec spec = bench_spec(file, N, fictus::Variant::smooth);
     spec.options.fit_contact = 0;
-    offset_override(spec.options);
     const fictus::Solution plain = fictus::solve(spec.problem, spec.options);
     const double spacing = plain.collocation.length / plain.collocation.m;
     std::printf("| %d | %d |", N, plain.collocation.m);
@@ -156,12 +163,7 @@ void shifted(const reference::Reference& ref, const std::string& file, const std
 /// the first two swing together from one N to the next and the third does not.
 void quadrature(const reference::Reference& ref, const std::string& file, int fine_N, const std::vector<int>& Ns) {
   const auto solve_at = [&file](int N) {
-    fictus::ProblemSpec spec = fictus::read_problem_file(file);
-    spec.problem.N = N;
-    spec.options.variant = fictus::Variant::smooth;
-    spec.options.condition_number = false;
-    spec.options.error_estimate = false;
-    spec.options.threads = 2;
+    fictus::ProblemSpec spec = bench_spec(file, N, fictus::Variant::smooth);
     overrides(spec.options);
     return fictus::solve(spec.problem, spec.options);
   };
@@ -230,13 +232,7 @@ int run(int argc, char** argv) {
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
   for (int a = 3; a < argc; ++a) {
     const int N = std::stoi(argv[a]);
-    fictus::ProblemSpec spec = fictus::read_problem_file(dir + name + ".toml");
-    spec.problem.N = N;
-    spec.options.variant = variant;
-    spec.options.condition_number = false;
-    spec.options.error_estimate = false;
-    spec.options.threads = 2;
-    offset_override(spec.options);
+    const fictus::ProblemSpec spec = bench_spec(dir + name + ".toml", N, variant);
     Ns.push_back(N);
     std::string ends, seconds;
     int m = 0;
