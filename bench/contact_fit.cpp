@@ -213,6 +213,8 @@ int run(int argc, char** argv) {
       std::string(argv[2]) == "nonsmooth" ? fictus::Variant::nonsmooth : fictus::Variant::smooth;
   const reference::Reference ref = reference::load(dir, name);
   print_trials();
+  if (std::string(argv[2]) != "quadrature" && (std::getenv("FIT") || std::getenv("VARIANT")))
+    throw std::invalid_argument("FIT and VARIANT apply to the quadrature mode only");
   if (std::string(argv[2]) == "shifted") {
     std::vector<int> Ns;
     for (int a = 3; a < argc; ++a) Ns.push_back(std::stoi(argv[a]));

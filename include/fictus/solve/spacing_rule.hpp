@@ -20,11 +20,11 @@
 
 namespace fictus {
 
-/// The default rule's δ/s. The piecewise-constant controls on Γ leave a ripple whose error in û is
-/// about s·e^{−2πδ/s} (first order, docs/math.md "Rules for m and δ"): on a curve, at the N that 2-D
-/// solves reach (4096 and beyond), δ = 1.5·s let it overtake the second-order error, and δ = 2·s keeps
-/// it below; on a surface, at the N that 3-D solves reach, it stays below the other errors with δ = 1.5·s,
-/// and the larger δ would leave Γ no room on more coarse grids.
+/// The default rule's δ/s. The piecewise-constant controls on Γ leave a ripple of relative size about
+/// e^{−2πδ/s}, whose error in û falls more slowly with N than the second-order one (docs/math.md "Rules
+/// for m and δ"): on a curve, from N ≈ 2048 on, δ = 1.5·s let it overtake the second-order error and
+/// δ = 2·s keeps it below; on a surface, at N = 96 and 128 on the references, δ = 2·s moved the
+/// quantities both ways, and it would leave Γ no room on more coarse grids, so surfaces keep 1.5·s.
 constexpr double default_offset(int dim) { return dim == 2 ? 2.0 : 1.5; }
 
 /// The largest δ for which Γ keeps 2h from ∂Ω and does not fold, at grid spacing h (+∞ when nothing
