@@ -76,28 +76,13 @@ void print_trials() {
   if (!in_effect.empty()) std::printf("trial settings:%s\n\n", in_effect.c_str());
 }
 
-/// The polar angle of x about c, in [0, 2π).
-double angle_about(const fictus::Point2& c, const fictus::Point2& x) {
-  const double t = std::atan2(x.y - c.y, x.x - c.x);
-  return t < 0 ? t + reference::two_pi : t;
-}
-
-/// Whether θ lies in one of the reference's contact intervals [ends[2k], ends[2k+1]] (cyclic).
-bool in_reference_contact(const std::vector<double>& ends, double theta) {
-  for (std::size_t k = 0; k + 1 < ends.size(); k += 2) {
-    const double a = ends[k], b = ends[k + 1];
-    if (a < b ? (theta >= a && theta < b) : (theta >= a || theta < b)) return true;
-  }
-  return false;
-}
-
 /// The reference's contact intervals (polar angles about `centre`, [ends[2k], ends[2k+1]] in contact) with
 /// each end moved along γ by `shift` in arc length, outwards (the contact set grows) for shift > 0.
 std::vector<double> shifted_ends(const std::vector<double>& ends, const fictus::Point2& centre,
                                  const fictus::Curve& curve, double shift) {
   const fictus::ArcLengthTable table(curve);
   const double L = table.length(), pi = std::numbers::pi;
-  const auto angle_at = [&](double t) { return angle_about(centre, curve.position(t)); };
+  const auto angle_at = [&](double t) { return reference::angle_about(centre, curve.position(t)); };
   const auto off = [pi](double a, double b) { return std::remainder(a - b, 2 * pi); };  // a − b in (−π, π]
   constexpr int samples = 20000;
   std::vector<double> moved;
@@ -124,10 +109,10 @@ fictus::Problem fixed_contact(const fictus::Problem& problem, const fictus::Poin
   fictus::Problem fixed = problem;
   const auto g = problem.g_along_curve;
   fixed.conditions.dirichlet = [=](const fictus::Point2& x) {
-    return in_reference_contact(ends, angle_about(centre, x)) ? 1.0 : 0.0;
+    return reference::in_contact(ends, reference::angle_about(centre, x)) ? 1.0 : 0.0;
   };
   fixed.conditions.neumann = [=](const fictus::Point2& x) {
-    return in_reference_contact(ends, angle_about(centre, x)) ? 0.0 : 1.0;
+    return reference::in_contact(ends, reference::angle_about(centre, x)) ? 0.0 : 1.0;
   };
   fixed.conditions.u = [g](const fictus::Point2& x) { return g(x.x, x.y, 0.0); };
   return fixed;

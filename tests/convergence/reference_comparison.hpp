@@ -78,6 +78,34 @@ void for_each_polar_point(const Reference& r, int n_theta, int n_rho, Visit&& vi
   }
 }
 
+/// The polar angle of x about c, in [0, 2π).
+inline double angle_about(const fictus::Point2& c, const fictus::Point2& x) {
+  const double t = std::atan2(x.y - c.y, x.x - c.x);
+  return t < 0 ? t + two_pi : t;
+}
+
+/// Whether θ lies in one of the contact intervals [ends[2k], ends[2k+1]] (cyclic; the reference's own ends
+/// or moved ones).
+inline bool in_contact(const std::vector<double>& ends, double theta) {
+  for (std::size_t k = 0; k + 1 < ends.size(); k += 2) {
+    const double a = ends[k], b = ends[k + 1];
+    if (a < b ? (theta >= a && theta < b) : (theta >= a || theta < b)) return true;
+  }
+  return false;
+}
+
+/// The reference's contact measure on `curve` (γ as fictus parametrizes it): the length of the parts of γ
+/// whose polar angle about r's centre lies in its contact intervals, by the midpoint rule over `samples`
+/// pieces in the curve's parameter (exact to about the length of one piece at each end).
+inline double contact_length(const Reference& r, const fictus::Curve& curve, int samples = 1 << 20) {
+  double length = 0;
+  for (int i = 0; i < samples; ++i) {
+    const double t = two_pi * (i + 0.5) / samples;
+    if (in_contact(r.ends, angle_about(r.center, curve.position(t)))) length += two_pi / samples * curve.speed(t);
+  }
+  return length;
+}
+
 struct Comparison {
   fictus::LevelResult level;               // relative errors against the reference
   double end_error_spacings = 0;           // largest distance of a reference contact end to fictus's, in s = L/m

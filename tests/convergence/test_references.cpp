@@ -465,4 +465,28 @@ TEST(References3d, MixedEllipsoidConvergesToTheFittedMeshSolution) {
   }
 }
 
+// The error estimate of û (from the same problem solved at N/2, docs/math.md "The error estimate") against
+// the true error on every 2-D reference, smooth variant, N = 2048: within a factor 3 (measured
+// estimated/true 0.63 ellipse, 1.97 peanut, 0.69 star, 1.11 tips). Over all references, both variants and
+// N = 256 … 2048, and for the other quantities: bench/results/2026-12-06-estimate-quality.md.
+TEST(ReferencesEstimate, EstimateOfUWithinAFactorThree) {
+  const std::string folder = std::string(FICTUS_SOURCE_DIR) + "/tests/references";
+  for (const char* name : {"ellipse", "peanut", "star", "tips"}) {
+    const reference::Reference reference = reference::load(folder, name);
+    fictus::ProblemSpec spec = fictus::read_problem_file(folder + "/" + name + ".toml");
+    spec.problem.N = 2048;
+    spec.options.variant = fictus::Variant::smooth;
+    spec.options.condition_number = false;
+    spec.options.threads = 2;
+    const fictus::Solution s = fictus::solve(spec.problem, spec.options);
+    ASSERT_TRUE(s.newton.converged) << name;
+    ASSERT_TRUE(s.estimate && s.estimate->skipped.empty()) << name;
+    EXPECT_EQ(s.estimate->N, 1024) << name;
+    const double ratio = s.estimate->rel_l2_omega / reference::compare(reference, s).level.l2_omega;
+    std::cout << name << ": estimated/true relative L2(omega) error of u " << ratio << '\n';
+    EXPECT_GT(ratio, 1.0 / 3) << name;
+    EXPECT_LT(ratio, 3.0) << name;
+  }
+}
+
 }  // namespace
