@@ -180,6 +180,18 @@ const CurveGridIntersection::CutRules& CurveGridIntersection::cut_rules(int iy, 
   return *slot;
 }
 
+bool CurveGridIntersection::inside_uncut_cell(int ix, int iy, int corners_inside) const {
+  // γ does not enter the cell, so its corners and edges are all on one side, except where γ touches
+  // them: a corner on γ is counted with the side to its left along the row, whatever ω's side is (a
+  // curve through a grid node with its tangent along the grid line leaves a whole cell beside the
+  // node with three corners inside). With the corners split, the edges' midpoints decide with them.
+  if (corners_inside == 4 || corners_inside == 0) return corners_inside == 4;
+  const double xm = grid_.x(ix) + 0.5 * grid_.h(), ym = grid_.y(iy) + 0.5 * grid_.h();
+  const int midpoints_inside =
+      int(inside_on_row(iy, xm)) + inside_on_row(iy + 1, xm) + inside_on_column(ix, ym) + inside_on_column(ix + 1, ym);
+  return corners_inside + midpoints_inside >= 5;
+}
+
 void CurveGridIntersection::row_rule(int iy, int q, std::vector<CellQuadraturePoint>& out) const {
   out.clear();
   const GaussRule& rule = gauss_legendre(q);
@@ -209,7 +221,7 @@ void CurveGridIntersection::row_rule(int iy, int q, std::vector<CellQuadraturePo
       for (std::size_t j = cut_begin[k]; j < cut_begin[k + 1]; ++j)
         out.push_back({ix, cut_points[j].x, cut_points[j].y, cut_points[j].weight});
       ++next_cut;
-    } else if (left_lower && left_upper && right_lower && right_upper) {
+    } else if (inside_uncut_cell(ix, iy, int(left_lower) + left_upper + right_lower + right_upper)) {
       for (int b = 0; b < q; ++b)
         for (int a = 0; a < q; ++a)
           out.push_back({ix, grid_.x(ix) + rule.nodes[a] * h, grid_.y(iy) + rule.nodes[b] * h,

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "fictus/boundary/curve_grid_intersection.hpp"
+#include "fictus/boundary/shapes.hpp"
 
 namespace {
 
@@ -93,6 +94,24 @@ TEST(CurveGridIntersection, CurveStartingOnAGridLineKeepsTheParityOfThatRow) {
   for (int i = 0; i <= 128; ++i) {
     const double x = grid.x(i);
     EXPECT_EQ(geometry.node_inside(i, 64), x > 0.1 && x < 0.9) << "x = " << x;
+  }
+}
+
+TEST(CurveGridIntersection, CurveThroughAGridNodeKeepsTheCellsBesideIt) {
+  // r = 0.3 + 0.05·cos 5t about (½, ½) passes through the node (¼, ½) of every grid with N divisible by 4
+  // (t = π), its tangent along the column x = ¼ there: the cells right of that node have three corners
+  // inside ω and the fourth on γ. They were once left out (a whole cell of area missing).
+  const fictus::StarCurve star({0.5, 0.5}, [](double t) { return 0.3 + 0.05 * std::cos(5 * t); });
+  const double area = pi * (0.09 + 0.05 * 0.05 / 2);
+  for (int N : {256, 512, 1024}) {
+    const fictus::Grid2 grid(fictus::Box2{}, N);
+    const fictus::CurveGridIntersection geometry(star, grid);
+    const auto moments = fictus::integrate_over_domain<3>(geometry, 2, [](int, int, double x, double y) {
+      return std::array<double, 3>{1.0, x, y};
+    });
+    EXPECT_NEAR(moments[0] / area, 1.0, 1e-12) << "N = " << N;
+    EXPECT_NEAR(moments[1] / (0.5 * area), 1.0, 1e-12) << "N = " << N;  // the centroid is the centre
+    EXPECT_NEAR(moments[2] / (0.5 * area), 1.0, 1e-12) << "N = " << N;
   }
 }
 

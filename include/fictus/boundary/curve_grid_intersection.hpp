@@ -67,6 +67,10 @@ class CurveGridIntersection {
   void row_rule(int iy, int q, std::vector<CellQuadraturePoint>& out) const;
 
  private:
+  /// Whether cell (ix, iy), which γ does not cross, lies in ω, given how many of its corners the
+  /// crossing parity puts inside (a corner on γ may count either way): the majority of the corners and
+  /// the edges' midpoints.
+  bool inside_uncut_cell(int ix, int iy, int corners_inside) const;
   const Curve& curve_;
   Grid2 grid_;
   std::vector<CurvePiece> pieces_;
