@@ -10,7 +10,8 @@
 // references store no integrals; 3-D: the force, ∫û and the contact area the references store, where the
 // error is more than 3 times the reference's own uncertainty).
 // Usage: fictus_bench_estimate [FILTER...]: only the cases whose name contains one of the filters
-// ("2d", "3d", "manufactured", "reference", a problem's name); none: all (about 10 minutes on 2 cores).
+// ("2d", "3d", "manufactured", "reference", a problem's name); none: all (6.5 minutes on the 2-core machine of
+// bench/results).
 #include <algorithm>
 #include <array>
 #include <cmath>
