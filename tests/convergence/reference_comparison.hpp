@@ -2,7 +2,7 @@
 // Fitted-mesh references (tests/references/<name>.json, written by tests/references/generate.sh) and
 // the comparison of a fictus solution with them: errors in ω from the reference's polar Gauss rule,
 // on γ from its trace samples, and the distance of the contact ends. Used by the convergence tests
-// and bench/spacing_study.cpp.
+// and the benches spacing_study.cpp, contact_fit.cpp and estimate_quality.cpp.
 #include <nlohmann/json.hpp>
 
 #include <cmath>
