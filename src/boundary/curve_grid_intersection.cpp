@@ -102,7 +102,8 @@ std::vector<Crossing> grid_crossings(const Curve& curve, const Grid2& grid, cons
 }  // namespace
 
 CurveGridIntersection::CurveGridIntersection(const Curve& curve, const Grid2& grid, const char* what)
-    : curve_(curve), grid_(grid) {
+    : curve_(curve), grid_(grid), corners_(curve.corners()) {
+  std::sort(corners_.begin(), corners_.end());
   const std::vector<Crossing> crossings = grid_crossings(curve, grid, what);
 
   row_crossings_.assign(grid.ny() + 1, {});
@@ -298,9 +299,10 @@ void CurveGridIntersection::cut_cell_rule(const CutCell& cell, int q, std::vecto
   std::vector<double> breaks = {lo[outer], hi[outer]};
   const std::vector<MonotonePart> parts = monotone_parts(curve_, pieces_, cell, outer, breaks);
   // A corner of γ (a polygon's vertex) in the cell kinks the inside segments' length: split there too.
-  for (double corner : curve_.corners())
-    for (int k : cell.pieces)
-      if (corner > pieces_[k].t0 && corner < pieces_[k].t1) breaks.push_back(component(curve_.position(corner), outer));
+  for (int k : cell.pieces)
+    for (auto c = std::upper_bound(corners_.begin(), corners_.end(), pieces_[k].t0);
+         c != corners_.end() && *c < pieces_[k].t1; ++c)
+      breaks.push_back(component(curve_.position(*c), outer));
   for (double& b : breaks) b = std::clamp(b, lo[outer], hi[outer]);
   std::sort(breaks.begin(), breaks.end());
 

@@ -78,6 +78,7 @@ class CurveGridIntersection {
   std::vector<std::size_t> row_begin_;
   std::vector<std::vector<double>> row_crossings_;  // per grid row j: sorted x of crossings
   std::vector<std::vector<double>> col_crossings_;  // per grid column i: sorted y of crossings
+  std::vector<double> corners_;                     // the curve's corners (parameters t), sorted
   /// row_rule's rules of one row's cut cells for one q: its cut cells' points, cell after cell, and where
   /// each cell's points begin (and the end).
   struct CutRules {
