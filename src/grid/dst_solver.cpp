@@ -16,11 +16,12 @@ std::unique_ptr<FastSolver<dim>> make_fast_solver(const Grid<dim>& grid, double 
 
 template <int dim>
 Footprint footprint(const Grid<dim>& grid, std::initializer_list<const SparseRows*> rows) {
-  const std::size_t columns = grid.layer_size();
+  const std::size_t columns = grid.layer_size(), row = std::size_t(grid.periodic() ? grid.n(0) : grid.n(0) - 1);
   Footprint f;
   f.columns.assign(columns, 0);
+  f.lines.assign(grid.n_unknowns() / row, 0);
   for (const SparseRows* R : rows)
-    for (const SparseRows::Entry& e : R->entries) f.columns[e.index % columns] = 1;
+    for (const SparseRows::Entry& e : R->entries) f.columns[e.index % columns] = 1, f.lines[e.index / row] = 1;
   return f;
 }
 

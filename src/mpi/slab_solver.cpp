@@ -32,12 +32,41 @@ struct SlabSolver<dim>::Plans {
   double* work = nullptr;    // made at the first solve that cannot run on its caller's vector
   std::once_flag work_made;
   fftw_plan forward = nullptr, backward = nullptr;
+  // Dirichlet: FFTW-MPI's transposition of the two slowest axes (the layout of TRANSPOSED_OUT), and back.
+  fftw_plan transpose = nullptr, transpose_back = nullptr;
   ~Plans() {
     std::lock_guard lock(detail::planner_mutex());
-    if (forward) fftw_destroy_plan(forward);
-    if (backward) fftw_destroy_plan(backward);
+    for (fftw_plan plan : {forward, backward, transpose, transpose_back})
+      if (plan) fftw_destroy_plan(plan);
     fftw_free(work);
   }
+};
+
+namespace {
+/// Adjacent lines along a strided axis transformed together (two cache lines per step along the axis).
+constexpr int chunk = 16;
+/// Contiguous lines per task.
+constexpr int rows_per_task = 64;
+}  // namespace
+
+/// FFTW's 1-D plans (RODFT00) for solve_in_place_at, FFTW order [slowest … fastest]:
+///   rows: lines along the fastest axis of this rank's layers (the grid's axis 0), `rows_per_task` at a
+///         time, and one;
+///   slow_rows (2-D): the transposed layout's lines along the slowest axis, contiguous there;
+///   middle, slowest (3-D): `chunk` adjacent lines along the grid's axis 1 (this rank's layers) and axis
+///         2 (the transposed layout), strided by the fastest axis, and the last, narrower chunk.
+template <int dim>
+struct SlabSolver<dim>::Lines {
+  struct Rows {
+    std::unique_ptr<detail::R2rLines> many, one;
+    int length = 0;
+  };
+  struct Chunks {
+    std::unique_ptr<detail::R2rLines> wide, narrow;
+    int length = 0;
+  };
+  Rows rows, slow_rows;
+  Chunks middle, slowest;
 };
 
 template <int dim>
@@ -55,6 +84,18 @@ SlabSolver<dim>::SlabSolver(const Grid<dim>& grid, double c, const Communicator&
       fftw_mpi_local_size_many_transposed(dim, p.spectrum.data(), 1, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK,
                                           comm.get(), &local_n0, &local_0_start, &p.spectral_count, &p.spectral_first);
   p.allocation = std::max<ptrdiff_t>(1, periodic ? 2 * units : units);
+  if (!periodic) {
+    // solve_in_place_at's transposition runs in the same array, in the same blocks.
+    ptrdiff_t n0 = 0, first0 = 0, n1 = 0, first1 = 0;
+    const std::array<ptrdiff_t, 2> two{p.n[0], p.n[1]};
+    const ptrdiff_t doubles =
+        fftw_mpi_local_size_many_transposed(2, two.data(), dim == 3 ? p.n[2] : 1, FFTW_MPI_DEFAULT_BLOCK,
+                                            FFTW_MPI_DEFAULT_BLOCK, comm.get(), &n0, &first0, &n1, &first1);
+    p.allocation = std::max(p.allocation, doubles);
+    const bool same = n1 == p.spectral_count && (n1 == 0 || first1 == p.spectral_first);
+    if (comm.max(same ? 0.0 : 1.0) != 0.0)
+      throw std::logic_error("SlabSolver: FFTW-MPI's transposition is not in the transform's blocks");
+  }
   // FFTW-MPI's blocks are default_slab's (a rank without layers may be told any start: it takes the
   // default's). Checked on every rank together, so that all throw or none.
   slab_ = default_slab(grid.layers(), comm.rank(), comm.size());
@@ -73,6 +114,16 @@ SlabSolver<dim>::SlabSolver(const Grid<dim>& grid, double c, const Communicator&
   } scratch{fftw_alloc_real(std::size_t(p.allocation))};
   if (scratch.data == nullptr) throw std::bad_alloc();
   double* const planned = scratch.data;
+  if (!periodic) {
+    // The transposition of the lines along the fastest axis (3-D) or of single entries (2-D), in
+    // FFTW-MPI's default blocks: those of TRANSPOSED_OUT, as scale() reads them.
+    const ptrdiff_t rows = dim == 3 ? p.n[2] : 1;
+    p.transpose = fftw_mpi_plan_many_transpose(p.n[0], p.n[1], rows, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK,
+                                               planned, planned, comm.get(), FFTW_ESTIMATE);
+    p.transpose_back =
+        fftw_mpi_plan_many_transpose(p.n[1], p.n[0], rows, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, planned,
+                                     planned, comm.get(), FFTW_ESTIMATE);
+  }
   const unsigned out = FFTW_ESTIMATE | FFTW_MPI_TRANSPOSED_OUT, in = FFTW_ESTIMATE | FFTW_MPI_TRANSPOSED_IN;
   if (periodic) {
     fftw_complex* spectrum = reinterpret_cast<fftw_complex*>(planned);
@@ -91,7 +142,7 @@ SlabSolver<dim>::SlabSolver(const Grid<dim>& grid, double c, const Communicator&
     p.backward = fftw_mpi_plan_many_r2r(dim, p.n.data(), 1, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, planned,
                                         planned, comm.get(), kinds.data(), in);
   }
-  if (p.forward == nullptr || p.backward == nullptr)
+  if (p.forward == nullptr || p.backward == nullptr || (!periodic && (!p.transpose || !p.transpose_back)))
     throw std::runtime_error("FFTW-MPI: could not plan the transforms");
   // The periodic box's padded rows always go through the workspace: made here, every rank's success
   // agreed, so that all ranks throw or none (a Dirichlet box makes it at the first solve that needs it).
@@ -153,34 +204,52 @@ void SlabSolver<dim>::scale(double* data, bool inverse) const {
   }
 }
 
+namespace {
+void copy_rows(const double* from, std::size_t from_stride, double* to, std::size_t to_stride, std::size_t rows,
+               std::size_t row, int threads) {
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (std::size_t r = 0; r < rows; ++r) std::memcpy(to + r * to_stride, from + r * from_stride, row * sizeof(double));
+}
+}  // namespace
+
 template <int dim>
-void SlabSolver<dim>::transform(GridVector& v, bool inverse) const {
+double* SlabSolver<dim>::local_array(GridVector& v) const {
   if (v.size() != this->local_size()) throw std::invalid_argument("SlabSolver: vector size mismatch");
-  const Plans& p = *plans_;
+  Plans& p = *plans_;
   const std::size_t row = std::size_t(p.n[dim - 1]);  // the grid's first axis
   const std::size_t padded = grid_.periodic() ? 2 * std::size_t(p.spectrum[dim - 1]) : row;
-  const std::size_t rows = v.size() / row;
-  auto copy_rows = [&](const double* from, std::size_t from_stride, double* to, std::size_t to_stride) {
-#pragma omp parallel for num_threads(threads_) schedule(static)
-    for (std::size_t r = 0; r < rows; ++r)
-      std::memcpy(to + r * to_stride, from + r * from_stride, row * sizeof(double));
-  };
   // A Dirichlet box's slab is FFTW-MPI's input layout: in place on the caller's vector where its
   // capacity holds FFTW-MPI's local array (make_vector), else through the workspace.
-  const std::size_t allocation = std::size_t(p.allocation), local = v.size();
-  const bool in_place = !grid_.periodic() && v.capacity() >= allocation;
-  double* data = nullptr;
-  if (in_place) {
-    v.resize(std::max(local, allocation), 0.0);
-    data = v.data();
-  } else {
-    std::call_once(plans_->work_made, [&] {
-      plans_->work = fftw_alloc_real(allocation);
-      if (plans_->work == nullptr) throw std::bad_alloc();
-    });
-    data = p.work;
-    copy_rows(v.data(), row, data, padded);
+  const std::size_t allocation = std::size_t(p.allocation);
+  if (!grid_.periodic() && v.capacity() >= allocation) {
+    v.resize(std::max(v.size(), allocation), 0.0);
+    return v.data();
   }
+  std::call_once(p.work_made, [&] {
+    p.work = fftw_alloc_real(allocation);
+    if (p.work == nullptr) throw std::bad_alloc();
+  });
+  copy_rows(v.data(), row, p.work, padded, v.size() / row, row, threads_);
+  return p.work;
+}
+
+template <int dim>
+void SlabSolver<dim>::finish(GridVector& v, double* data) const {
+  const std::size_t local = this->local_size();
+  if (data == v.data()) {
+    v.resize(local);
+    return;
+  }
+  const Plans& p = *plans_;
+  const std::size_t row = std::size_t(p.n[dim - 1]);
+  const std::size_t padded = grid_.periodic() ? 2 * std::size_t(p.spectrum[dim - 1]) : row;
+  copy_rows(data, padded, v.data(), row, local / row, row, threads_);
+}
+
+template <int dim>
+void SlabSolver<dim>::transform(GridVector& v, bool inverse) const {
+  const Plans& p = *plans_;
+  double* const data = local_array(v);
   if (grid_.periodic())
     fftw_mpi_execute_dft_r2c(p.forward, data, reinterpret_cast<fftw_complex*>(data));
   else
@@ -190,10 +259,141 @@ void SlabSolver<dim>::transform(GridVector& v, bool inverse) const {
     fftw_mpi_execute_dft_c2r(p.backward, reinterpret_cast<fftw_complex*>(data), data);
   else
     fftw_mpi_execute_r2r(p.backward, data, data);
-  if (in_place)
-    v.resize(local);
-  else
-    copy_rows(data, padded, v.data(), row);
+  finish(v, data);
+}
+
+namespace {
+/// Tasks t < tasks on `threads` threads, those with `wanted(t)`.
+template <typename Wanted, typename Task>
+void run_tasks(std::size_t tasks, int threads, const Wanted& wanted, const Task& task) {
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 4)
+  for (std::size_t t = 0; t < tasks; ++t)
+    if (wanted(t)) task(t);
+}
+}  // namespace
+
+template <int dim>
+void SlabSolver<dim>::transform_near(double* data, const Footprint& f, bool forward) const {
+  const Lines& lines = *lines_;
+  const std::size_t row = std::size_t(lines.rows.length);
+  const std::size_t rows_per_layer = grid_.layer_size() / row, rows = std::size_t(slab_.count) * rows_per_layer;
+  const std::size_t first_row = std::size_t(slab_.first) * rows_per_layer;
+  auto meets = [&](std::size_t from, std::size_t to) {  // this rank's rows [from, to) meet f's lines
+    return std::any_of(f.lines.begin() + std::ptrdiff_t(first_row + from),
+                       f.lines.begin() + std::ptrdiff_t(first_row + to), [](char c) { return c != 0; });
+  };
+  const std::size_t tasks = (rows + rows_per_task - 1) / rows_per_task;
+  auto run_rows = [&] {
+    run_tasks(
+        tasks, threads_,
+        [&](std::size_t t) { return meets(t * rows_per_task, std::min(rows, (t + 1) * rows_per_task)); },
+        [&](std::size_t t) {
+          const std::size_t from = t * rows_per_task, to = std::min(rows, from + rows_per_task);
+          if (to - from == rows_per_task)
+            lines.rows.many->execute(data + from * row);
+          else
+            for (std::size_t r = from; r < to; ++r) lines.rows.one->execute(data + r * row);
+        });
+  };
+  if constexpr (dim == 2) {
+    run_rows();
+  } else {
+    // Forward the rows come first, then the layers' lines along the middle axis (their chunks of the
+    // fastest axis all carry the rows' transforms); backward the other way round.
+    const std::size_t chunks = (row + chunk - 1) / chunk, middle = std::size_t(lines.middle.length);
+    auto run_middle = [&] {
+      run_tasks(
+          std::size_t(slab_.count) * chunks, threads_,
+          [&](std::size_t t) { return meets(t / chunks * rows_per_layer, (t / chunks + 1) * rows_per_layer); },
+          [&](std::size_t t) {
+            const std::size_t layer = t / chunks, c = t % chunks;
+            double* first = data + layer * middle * row + c * chunk;
+            ((c + 1) * chunk <= row ? lines.middle.wide : lines.middle.narrow)->execute(first);
+          });
+    };
+    if (forward) {
+      run_rows();
+      run_middle();
+    } else {
+      run_middle();
+      run_rows();
+    }
+  }
+}
+
+template <int dim>
+void SlabSolver<dim>::transform_slowest(double* data) const {
+  const Lines& lines = *lines_;
+  const Plans& p = *plans_;
+  const std::size_t count = std::size_t(p.spectral_count);  // this rank's entries of the middle axis
+  if constexpr (dim == 2) {
+    // The transposed layout [x][y]: this rank's lines along y are its rows.
+    const std::size_t row = std::size_t(lines.slow_rows.length), tasks = (count + rows_per_task - 1) / rows_per_task;
+    run_tasks(
+        tasks, threads_, [](std::size_t) { return true; },
+        [&](std::size_t t) {
+          const std::size_t from = t * rows_per_task, to = std::min(count, from + rows_per_task);
+          if (to - from == rows_per_task)
+            lines.slow_rows.many->execute(data + from * row);
+          else
+            for (std::size_t r = from; r < to; ++r) lines.slow_rows.one->execute(data + r * row);
+        });
+  } else {
+    // The transposed layout [y][z][x]: for each of this rank's y, the lines along z, by chunks of x.
+    const std::size_t row = std::size_t(lines.rows.length), chunks = (row + chunk - 1) / chunk;
+    const std::size_t plane = std::size_t(lines.slowest.length) * row;
+    run_tasks(
+        count * chunks, threads_, [](std::size_t) { return true; },
+        [&](std::size_t t) {
+          const std::size_t y = t / chunks, c = t % chunks;
+          ((c + 1) * chunk <= row ? lines.slowest.wide : lines.slowest.narrow)->execute(data + y * plane + c * chunk);
+        });
+  }
+}
+
+template <int dim>
+void SlabSolver<dim>::solve_in_place_at(GridVector& r, const Footprint& load, const Footprint& wanted) const {
+  if (grid_.periodic()) {
+    solve_in_place(r);
+    return;
+  }
+  const Plans& p = *plans_;
+  const std::size_t row = std::size_t(p.n[dim - 1]), lines_along_row = grid_.n_unknowns() / row;
+  if (load.lines.size() != lines_along_row || wanted.lines.size() != lines_along_row)
+    throw std::invalid_argument("SlabSolver: footprint size mismatch");
+  double* const data = local_array(r);
+  std::call_once(lines_planned_, [&] {
+    // FFTW_ESTIMATE plans, made on this array without touching it.
+    auto lines = std::make_unique<Lines>();
+    const auto kind = detail::R2rKind::dst1;
+    const int x = int(p.n[dim - 1]);
+    lines->rows = {std::make_unique<detail::R2rLines>(x, 1, rows_per_task, x, kind, data),
+                   std::make_unique<detail::R2rLines>(x, 1, 1, x, kind, data), x};
+    if constexpr (dim == 2) {
+      const int y = int(p.n[0]);
+      lines->slow_rows = {std::make_unique<detail::R2rLines>(y, 1, rows_per_task, y, kind, data),
+                          std::make_unique<detail::R2rLines>(y, 1, 1, y, kind, data), y};
+    } else {
+      auto chunks = [&](int n) {
+        typename Lines::Chunks c;
+        c.length = n;
+        if (x >= chunk) c.wide = std::make_unique<detail::R2rLines>(n, x, chunk, 1, kind, data);
+        if (x % chunk != 0) c.narrow = std::make_unique<detail::R2rLines>(n, x, x % chunk, 1, kind, data);
+        return c;
+      };
+      lines->middle = chunks(int(p.n[1]));
+      lines->slowest = chunks(int(p.n[0]));
+    }
+    lines_ = std::move(lines);
+  });
+  transform_near(data, load, true);
+  fftw_mpi_execute_r2r(p.transpose, data, data);
+  transform_slowest(data);
+  scale(data, true);
+  transform_slowest(data);
+  fftw_mpi_execute_r2r(p.transpose_back, data, data);
+  transform_near(data, wanted, false);
+  finish(r, data);
 }
 
 template <int dim>

@@ -129,6 +129,63 @@ TEST(SlabSolver, PeriodicMatchesTheSerialSolverIn3d) {
   check<3>(box3, 16, Boundary::periodic, 1.0, 2);
 }
 
+/// solve_in_place_at (the Schur complement's products) against the serial full solve: a load on the
+/// lines of 3 scattered rows, read by 9 others (their partial sums over the ranks' layers added), on a
+/// vector transformed where it lies and on one through the workspace, twice (the second call on the
+/// first's plans).
+template <int dim>
+void check_at(const fictus::Box<dim>& box, int n0, double c, int threads) {
+  const Communicator comm;
+  const fictus::Grid<dim> grid(box, n0, Boundary::dirichlet);
+  const fictus::Execution execution(threads);
+  const fictus::mpi::SlabSolver<dim> slab_solver(grid, c, comm, execution);
+  const std::unique_ptr<fictus::FastSolver<dim>> serial = fictus::make_fast_solver(grid, c, execution);
+  const fictus::SparseRows all = fictus::test_support::scattered_rows(grid, 12);
+  const fictus::SparseRows loads = fictus::select_rows(all, {0, 1, 2}),
+                           readings = fictus::select_rows(all, {3, 4, 5, 6, 7, 8, 9, 10, 11});
+  const fictus::Footprint load = fictus::footprint(grid, {&loads}), wanted = fictus::footprint(grid, {&readings});
+  GridVector whole(grid.n_unknowns(), 0.0);
+  loads.add_transposed({0.7, -1.3, 0.4}, whole);
+  const std::size_t offset = grid.slab_offset(slab_solver.slab()), local_size = slab_solver.local_size();
+  const GridVector local(whole.begin() + std::ptrdiff_t(offset), whole.begin() + std::ptrdiff_t(offset + local_size));
+  serial->solve_in_place(whole);
+  std::vector<double> expected;
+  readings.multiply(whole, expected);
+  double size = 0;
+  for (double v : expected) size = std::max(size, std::abs(v));
+  ASSERT_GT(size, 0.0);
+  const std::string name = std::to_string(dim) + "-D, c = " + std::to_string(c).substr(0, 3) + ", " +
+                           std::to_string(threads) + " thread(s): solve at footprints";
+  for (int repeat = 0; repeat < 2; ++repeat) {
+    GridVector in_place = slab_solver.make_vector(), copied = local;
+    std::copy(local.begin(), local.end(), in_place.begin());
+    for (GridVector* u : {&in_place, &copied}) {
+      slab_solver.solve_in_place_at(*u, load, wanted);
+      ASSERT_EQ(u->size(), local_size);
+      std::vector<double> got;
+      readings.multiply(*u, offset, got);
+      comm.sum(got.data(), got.size());
+      double difference = 0;
+      for (std::size_t i = 0; i < got.size(); ++i) difference = std::max(difference, std::abs(got[i] - expected[i]));
+      expect_agreement(difference / size, name + (u == &in_place ? " (in place)" : " (workspace)"), comm);
+    }
+  }
+  GridVector u = slab_solver.make_vector();
+  EXPECT_THROW(slab_solver.solve_in_place_at(u, fictus::Footprint{}, wanted), std::invalid_argument);
+}
+
+TEST(SlabSolver, SolvesAtFootprintsMatchTheSerialSolver) {
+  // Rows of 39, 15, 33 and 7 unknowns (chunks of 16, 16 and 7; 15 alone; 16, 16 and 1; 7 alone), and
+  // 34, 13, 16 and 2 layers (a third rank holds none of the last two grids').
+  for (int threads : {1, 2}) {
+    check_at<2>(box2, 40, 2.5, threads);
+    check_at<3>(box3, 16, 0.0, threads);
+    check_at<3>(fictus::Box<3>{{0.0, 0.0, 0.0}, {2.0, 1.0, 1.0}}, 34, 1.0, threads);
+  }
+  check_at<2>(fictus::Box<2>{{0.0, 0.0}, {1.0, 0.375}}, 8, 1.0, 1);
+  check_at<3>(fictus::Box<3>{{0.0, 0.0, 0.0}, {1.0, 1.0, 0.375}}, 8, 1.0, 1);
+}
+
 /// The grid steps of a solve on the ranks' slabs against one process: u₀ = A⁻¹F from the load F, its
 /// readings R u₀ (partial sums added over the ranks), and û = u₀ + A⁻¹Rᵀλ with its readings.
 template <int dim>

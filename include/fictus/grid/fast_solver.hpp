@@ -21,9 +21,11 @@ namespace fictus {
 
 /// The columns of a grid's unknowns (its lines along the slowest axis) that hold a node of some sparse
 /// rows: where a load Rᵀλ made from those rows can be non-zero, or where rows read a solve's answer.
-/// `columns` is indexed by Grid::index with the slowest axis dropped.
+/// `columns` is indexed by Grid::index with the slowest axis dropped; `lines`, the same for the lines
+/// along the fastest axis, by Grid::index over the unknowns along axis 0 (the solver on slabs, which
+/// transforms those lines first, takes these).
 struct Footprint {
-  std::vector<char> columns;
+  std::vector<char> columns, lines;
 };
 
 template <int dim>

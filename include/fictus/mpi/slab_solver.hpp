@@ -6,10 +6,14 @@
 //   periodic:  fftw_mpi_plan_many_dft_r2c / c2r.
 // The forward transform leaves its output transposed (FFTW_MPI_TRANSPOSED_OUT: the two slowest axes
 // swapped, distributed along the second), the division by λ runs there, and the backward transform takes
-// it back (FFTW_MPI_TRANSPOSED_IN): one global transposition per transform, not two. The constructor,
+// it back (FFTW_MPI_TRANSPOSED_IN): one global transposition per transform, not two. The Schur
+// complement's products (solve_in_place_at, Dirichlet box) are made of FFTW's 1-D transforms of the
+// lines their load and readings meet, along the axes a rank holds whole, with FFTW-MPI's transposition
+// between them: the same layouts, on fewer lines. The constructor,
 // the destructor, solve_in_place and apply are collective: every rank of the communicator calls them, in
 // the same order (a rank that fails alone leaves the others waiting).
 #include <memory>
+#include <mutex>
 
 #include "fictus/grid/fast_solver.hpp"
 #include "fictus/mpi/communicator.hpp"
@@ -38,6 +42,12 @@ class SlabSolver final : public FastSolver<dim> {
   /// any other goes through a workspace of that size, made at the first such call and kept. A periodic
   /// box always uses the workspace, made by the constructor.
   void solve_in_place(GridVector& r) const override;
+  /// r zero outside the lines of `load`, exact on the lines of `wanted` (footprint()), unspecified
+  /// elsewhere. A Dirichlet box transforms along the fastest axis only the lines of rows that meet the
+  /// load (forward) or the readings (backward), in 3-D along the middle axis only the layers that do,
+  /// and along the slowest axis every line of the transposed layout; a periodic box solves everywhere.
+  /// Plans its lines at the first call. Collective.
+  void solve_in_place_at(GridVector& r, const Footprint& load, const Footprint& wanted) const override;
   void apply(const GridVector& x, GridVector& y) const override;
   GridVector make_vector() const override;
   /// Bytes of the workspace on this rank (0 while every solve ran in place).
@@ -45,13 +55,25 @@ class SlabSolver final : public FastSolver<dim> {
 
  private:
   struct Plans;
+  struct Lines;
+  /// FFTW-MPI's local array holding v's layers: v's own storage where its capacity holds it (v resized
+  /// to it), else the workspace with v's rows copied in; `finish` takes the answer back into v.
+  double* local_array(GridVector& v) const;
+  void finish(GridVector& v, double* data) const;
   void transform(GridVector& v, bool inverse) const;
   void scale(double* data, bool inverse) const;
+  /// The lines of the transposed layout along the slowest axis (forward and backward alike: RODFT00).
+  void transform_slowest(double* data) const;
+  /// The lines along the fastest axis (and in 3-D the middle one) of this rank's layers that `f` meets,
+  /// in the order of a forward or a backward transform.
+  void transform_near(double* data, const Footprint& f, bool forward) const;
   Grid<dim> grid_;
   Q1Symbol<dim> symbol_;
   int threads_;
   Slab slab_;
   std::unique_ptr<Plans> plans_;
+  mutable std::once_flag lines_planned_;
+  mutable std::unique_ptr<Lines> lines_;  // planned by the first solve_in_place_at
 };
 
 }  // namespace fictus::mpi
