@@ -273,6 +273,11 @@ struct SurfaceKink::State::Build {
   const PatchedSurface& patches;
   double c;
   const Execution& execution;
+  // Distributed, each rank makes every P-th piece of the work (layers, voxels), and all take the parts.
+  const Distribution& distribution = execution.distribution();
+  bool mine(std::size_t piece) const {
+    return piece % std::size_t(distribution.size()) == std::size_t(distribution.rank());
+  }
   double h = grid.h();
   double band_width = 6 * h;  // the nodes of the two rings of voxels around the cut ones (≤ 5.2h)
   double tolerance = 1e-13 * h;
@@ -292,7 +297,12 @@ struct SurfaceKink::State::Build {
 #pragma omp critical(fictus_surface_kink_failure)
     if (!failure) failure = std::current_exception();
   }
+  /// After each loop: a failure or an interruption, thrown. Distributed, every rank throws if one does
+  /// (the ranks then take each other's parts: none may be left waiting).
   void rethrow() const {
+    const bool failed = failure || stop || execution.interrupt_requested();
+    if (distribution.distributed() && !distribution.all(!failed) && !failed)
+      throw std::runtime_error("the non-smooth variant's kink correction failed on another rank");
     if (failure) std::rethrow_exception(failure);
     execution.throw_if_interrupted();
   }
@@ -318,12 +328,13 @@ void SurfaceKink::State::Build::bounds() {
 }
 
 /// Step 1. The band: the nodes outside ω within 6h of γ, with ψ and the patch of their nearest point.
+/// Distributed, each rank makes every P-th layer, and all take every rank's nodes.
 void SurfaceKink::State::Build::band() {
   std::vector<std::vector<BandNode>> band_by_z(std::size_t(last[2] - first[2] + 1));
 #pragma omp parallel for num_threads(execution.threads()) schedule(dynamic, 1)
   for (int k = first[2]; k <= last[2]; ++k) {
     if (omp_get_thread_num() == 0 && execution.interrupt_requested()) stop = true;
-    if (stop) continue;
+    if (stop || !mine(std::size_t(k))) continue;
     try {
       for (int j = first[1]; j <= last[1]; ++j)
         for (int i = first[0]; i <= last[0]; ++i) {
@@ -341,6 +352,7 @@ void SurfaceKink::State::Build::band() {
   }
   rethrow();
   for (auto& layer : band_by_z) st.band.insert(st.band.end(), layer.begin(), layer.end());
+  st.band = distribution.concatenate(st.band);
   std::sort(st.band.begin(), st.band.end(), [](const BandNode& a, const BandNode& b) { return a.key < b.key; });
 }
 
@@ -369,11 +381,11 @@ std::vector<Grid3::Index> SurfaceKink::State::Build::cut_voxels() {
         const Point3 center{grid.x(i) + h / 2, grid.y(j) + h / 2, grid.z(k) + h / 2};
         if (near_surface(gamma, center, 0.87 * h)) near_voxels.push_back({i, j, k});
       }
-  std::vector<char> is_cut(near_voxels.size(), 0);
+  std::vector<double> is_cut(near_voxels.size(), 0.0);  // 1: cut (distributed, each rank decides every P-th)
 #pragma omp parallel for num_threads(execution.threads()) schedule(dynamic, 64)
   for (std::size_t n = 0; n < near_voxels.size(); ++n) {
     if (omp_get_thread_num() == 0 && n % 256 == 0 && execution.interrupt_requested()) stop = true;
-    if (stop) continue;
+    if (stop || !mine(n)) continue;
     // Cut: corners on both sides of γ, or a part in ω that the cut-voxel rule sees as neither empty
     // nor whole (γ through a face between the corners). The rule alone misses a corner just outside
     // γ: that voxel's ψ at the corner and its residual would be lost (docs/math.md, "Three dimensions":
@@ -386,14 +398,15 @@ std::vector<Grid3::Index> SurfaceKink::State::Build::cut_voxels() {
       (level > 0 ? outside : inside) = true;
     }
     if (inside && outside) {
-      is_cut[n] = true;
+      is_cut[n] = 1;
       continue;
     }
     double volume = 0;
     for_each_omega_point_in_voxel(grid, gamma, cell, cut_q, [&](const Point3&, double w) { volume += w; });
-    is_cut[n] = volume > 1e-12 * h * h * h && volume < (1 - 1e-12) * h * h * h;
+    is_cut[n] = volume > 1e-12 * h * h * h && volume < (1 - 1e-12) * h * h * h ? 1 : 0;
   }
-  execution.throw_if_interrupted();
+  rethrow();
+  distribution.sum(is_cut);
   std::vector<Grid3::Index> voxels;
   for (std::size_t n = 0; n < near_voxels.size(); ++n)
     if (is_cut[n]) voxels.push_back(near_voxels[n]);
@@ -451,13 +464,31 @@ std::vector<std::vector<RowEntry>> SurfaceKink::State::Build::residuals(const st
 #pragma omp for schedule(dynamic, 16)
     for (std::size_t n = 0; n < voxels.size(); ++n) try {
         if (omp_get_thread_num() == 0 && n % 64 == 0 && execution.interrupt_requested()) stop = true;
-        if (stop) continue;
+        if (stop || !mine(n)) continue;
         voxel_residual(voxels[n], near, local, sums, inside, by_voxel[n]);
       } catch (...) {
         keep();
       }
   }
   rethrow();
+  if (!distribution.distributed()) return by_voxel;
+  // Every rank's voxels (every P-th, from its rank on) back in voxel order: their entry counts and
+  // entries in the order each rank made them.
+  std::vector<std::uint64_t> counts;
+  std::vector<RowEntry> made;
+  for (std::size_t n = std::size_t(distribution.rank()); n < voxels.size(); n += std::size_t(distribution.size())) {
+    counts.push_back(by_voxel[n].size());
+    made.insert(made.end(), by_voxel[n].begin(), by_voxel[n].end());
+  }
+  counts = distribution.concatenate(counts);
+  made = distribution.concatenate(made);
+  std::size_t count = 0, entry = 0;
+  for (int r = 0; r < distribution.size(); ++r)
+    for (std::size_t n = std::size_t(r); n < voxels.size(); n += std::size_t(distribution.size()), ++count) {
+      const auto from = made.begin() + std::ptrdiff_t(entry);
+      by_voxel[n].assign(from, from + std::ptrdiff_t(counts[count]));
+      entry += counts[count];
+    }
   return by_voxel;
 }
 

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstring>
+#include <numeric>
 #include <stdexcept>
 #include <vector>
 
@@ -135,6 +137,27 @@ void SlabDistribution::broadcast(double* values, std::size_t n) const {
     MPI_Bcast(values + done, chunk, MPI_DOUBLE, 0, comm_.get());
     done += std::size_t(chunk);
   }
+}
+
+std::vector<unsigned char> SlabDistribution::concatenate_bytes(const std::vector<unsigned char>& mine) const {
+  const int P = comm_.size();
+  std::vector<unsigned long long> sizes(static_cast<std::size_t>(P));
+  const unsigned long long size = mine.size();
+  MPI_Allgather(&size, 1, MPI_UNSIGNED_LONG_LONG, sizes.data(), 1, MPI_UNSIGNED_LONG_LONG, comm_.get());
+  std::size_t total = 0;
+  for (unsigned long long s : sizes) total += std::size_t(s);
+  std::vector<unsigned char> all(total);
+  // Each rank's part from it to all, in pieces an int counts.
+  for (int r = 0; r < P; ++r) {
+    unsigned char* const part = all.data() + std::accumulate(sizes.begin(), sizes.begin() + r, std::size_t(0));
+    if (r == comm_.rank() && !mine.empty()) std::memcpy(part, mine.data(), mine.size());
+    for (std::size_t done = 0; done < sizes[std::size_t(r)];) {
+      const int piece = int(std::min<std::size_t>(sizes[std::size_t(r)] - done, INT_MAX));
+      MPI_Bcast(part + done, piece, MPI_UNSIGNED_CHAR, r, comm_.get());
+      done += std::size_t(piece);
+    }
+  }
+  return all;
 }
 
 std::unique_ptr<FastSolver<2>> SlabDistribution::fast_solver(const Grid<2>& grid, double c,

@@ -11,6 +11,7 @@
 #include "fictus/boundary/curve.hpp"
 #include "fictus/boundary/curve_grid_intersection.hpp"
 #include "fictus/boundary/surface.hpp"
+#include "fictus/boundary/surface_kink.hpp"
 #include "fictus/grid/green_table.hpp"
 #include "fictus/grid/load_vector.hpp"
 #include "fictus/mpi/distribution.hpp"
@@ -456,6 +457,90 @@ TEST(SlabGreenTable, CompressedNewtonSolvesWithTheGroupsSharedOut) {
     EXPECT_EQ(parts.factorizations(), serial.factorizations()) << name;
   }
   EXPECT_GT(serial.factorizations(), 2);
+}
+
+/// Distribution::concatenate: every rank's items (of differing counts, none on rank 1) in rank order, on
+/// every rank.
+TEST(SlabConcatenate, EveryRankGetsEveryRanksItemsInRankOrder) {
+  const Communicator comm;
+  const fictus::mpi::SlabDistribution distribution(comm);
+  struct Item {
+    int rank, k;
+    double value;
+  };
+  auto items_of = [](int rank) {
+    std::vector<Item> items;
+    for (int k = 0; k < (rank == 1 ? 0 : 3 + 2 * rank); ++k) items.push_back({rank, k, 0.5 * k - rank});
+    return items;
+  };
+  const std::vector<Item> all = distribution.concatenate(items_of(comm.rank()));
+  std::size_t at = 0;
+  for (int r = 0; r < comm.size(); ++r)
+    for (const Item& want : items_of(r)) {
+      ASSERT_LT(at, all.size());
+      EXPECT_TRUE(all[at].rank == want.rank && all[at].k == want.k && all[at].value == want.value) << "item " << at;
+      ++at;
+    }
+  EXPECT_EQ(at, all.size());
+}
+
+/// The non-smooth variant's kink rows with their work shared out over the ranks (the band's layers, the
+/// cut voxels' test, the voxels' residuals): the serial rows, bit for bit, on every rank.
+TEST(SlabKink, RanksMakeTheSerialKinkRows) {
+  const Communicator comm;
+  const fictus::Grid3 grid(fictus::Box3{{0, 0, 0}, {1, 1, 1}}, 24);
+  const fictus::Ellipsoid gamma({0.5, 0.48, 0.52}, {0.3, 0.25, 0.28});
+  const fictus::PatchedSurface patches = gamma.patches(40, grid.h());
+  const fictus::SurfaceKink serial(grid, gamma, patches, 1.0, fictus::Execution(2));
+  fictus::set_process_distribution(std::make_shared<fictus::mpi::SlabDistribution>(comm));
+  const fictus::SurfaceKink parts(grid, gamma, patches, 1.0, fictus::Execution(1));
+  fictus::set_process_distribution(nullptr);
+  const fictus::SparseRows &want = serial.galerkin(), &got = parts.galerkin();
+  ASSERT_GT(want.entries.size(), 0u);
+  EXPECT_EQ(parts.cut_voxels(), serial.cut_voxels());
+  bool same = want.row_begin == got.row_begin && want.entries.size() == got.entries.size();
+  for (std::size_t e = 0; same && e < want.entries.size(); ++e)
+    same = want.entries[e].index == got.entries[e].index && want.entries[e].value == got.entries[e].value;
+  EXPECT_EQ(comm.max(same ? 0.0 : 1.0), 0.0) << "the kink rows differ from the serial ones";
+}
+
+/// A sphere whose level gradient vanishes near one layer of nodes (z = 13/24 on a grid of 24 cells): the
+/// band's nearest points fail on the rank that makes the layer whose searches pass there only.
+class BrokenNearALayer final : public fictus::Surface {
+ public:
+  double level(const fictus::Point3& p) const override { return e_.level(p); }
+  fictus::Point3 level_gradient(const fictus::Point3& p) const override {
+    return p.x > 0.75 && std::abs(p.z - 13.0 / 24) < 0.01 ? fictus::Point3{} : e_.level_gradient(p);
+  }
+  fictus::PatchedSurface patches(int m, double edge) const override { return e_.patches(m, edge); }
+  double area() const override { return e_.area(); }
+  fictus::Box3 bounds() const override { return e_.bounds(); }
+
+ private:
+  fictus::Ellipsoid e_{{0.5, 0.5, 0.5}, {0.3, 0.3, 0.3}};
+};
+
+/// A failure in one rank's share of the kink rows' work reaches every rank as an error, and none waits
+/// for the others' parts (a hang here ends in ctest's timeout).
+TEST(SlabKink, AFailureOnOneRankIsAnErrorOnEvery) {
+  const Communicator comm;
+  const fictus::Grid3 grid(fictus::Box3{{0, 0, 0}, {1, 1, 1}}, 24);
+  const BrokenNearALayer gamma;
+  fictus::set_process_distribution(std::make_shared<fictus::mpi::SlabDistribution>(comm));
+  bool thrown = false, own = false;
+  try {
+    const fictus::SurfaceKink kink(grid, gamma, gamma.patches(40, grid.h()), 1.0, fictus::Execution(1));
+  } catch (const std::exception& e) {
+    thrown = true;
+    own = std::string(e.what()).find("no nearest point") != std::string::npos;
+  }
+  fictus::set_process_distribution(nullptr);
+  EXPECT_TRUE(thrown);
+  // One rank met the failure itself (its layers hold the nodes whose nearest points fail), the others
+  // learnt of it.
+  double failed_here = own ? 1.0 : 0.0;
+  comm.sum(&failed_here, 1);
+  EXPECT_EQ(failed_here, 1.0);
 }
 
 /// Distribution::layers: each rank asks for its own run of layers (wrapping past the last one, or none)

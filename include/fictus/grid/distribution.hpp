@@ -9,7 +9,9 @@
 // that failed alone would leave the others waiting, so a check whose answer may differ between ranks
 // (a NaN in one rank's layers) asks all() first and every rank throws together.
 #include <cstddef>
+#include <cstring>
 #include <memory>
+#include <type_traits>
 #include <vector>
 
 #include "fictus/grid/grid.hpp"
@@ -48,6 +50,20 @@ class Distribution {
   virtual double max(double value) const { return value; }
   /// values ← rank 0's values, on every rank.
   virtual void broadcast(double* values, std::size_t n) const { (void)values, (void)n; }
+  /// Every rank's `mine`, one after the other in rank order, on every rank (serial: mine). Collective.
+  virtual std::vector<unsigned char> concatenate_bytes(const std::vector<unsigned char>& mine) const { return mine; }
+  /// The same for items of a trivially copyable type (what a rank made of a task shared out by rank).
+  template <class T>
+  std::vector<T> concatenate(const std::vector<T>& mine) const {
+    static_assert(std::is_trivially_copyable_v<T>, "concatenate: items copied as bytes");
+    if (!distributed()) return mine;
+    std::vector<unsigned char> bytes(mine.size() * sizeof(T));
+    if (!mine.empty()) std::memcpy(bytes.data(), mine.data(), bytes.size());
+    bytes = concatenate_bytes(bytes);
+    std::vector<T> all(bytes.size() / sizeof(T));
+    if (!all.empty()) std::memcpy(static_cast<void*>(all.data()), bytes.data(), bytes.size());
+    return all;
+  }
   /// Is `ok` true on every rank? The same answer on all of them.
   bool all(bool ok) const { return max(ok ? 0.0 : 1.0) == 0.0; }
 

@@ -21,6 +21,7 @@ class SlabDistribution final : public Distribution {
   void sum_onto(double* values, std::size_t n, int root) const override { comm_.sum_onto(values, n, root); }
   double max(double value) const override { return comm_.max(value); }
   void broadcast(double* values, std::size_t n) const override;
+  std::vector<unsigned char> concatenate_bytes(const std::vector<unsigned char>& mine) const override;
   std::unique_ptr<FastSolver<2>> fast_solver(const Grid<2>& grid, double c, const Execution& execution) const override;
   std::unique_ptr<FastSolver<3>> fast_solver(const Grid<3>& grid, double c, const Execution& execution) const override;
   GridVector with_next_layer(const Grid<2>& grid, const GridVector& local) const override;
