@@ -26,10 +26,8 @@ Footprint footprint(const Grid<dim>& grid, std::initializer_list<const SparseRow
 }
 
 namespace {
-/// Adjacent lines along a slow axis transformed together: two cache lines per step along the axis.
-constexpr int chunk = 16;
-/// Rows along the fastest axis per task.
-constexpr int rows_per_task = 64;
+constexpr int chunk = detail::line_chunk;
+constexpr int rows_per_task = detail::rows_per_task;
 }  // namespace
 
 /// Plans for the lines of the grid: per axis a ≥ 1, `chunk` adjacent lines and the last, narrower chunk

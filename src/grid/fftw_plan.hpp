@@ -34,6 +34,12 @@ class R2rPlan {
   fftw_plan plan_ = nullptr;
 };
 
+/// The fast solvers' transforms of chosen lines (DstSolver, the solver on slabs): adjacent lines along a
+/// strided axis transformed together (two cache lines per step along the axis), and contiguous rows per
+/// thread's task.
+inline constexpr int line_chunk = 16;
+inline constexpr int rows_per_task = 64;
+
 /// An in-place 1-D transform of `howmany` lines of length n, each line's entries `stride` apart and the
 /// lines `distance` apart, single-threaded and on any pointer (FFTW_UNALIGNED), so that callers run
 /// many of them at once on threads (a transform of chosen lines of a grid). Planned on `example`, an

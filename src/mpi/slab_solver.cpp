@@ -43,10 +43,9 @@ struct SlabSolver<dim>::Plans {
 };
 
 namespace {
-/// Adjacent lines along a strided axis transformed together (two cache lines per step along the axis).
-constexpr int chunk = 16;
-/// Contiguous lines per task.
-constexpr int rows_per_task = 64;
+// The serial solver's tuning (DstSolver): adjacent strided lines per plan, contiguous rows per task.
+constexpr int chunk = detail::line_chunk;
+constexpr int rows_per_task = detail::rows_per_task;
 }  // namespace
 
 /// FFTW's 1-D plans (RODFT00) for solve_in_place_at, FFTW order [slowest … fastest]:
@@ -270,6 +269,22 @@ void run_tasks(std::size_t tasks, int threads, const Wanted& wanted, const Task&
   for (std::size_t t = 0; t < tasks; ++t)
     if (wanted(t)) task(t);
 }
+
+/// Contiguous rows [0, rows) of `length` doubles from `data`, rows_per_task per task (the tasks whose
+/// rows [from, to) are `wanted`): by `many` at a time, the last few by `one`.
+template <typename Wanted>
+void transform_rows(const detail::R2rLines& many, const detail::R2rLines& one, double* data, std::size_t rows,
+                    std::size_t length, int threads, const Wanted& wanted) {
+  run_tasks((rows + rows_per_task - 1) / rows_per_task, threads,
+            [&](std::size_t t) { return wanted(t * rows_per_task, std::min(rows, (t + 1) * rows_per_task)); },
+            [&](std::size_t t) {
+              const std::size_t from = t * rows_per_task, to = std::min(rows, from + rows_per_task);
+              if (to - from == rows_per_task)
+                many.execute(data + from * length);
+              else
+                for (std::size_t r = from; r < to; ++r) one.execute(data + r * length);
+            });
+}
 }  // namespace
 
 template <int dim>
@@ -282,19 +297,7 @@ void SlabSolver<dim>::transform_near(double* data, const Footprint& f, bool forw
     return std::any_of(f.lines.begin() + std::ptrdiff_t(first_row + from),
                        f.lines.begin() + std::ptrdiff_t(first_row + to), [](char c) { return c != 0; });
   };
-  const std::size_t tasks = (rows + rows_per_task - 1) / rows_per_task;
-  auto run_rows = [&] {
-    run_tasks(
-        tasks, threads_,
-        [&](std::size_t t) { return meets(t * rows_per_task, std::min(rows, (t + 1) * rows_per_task)); },
-        [&](std::size_t t) {
-          const std::size_t from = t * rows_per_task, to = std::min(rows, from + rows_per_task);
-          if (to - from == rows_per_task)
-            lines.rows.many->execute(data + from * row);
-          else
-            for (std::size_t r = from; r < to; ++r) lines.rows.one->execute(data + r * row);
-        });
-  };
+  auto run_rows = [&] { transform_rows(*lines.rows.many, *lines.rows.one, data, rows, row, threads_, meets); };
   if constexpr (dim == 2) {
     run_rows();
   } else {
@@ -328,16 +331,8 @@ void SlabSolver<dim>::transform_slowest(double* data) const {
   const std::size_t count = std::size_t(p.spectral_count);  // this rank's entries of the middle axis
   if constexpr (dim == 2) {
     // The transposed layout [x][y]: this rank's lines along y are its rows.
-    const std::size_t row = std::size_t(lines.slow_rows.length), tasks = (count + rows_per_task - 1) / rows_per_task;
-    run_tasks(
-        tasks, threads_, [](std::size_t) { return true; },
-        [&](std::size_t t) {
-          const std::size_t from = t * rows_per_task, to = std::min(count, from + rows_per_task);
-          if (to - from == rows_per_task)
-            lines.slow_rows.many->execute(data + from * row);
-          else
-            for (std::size_t r = from; r < to; ++r) lines.slow_rows.one->execute(data + r * row);
-        });
+    transform_rows(*lines.slow_rows.many, *lines.slow_rows.one, data, count, std::size_t(lines.slow_rows.length),
+                   threads_, [](std::size_t, std::size_t) { return true; });
   } else {
     // The transposed layout [y][z][x]: for each of this rank's y, the lines along z, by chunks of x.
     const std::size_t row = std::size_t(lines.rows.length), chunks = (row + chunk - 1) / chunk;
