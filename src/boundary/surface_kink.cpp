@@ -297,14 +297,40 @@ struct SurfaceKink::State::Build {
 #pragma omp critical(fictus_surface_kink_failure)
     if (!failure) failure = std::current_exception();
   }
-  /// After each loop: a failure or an interruption, thrown. Distributed, every rank throws if one does
-  /// (the ranks then take each other's parts: none may be left waiting).
+  /// After each loop: a failure or an interruption, thrown. Distributed, the ranks then take each other's
+  /// parts, so none may go on alone: every rank throws the first failing rank's error (its kind and
+  /// message), decided from what each knew before they agreed.
   void rethrow() const {
-    const bool failed = failure || stop || execution.interrupt_requested();
-    if (distribution.distributed() && !distribution.all(!failed) && !failed)
-      throw std::runtime_error("the non-smooth variant's kink correction failed on another rank");
-    if (failure) std::rethrow_exception(failure);
-    execution.throw_if_interrupted();
+    const bool interrupted = stop || execution.interrupt_requested();
+    if (!distribution.distributed()) {
+      if (failure) std::rethrow_exception(failure);
+      if (interrupted) throw Interrupted();
+      return;
+    }
+    std::string mine;  // kind ('a': invalid argument, 'r': any other error, 'i': interrupted) and message
+    if (failure) try {
+        std::rethrow_exception(failure);
+      } catch (const std::invalid_argument& e) {
+        mine = std::string("a") + e.what();
+      } catch (const std::exception& e) {
+        mine = std::string("r") + e.what();
+      } catch (...) {
+        mine = "rthe kink correction failed";
+      }
+    else if (interrupted)
+      mine = "i";
+    std::vector<char> bytes(mine.begin(), mine.end());
+    bytes.push_back('\0');
+    const std::vector<char> all = distribution.concatenate(bytes);
+    for (std::size_t at = 0; at < all.size();) {
+      const std::string first(all.data() + at);
+      at += first.size() + 1;
+      if (first.empty()) continue;
+      if (first == mine && failure) std::rethrow_exception(failure);
+      if (first[0] == 'i') throw Interrupted();
+      if (first[0] == 'a') throw std::invalid_argument(first.substr(1));
+      throw std::runtime_error(first.substr(1));
+    }
   }
   void bounds();
   void band();
@@ -390,20 +416,24 @@ std::vector<Grid3::Index> SurfaceKink::State::Build::cut_voxels() {
     // nor whole (γ through a face between the corners). The rule alone misses a corner just outside
     // γ: that voxel's ψ at the corner and its residual would be lost (docs/math.md, "Three dimensions":
     // the error then follows the grid's position against γ).
-    const Grid3::Index& cell = near_voxels[n];
-    bool inside = false, outside = false;
-    for (int corner = 0; corner < 8; ++corner) {
-      const double level = gamma.level({grid.x(cell[0] + (corner & 1)), grid.y(cell[1] + ((corner >> 1) & 1)),
-                                        grid.z(cell[2] + ((corner >> 2) & 1))});
-      (level > 0 ? outside : inside) = true;
+    try {
+      const Grid3::Index& cell = near_voxels[n];
+      bool inside = false, outside = false;
+      for (int corner = 0; corner < 8; ++corner) {
+        const double level = gamma.level({grid.x(cell[0] + (corner & 1)), grid.y(cell[1] + ((corner >> 1) & 1)),
+                                          grid.z(cell[2] + ((corner >> 2) & 1))});
+        (level > 0 ? outside : inside) = true;
+      }
+      if (inside && outside) {
+        is_cut[n] = 1;
+        continue;
+      }
+      double volume = 0;
+      for_each_omega_point_in_voxel(grid, gamma, cell, cut_q, [&](const Point3&, double w) { volume += w; });
+      is_cut[n] = volume > 1e-12 * h * h * h && volume < (1 - 1e-12) * h * h * h ? 1 : 0;
+    } catch (...) {
+      keep();
     }
-    if (inside && outside) {
-      is_cut[n] = 1;
-      continue;
-    }
-    double volume = 0;
-    for_each_omega_point_in_voxel(grid, gamma, cell, cut_q, [&](const Point3&, double w) { volume += w; });
-    is_cut[n] = volume > 1e-12 * h * h * h && volume < (1 - 1e-12) * h * h * h ? 1 : 0;
   }
   rethrow();
   distribution.sum(is_cut);

@@ -102,9 +102,6 @@ SlabSolver<dim>::SlabSolver(const Grid<dim>& grid, double c, const Communicator&
   if (comm.max(same ? 0.0 : 1.0) != 0.0)
     throw std::logic_error("SlabSolver: FFTW-MPI's distribution is not the default blocks");
 
-  std::lock_guard lock(detail::planner_mutex());
-  detail::init_threads_once();
-  fftw_plan_with_nthreads(threads_ < 1 ? 1 : threads_);
   // Planned on a scratch array (FFTW_ESTIMATE does not touch it), executed on the caller's vector or the
   // workspace: both aligned as FFTW's allocator aligns.
   struct Scratch {
@@ -113,6 +110,33 @@ SlabSolver<dim>::SlabSolver(const Grid<dim>& grid, double c, const Communicator&
   } scratch{fftw_alloc_real(std::size_t(p.allocation))};
   if (scratch.data == nullptr) throw std::bad_alloc();
   double* const planned = scratch.data;
+  plan_transforms(comm, planned);
+  // The pruned solve's plans of lines (solve_in_place_at), every rank's success agreed: that call is
+  // collective, so none may fail in it alone.
+  bool lines_made = true;
+  if (!periodic) try {
+      lines_ = plan_lines(planned);
+    } catch (const std::exception&) {
+      lines_made = false;
+    }
+  if (comm.max(lines_made ? 0.0 : 1.0) != 0.0)
+    throw std::runtime_error("FFTW: could not plan the transforms of grid lines");
+  // The periodic box's padded rows always go through the workspace: made here, every rank's success
+  // agreed, so that all ranks throw or none (a Dirichlet box makes it at the first solve that needs it).
+  if (periodic) {
+    std::call_once(p.work_made, [&] { p.work = fftw_alloc_real(std::size_t(p.allocation)); });
+    if (comm.max(p.work == nullptr ? 1.0 : 0.0) != 0.0) throw std::bad_alloc();
+  }
+}
+
+/// FFTW-MPI's plans of the whole transforms and of the transposition, on `planned`.
+template <int dim>
+void SlabSolver<dim>::plan_transforms(const Communicator& comm, double* planned) {
+  Plans& p = *plans_;
+  const bool periodic = grid_.periodic();
+  std::lock_guard lock(detail::planner_mutex());
+  detail::init_threads_once();
+  fftw_plan_with_nthreads(threads_ < 1 ? 1 : threads_);
   if (!periodic) {
     // The transposition of the lines along the fastest axis (3-D) or of single entries (2-D), in
     // FFTW-MPI's default blocks: those of TRANSPOSED_OUT, as scale() reads them.
@@ -143,12 +167,33 @@ SlabSolver<dim>::SlabSolver(const Grid<dim>& grid, double c, const Communicator&
   }
   if (p.forward == nullptr || p.backward == nullptr || (!periodic && (!p.transpose || !p.transpose_back)))
     throw std::runtime_error("FFTW-MPI: could not plan the transforms");
-  // The periodic box's padded rows always go through the workspace: made here, every rank's success
-  // agreed, so that all ranks throw or none (a Dirichlet box makes it at the first solve that needs it).
-  if (periodic) {
-    std::call_once(p.work_made, [&] { p.work = fftw_alloc_real(std::size_t(p.allocation)); });
-    if (comm.max(p.work == nullptr ? 1.0 : 0.0) != 0.0) throw std::bad_alloc();
+}
+
+/// FFTW's 1-D plans of solve_in_place_at (FFTW_ESTIMATE: made on `example` without touching it).
+template <int dim>
+std::unique_ptr<typename SlabSolver<dim>::Lines> SlabSolver<dim>::plan_lines(double* example) const {
+  const Plans& p = *plans_;
+  auto lines = std::make_unique<Lines>();
+  const auto kind = detail::R2rKind::dst1;
+  const int x = int(p.n[dim - 1]);
+  lines->rows = {std::make_unique<detail::R2rLines>(x, 1, rows_per_task, x, kind, example),
+                 std::make_unique<detail::R2rLines>(x, 1, 1, x, kind, example), x};
+  if constexpr (dim == 2) {
+    const int y = int(p.n[0]);
+    lines->slow_rows = {std::make_unique<detail::R2rLines>(y, 1, rows_per_task, y, kind, example),
+                        std::make_unique<detail::R2rLines>(y, 1, 1, y, kind, example), y};
+  } else {
+    auto chunks = [&](int n) {
+      typename Lines::Chunks c;
+      c.length = n;
+      if (x >= chunk) c.wide = std::make_unique<detail::R2rLines>(n, x, chunk, 1, kind, example);
+      if (x % chunk != 0) c.narrow = std::make_unique<detail::R2rLines>(n, x, x % chunk, 1, kind, example);
+      return c;
+    };
+    lines->middle = chunks(int(p.n[1]));
+    lines->slowest = chunks(int(p.n[0]));
   }
+  return lines;
 }
 
 template <int dim>
@@ -357,30 +402,6 @@ void SlabSolver<dim>::solve_in_place_at(GridVector& r, const Footprint& load, co
   if (load.lines.size() != lines_along_row || wanted.lines.size() != lines_along_row)
     throw std::invalid_argument("SlabSolver: footprint size mismatch");
   double* const data = local_array(r);
-  std::call_once(lines_planned_, [&] {
-    // FFTW_ESTIMATE plans, made on this array without touching it.
-    auto lines = std::make_unique<Lines>();
-    const auto kind = detail::R2rKind::dst1;
-    const int x = int(p.n[dim - 1]);
-    lines->rows = {std::make_unique<detail::R2rLines>(x, 1, rows_per_task, x, kind, data),
-                   std::make_unique<detail::R2rLines>(x, 1, 1, x, kind, data), x};
-    if constexpr (dim == 2) {
-      const int y = int(p.n[0]);
-      lines->slow_rows = {std::make_unique<detail::R2rLines>(y, 1, rows_per_task, y, kind, data),
-                          std::make_unique<detail::R2rLines>(y, 1, 1, y, kind, data), y};
-    } else {
-      auto chunks = [&](int n) {
-        typename Lines::Chunks c;
-        c.length = n;
-        if (x >= chunk) c.wide = std::make_unique<detail::R2rLines>(n, x, chunk, 1, kind, data);
-        if (x % chunk != 0) c.narrow = std::make_unique<detail::R2rLines>(n, x, x % chunk, 1, kind, data);
-        return c;
-      };
-      lines->middle = chunks(int(p.n[1]));
-      lines->slowest = chunks(int(p.n[0]));
-    }
-    lines_ = std::move(lines);
-  });
   transform_near(data, load, true);
   fftw_mpi_execute_r2r(p.transpose, data, data);
   transform_slowest(data);

@@ -70,7 +70,9 @@ SurfaceMap onto_surface(const Surface& gamma, double tolerance);
 
 class SurfaceKink {
  public:
-  /// The kink model for the patches of γ on `grid`; computes r_j for A = K + cM.
+  /// The kink model for the patches of γ on `grid`; computes r_j for A = K + cM. With a distributed
+  /// `execution`, collective: the ranks share the work, and each holds the whole model (the serial one,
+  /// bit for bit); an error on one rank is thrown on every rank.
   SurfaceKink(const Grid3& grid, const Surface& gamma, const PatchedSurface& patches, double c,
               const Execution& execution = Execution{});
   ~SurfaceKink();

@@ -5,8 +5,8 @@
 //                        constants) and solve_in_place applies the pseudo-inverse A⁺ (the mean of r
 //                        is discarded and the result has zero mean).
 // λ(p) comes from Q1Symbol. Solvers plan once in the constructor; solve_in_place() is const and
-// allocation-free (solve_in_place_at plans its transforms of lines at its first call and makes a mask
-// of the lines, a few bytes per column, at each call).
+// allocation-free (DstSolver::solve_in_place_at plans its transforms of lines at its first call and
+// makes a mask of the lines, a few bytes per column, at each call).
 #include <complex>
 #include <initializer_list>
 #include <memory>
@@ -46,9 +46,10 @@ class FastSolver {
   virtual GridVector make_vector() const { return GridVector(local_size(), 0.0); }
   /// Overwrites r (size local_size(): n_unknowns when serial) with A⁻¹r (A⁺r when singular()).
   virtual void solve_in_place(GridVector& r) const = 0;
-  /// The same for r zero outside the columns of `load`, exact where `wanted` says and unspecified
-  /// elsewhere: the Dirichlet solver transforms only the lines these meet (the Schur complement's
-  /// products, whose loads and readings lie near γ); the others solve everywhere.
+  /// The same for r zero outside the nodes of the rows `load` was made from (footprint()), exact at the
+  /// nodes of those `wanted` was made from and unspecified elsewhere: the Dirichlet solvers transform
+  /// only the lines these meet (the Schur complement's products, whose loads and readings lie near γ);
+  /// the others solve everywhere.
   virtual void solve_in_place_at(GridVector& r, const Footprint& load, const Footprint& wanted) const {
     (void)load, (void)wanted;
     solve_in_place(r);

@@ -9,11 +9,10 @@
 // it back (FFTW_MPI_TRANSPOSED_IN): one global transposition per transform, not two. The Schur
 // complement's products (solve_in_place_at, Dirichlet box) are made of FFTW's 1-D transforms of the
 // lines their load and readings meet, along the axes a rank holds whole, with FFTW-MPI's transposition
-// between them: the same layouts, on fewer lines. The constructor,
-// the destructor, solve_in_place and apply are collective: every rank of the communicator calls them, in
-// the same order (a rank that fails alone leaves the others waiting).
+// between them: the same layouts, on fewer lines. The constructor, the destructor, solve_in_place,
+// solve_in_place_at and apply are collective: every rank of the communicator calls them, in the same
+// order (a rank that fails alone leaves the others waiting).
 #include <memory>
-#include <mutex>
 
 #include "fictus/grid/fast_solver.hpp"
 #include "fictus/mpi/communicator.hpp"
@@ -42,11 +41,11 @@ class SlabSolver final : public FastSolver<dim> {
   /// any other goes through a workspace of that size, made at the first such call and kept. A periodic
   /// box always uses the workspace, made by the constructor.
   void solve_in_place(GridVector& r) const override;
-  /// r zero outside the lines of `load`, exact on the lines of `wanted` (footprint()), unspecified
-  /// elsewhere. A Dirichlet box transforms along the fastest axis only the lines of rows that meet the
-  /// load (forward) or the readings (backward), in 3-D along the middle axis only the layers that do,
-  /// and along the slowest axis every line of the transposed layout; a periodic box solves everywhere.
-  /// Plans its lines at the first call. Collective.
+  /// r zero outside the nodes of the rows `load` was made from, exact at the nodes of those of `wanted`
+  /// (footprint()), unspecified elsewhere. A Dirichlet box transforms along the fastest axis only the
+  /// rows that meet the load (forward) or the readings (backward), in 3-D along the middle axis only
+  /// the layers that do, and along the slowest axis every line of the transposed layout (its plans are
+  /// the constructor's); a periodic box solves everywhere. Collective.
   void solve_in_place_at(GridVector& r, const Footprint& load, const Footprint& wanted) const override;
   void apply(const GridVector& x, GridVector& y) const override;
   GridVector make_vector() const override;
@@ -56,6 +55,8 @@ class SlabSolver final : public FastSolver<dim> {
  private:
   struct Plans;
   struct Lines;
+  void plan_transforms(const Communicator& comm, double* planned);
+  std::unique_ptr<Lines> plan_lines(double* example) const;
   /// FFTW-MPI's local array holding v's layers: v's own storage where its capacity holds it (v resized
   /// to it), else the workspace with v's rows copied in; `finish` takes the answer back into v.
   double* local_array(GridVector& v) const;
@@ -72,8 +73,7 @@ class SlabSolver final : public FastSolver<dim> {
   int threads_;
   Slab slab_;
   std::unique_ptr<Plans> plans_;
-  mutable std::once_flag lines_planned_;
-  mutable std::unique_ptr<Lines> lines_;  // planned by the first solve_in_place_at
+  std::unique_ptr<Lines> lines_;  // solve_in_place_at's (Dirichlet box)
 };
 
 }  // namespace fictus::mpi
