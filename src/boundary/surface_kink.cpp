@@ -297,41 +297,9 @@ struct SurfaceKink::State::Build {
 #pragma omp critical(fictus_surface_kink_failure)
     if (!failure) failure = std::current_exception();
   }
-  /// After each loop: a failure or an interruption, thrown. Distributed, the ranks then take each other's
-  /// parts, so none may go on alone: every rank throws the first failing rank's error (its kind and
-  /// message), decided from what each knew before they agreed.
-  void rethrow() const {
-    const bool interrupted = stop || execution.interrupt_requested();
-    if (!distribution.distributed()) {
-      if (failure) std::rethrow_exception(failure);
-      if (interrupted) throw Interrupted();
-      return;
-    }
-    std::string mine;  // kind ('a': invalid argument, 'r': any other error, 'i': interrupted) and message
-    if (failure) try {
-        std::rethrow_exception(failure);
-      } catch (const std::invalid_argument& e) {
-        mine = std::string("a") + e.what();
-      } catch (const std::exception& e) {
-        mine = std::string("r") + e.what();
-      } catch (...) {
-        mine = "rthe kink correction failed";
-      }
-    else if (interrupted)
-      mine = "i";
-    std::vector<char> bytes(mine.begin(), mine.end());
-    bytes.push_back('\0');
-    const std::vector<char> all = distribution.concatenate(bytes);
-    for (std::size_t at = 0; at < all.size();) {
-      const std::string first(all.data() + at);
-      at += first.size() + 1;
-      if (first.empty()) continue;
-      if (first == mine && failure) std::rethrow_exception(failure);
-      if (first[0] == 'i') throw Interrupted();
-      if (first[0] == 'a') throw std::invalid_argument(first.substr(1));
-      throw std::runtime_error(first.substr(1));
-    }
-  }
+  /// After each loop: a failure or an interruption, thrown on every rank (they then take each other's
+  /// parts: none may go on alone).
+  void rethrow() const { distribution.throw_first_failure(failure, stop || execution.interrupt_requested()); }
   void bounds();
   void band();
   void element_matrices();

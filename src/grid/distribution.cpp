@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "fictus/grid/dst_solver.hpp"
@@ -50,6 +51,38 @@ Slab Distribution::transform_planes(const std::vector<int>& shape, std::size_t& 
   for (int n : shape) local_size *= std::size_t(n);
   return Slab{0, shape.empty() ? 0 : shape[0]};
 }
+void Distribution::throw_first_failure(const std::exception_ptr& failure, bool interrupted) const {
+  if (!distributed()) {
+    if (failure) std::rethrow_exception(failure);
+    if (interrupted) throw Interrupted();
+    return;
+  }
+  std::string mine;  // the kind ('a': invalid argument, 'r': another error, 'i': interrupted), the message
+  if (failure) try {
+      std::rethrow_exception(failure);
+    } catch (const std::invalid_argument& e) {
+      mine = std::string("a") + e.what();
+    } catch (const std::exception& e) {
+      mine = std::string("r") + e.what();
+    } catch (...) {
+      mine = "ran unknown error";
+    }
+  else if (interrupted)
+    mine = "i";
+  std::vector<char> bytes(mine.begin(), mine.end());
+  bytes.push_back('\0');
+  const std::vector<char> all = concatenate(bytes);
+  for (std::size_t at = 0, r = 0; at < all.size(); ++r) {
+    const std::string first(all.data() + at);
+    at += first.size() + 1;
+    if (first.empty()) continue;
+    if (int(r) == rank() && failure) std::rethrow_exception(failure);
+    if (first[0] == 'i') throw Interrupted();
+    if (first[0] == 'a') throw std::invalid_argument(first.substr(1));
+    throw std::runtime_error(first.substr(1));
+  }
+}
+
 void Distribution::dct1(const std::vector<int>&, double*, int) const { serial_only("dct1"); }
 GridVector Distribution::layers(const Grid<2>&, const GridVector&, Slab) const { serial_only("layers"); }
 GridVector Distribution::layers(const Grid<3>&, const GridVector&, Slab) const { serial_only("layers"); }

@@ -10,6 +10,7 @@
 // (a NaN in one rank's layers) asks all() first and every rank throws together.
 #include <cstddef>
 #include <cstring>
+#include <exception>
 #include <memory>
 #include <type_traits>
 #include <vector>
@@ -66,6 +67,11 @@ class Distribution {
   }
   /// Is `ok` true on every rank? The same answer on all of them.
   bool all(bool ok) const { return max(ok ? 0.0 : 1.0) == 0.0; }
+  /// After work shared out: throws on every rank the error of the first rank that had one (`failure`,
+  /// or an interruption where `interrupted`), of its kind (std::invalid_argument, Interrupted, else
+  /// std::runtime_error) with its message; the rank that had it rethrows it. Returns where no rank had
+  /// one. Collective. Serial: rethrows `failure`, then throws Interrupted where `interrupted`.
+  void throw_first_failure(const std::exception_ptr& failure, bool interrupted) const;
 
   /// The fast solver of A = K + c·M for this distribution (serial: make_fast_solver's).
   virtual std::unique_ptr<FastSolver<2>> fast_solver(const Grid<2>& grid, double c, const Execution& execution) const;
