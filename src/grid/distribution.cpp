@@ -1,5 +1,6 @@
 #include "fictus/grid/distribution.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <stdexcept>
 #include <string>
@@ -86,6 +87,16 @@ void Distribution::throw_first_failure(const std::exception_ptr& failure, bool i
 void Distribution::dct1(const std::vector<int>&, double*, int) const { serial_only("dct1"); }
 GridVector Distribution::layers(const Grid<2>&, const GridVector&, Slab) const { serial_only("layers"); }
 GridVector Distribution::layers(const Grid<3>&, const GridVector&, Slab) const { serial_only("layers"); }
+AlignedVector<double> Distribution::planes(const double* local, Slab mine, std::size_t plane_size,
+                                           const std::vector<int>& wanted, std::size_t zeros) const {
+  AlignedVector<double> out(wanted.size() * plane_size + zeros, 0.0);
+  for (std::size_t t = 0; t < wanted.size(); ++t) {
+    if (!mine.holds(wanted[t])) throw std::invalid_argument("planes: a plane that is not held");
+    std::copy_n(local + std::size_t(wanted[t] - mine.first) * plane_size, plane_size,
+                out.begin() + std::ptrdiff_t(t * plane_size));
+  }
+  return out;
+}
 GridVector Distribution::gather(const Grid<2>&, const GridVector& local, bool) const { return local; }
 GridVector Distribution::gather(const Grid<3>&, const GridVector& local, bool) const { return local; }
 

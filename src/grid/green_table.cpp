@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <stdexcept>
 
 #include "fftw_plan.hpp"
 #include "fictus/grid/distribution.hpp"
@@ -27,6 +28,7 @@ GreenTable<dim>::GreenTable(const Grid<dim>& grid, double c, const Execution& ex
   partial_ = distribution.distributed();
   std::size_t local = entries;
   const Slab held = partial_ ? distribution.transform_planes(shape, local) : Slab{0, shape[0]};
+  held_ = held;
   const std::size_t plane = entries / size_[dim - 1];
   plane_.resize(size_[dim - 1]);
   for (int z = 0; z < shape[0]; ++z)
@@ -69,6 +71,39 @@ GreenTable<dim>::GreenTable(const Grid<dim>& grid, double c, const Execution& ex
   }
   detail::R2rPlan plan(shape, detail::R2rKind::dct1, execution.threads());
   plan.execute(table_.data());
+}
+
+template <int dim>
+GreenTable<dim>::GreenTable(const GreenTable& table, const std::vector<char>& wanted, const Distribution& distribution)
+    : grid_(table.grid_), c_(table.c_), periodic_(table.periodic_), period_(table.period_), size_(table.size_) {
+  if (wanted.size() != size_[dim - 1]) throw std::invalid_argument("GreenTable: one mark per plane");
+  std::vector<int> list;
+  for (std::size_t z = 0; z < wanted.size(); ++z)
+    if (wanted[z]) list.push_back(int(z));
+  std::size_t entries = 1;
+  for (int d = 0; d < dim - 1; ++d) entries *= size_[d];
+  held_ = Slab{0, int(size_[dim - 1])};
+  // The planes, then one of zeros: the planes not copied read it, and the node sums refuse them.
+  if (table.partial_) {
+    table_ = distribution.planes(table.table_.data(), table.held_, entries, list, entries);
+  } else {
+    table_.assign((list.size() + 1) * entries, 0.0);
+    for (std::size_t t = 0; t < list.size(); ++t)
+      std::copy_n(table.table_.begin() + std::ptrdiff_t(std::size_t(list[t]) * entries), entries,
+                  table_.begin() + std::ptrdiff_t(t * entries));
+  }
+  missing_ = list.size() * entries;
+  plane_.assign(size_[dim - 1], missing_);
+  for (std::size_t t = 0; t < list.size(); ++t) plane_[std::size_t(list[t])] = t * entries;
+}
+
+template <int dim>
+void GreenTable<dim>::mark_planes(int a_lo, int a_hi, int b_lo, int b_hi, std::vector<char>& planes) const {
+  const int period = period_[dim - 1];
+  planes.resize(size_[dim - 1], 0);
+  for (int s = a_lo - b_hi; s <= a_hi - b_lo; ++s) planes[std::size_t(fold(s, period))] = 1;
+  if (!periodic_)
+    for (int s = a_lo + b_lo; s <= a_hi + b_hi; ++s) planes[std::size_t(fold(s, period))] = 1;
 }
 
 namespace {
@@ -220,6 +255,10 @@ void GreenTable<dim>::G(const Index* a, std::size_t n_a, const Index* b, const d
         const int y = low[d] + j;
         offsets[minus_at[d] + std::size_t(j)] = offset(d, near_fold(a[u][d] - y, period_[d]), stride[d]);
         if (!periodic_) offsets[plus_at[d] + std::size_t(j)] = offset(d, near_fold(a[u][d] + y, period_[d]), stride[d]);
+        if (d == dim - 1 && missing_ != SIZE_MAX &&
+            (offsets[minus_at[d] + std::size_t(j)] == missing_ ||
+             (!periodic_ && offsets[plus_at[d] + std::size_t(j)] == missing_)))
+          throw std::logic_error("GreenTable: the sums read a plane that was not copied");
       }
     const std::size_t *xm = offsets.data() + minus_at[0], *xp = offsets.data() + plus_at[0];
     const std::size_t *ym = offsets.data() + minus_at[1], *yp = offsets.data() + plus_at[1];

@@ -40,54 +40,79 @@ GridVector gather_layers(const Grid<dim>& grid, const GridVector& local, const C
   return whole;
 }
 
-/// Each rank's wanted layers (wrapped) from their holders: every rank learns every rank's wish, sends the
-/// layers it holds of each in the wished order, and the receiver puts each sender's layers in place.
+/// Each rank's wanted planes from their holders: every rank learns every rank's held planes and wish,
+/// sends the planes it holds of each wish in the wished order, and the receiver puts each sender's planes
+/// in place. A plane no rank holds is an error on every rank (found before anything is sent).
+AlignedVector<double> fetch_planes(const double* local, Slab mine, std::size_t plane_size,
+                                   const std::vector<int>& wanted, std::size_t zeros, const Communicator& comm) {
+  const int P = comm.size();
+  const auto np = static_cast<std::size_t>(P);
+  std::vector<int> held(2 * np), counts(np);
+  const int slab[2] = {mine.first, mine.count}, count = int(wanted.size());
+  MPI_Allgather(slab, 2, MPI_INT, held.data(), 2, MPI_INT, comm.get());
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm.get());
+  std::vector<int> firsts(np, 0);
+  for (std::size_t r = 1; r < np; ++r) firsts[r] = firsts[r - 1] + counts[r - 1];
+  std::vector<int> wishes(std::size_t(firsts.back() + counts.back()));
+  MPI_Allgatherv(wanted.data(), count, MPI_INT, wishes.data(), counts.data(), firsts.data(), MPI_INT, comm.get());
+  const auto holder = [&](int plane) {
+    for (std::size_t r = 0; r < np; ++r)
+      if (plane >= held[2 * r] && plane < held[2 * r] + held[2 * r + 1]) return int(r);
+    return -1;
+  };
+  std::vector<int> owner(wishes.size());
+  bool held_somewhere = plane_size <= std::size_t(INT_MAX);  // a plane is one MPI datatype
+  for (std::size_t t = 0; t < wishes.size(); ++t)
+    held_somewhere = held_somewhere && (owner[t] = holder(wishes[t])) >= 0;
+  if (!held_somewhere) throw std::invalid_argument("planes: a wanted plane that no rank holds");  // every rank sees it
+  std::vector<int> send_counts(np, 0), recv_counts(np, 0);
+  for (std::size_t r = 0; r < np; ++r)
+    for (int t = firsts[r]; t < firsts[r] + counts[r]; ++t) send_counts[r] += owner[std::size_t(t)] == comm.rank();
+  AlignedVector<double> send(std::size_t(std::accumulate(send_counts.begin(), send_counts.end(), 0)) * plane_size);
+  double* to = send.data();
+  for (std::size_t r = 0; r < np; ++r)  // in r's order, the planes this rank holds
+    for (int t = firsts[r]; t < firsts[r] + counts[r]; ++t)
+      if (owner[std::size_t(t)] == comm.rank())
+        to = std::copy_n(local + std::size_t(wishes[std::size_t(t)] - mine.first) * plane_size, plane_size, to);
+  const int* my_owners = owner.data() + firsts[std::size_t(comm.rank())];
+  for (int t = 0; t < count; ++t) ++recv_counts[std::size_t(my_owners[t])];
+  std::vector<int> send_firsts(np, 0), recv_firsts(np, 0);
+  for (std::size_t r = 1; r < np; ++r) {
+    send_firsts[r] = send_firsts[r - 1] + send_counts[r - 1];
+    recv_firsts[r] = recv_firsts[r - 1] + recv_counts[r - 1];
+  }
+  MPI_Datatype plane;  // counted in planes: the counts fit an int
+  MPI_Type_contiguous(int(plane_size), MPI_DOUBLE, &plane);
+  MPI_Type_commit(&plane);
+  AlignedVector<double> received(wanted.size() * plane_size + zeros, 0.0);
+  MPI_Alltoallv(send.data(), send_counts.data(), send_firsts.data(), plane, received.data(), recv_counts.data(),
+                recv_firsts.data(), plane, comm.get());
+  MPI_Type_free(&plane);
+  send = AlignedVector<double>();
+  // Received by sender, each sender's planes in the wished order: that is the wished order where the
+  // wish goes from holder to holder in rank order (ascending planes do), else each is taken in turn.
+  if (std::is_sorted(my_owners, my_owners + count)) return received;
+  AlignedVector<double> out(received.size(), 0.0);
+  std::vector<int> next = recv_firsts;
+  for (int t = 0; t < count; ++t) {
+    const int from = next[std::size_t(my_owners[t])]++;
+    std::copy_n(received.begin() + std::ptrdiff_t(std::size_t(from) * plane_size), plane_size,
+                out.begin() + std::ptrdiff_t(std::size_t(t) * plane_size));
+  }
+  return out;
+}
+
+/// Each rank's wanted layers (wrapped) from their holders.
 template <int dim>
 GridVector fetch_layers(const Grid<dim>& grid, const GridVector& local, Slab wanted, const Communicator& comm) {
-  const int P = comm.size(), L = grid.layers();
-  const Slab mine = default_slab(L, comm.rank(), P);
+  const int L = grid.layers();
+  const Slab mine = default_slab(L, comm.rank(), comm.size());
   if (local.size() != grid.slab_size(mine)) throw std::invalid_argument("layers: vector size mismatch");
   if (wanted.count < 0 || wanted.count > L || wanted.first < 0)
     throw std::invalid_argument("layers: a range of at most the grid's layers, from layer >= 0");
-  std::vector<int> wishes(2 * static_cast<std::size_t>(P));
-  const int wish[2] = {wanted.first, wanted.count};
-  MPI_Allgather(wish, 2, MPI_INT, wishes.data(), 2, MPI_INT, comm.get());
-  std::vector<int> holder(static_cast<std::size_t>(L));
-  for (int r = 0; r < P; ++r) {
-    const Slab s = default_slab(L, r, P);
-    for (int l = s.first; l < s.first + s.count; ++l) holder[std::size_t(l)] = r;
-  }
-  const std::size_t size = grid.layer_size();
-  std::vector<int> send_counts(static_cast<std::size_t>(P), 0), recv_counts(static_cast<std::size_t>(P), 0);
-  std::vector<double> send;
-  for (int r = 0; r < P; ++r)  // in r's order, the layers this rank holds
-    for (int t = 0; t < wishes[2 * std::size_t(r) + 1]; ++t)
-      if (const int l = (wishes[2 * std::size_t(r)] + t) % L; mine.holds(l)) {
-        send.insert(send.end(), local.begin() + std::ptrdiff_t(std::size_t(l - mine.first) * size),
-                    local.begin() + std::ptrdiff_t(std::size_t(l - mine.first + 1) * size));
-        ++send_counts[std::size_t(r)];
-      }
-  for (int t = 0; t < wanted.count; ++t) ++recv_counts[std::size_t(holder[std::size_t((wanted.first + t) % L)])];
-  std::vector<int> send_firsts(static_cast<std::size_t>(P), 0), recv_firsts(static_cast<std::size_t>(P), 0);
-  for (int r = 1; r < P; ++r) {
-    send_firsts[std::size_t(r)] = send_firsts[std::size_t(r) - 1] + send_counts[std::size_t(r) - 1];
-    recv_firsts[std::size_t(r)] = recv_firsts[std::size_t(r) - 1] + recv_counts[std::size_t(r) - 1];
-  }
-  MPI_Datatype layer;  // counted in layers: the counts fit an int
-  MPI_Type_contiguous(int(size), MPI_DOUBLE, &layer);
-  MPI_Type_commit(&layer);
-  GridVector received(std::size_t(wanted.count) * size);
-  MPI_Alltoallv(send.data(), send_counts.data(), send_firsts.data(), layer, received.data(), recv_counts.data(),
-                recv_firsts.data(), layer, comm.get());
-  MPI_Type_free(&layer);
-  GridVector out(received.size());  // each sender's layers are in the wished order: take them in turn
-  std::vector<int> next = recv_firsts;
-  for (int t = 0; t < wanted.count; ++t) {
-    const int from = next[std::size_t(holder[std::size_t((wanted.first + t) % L)])]++;
-    std::copy_n(received.begin() + std::ptrdiff_t(std::size_t(from) * size), size,
-                out.begin() + std::ptrdiff_t(std::size_t(t) * size));
-  }
-  return out;
+  std::vector<int> list(static_cast<std::size_t>(wanted.count));
+  for (int t = 0; t < wanted.count; ++t) list[std::size_t(t)] = (wanted.first + t) % L;
+  return fetch_planes(local.data(), mine, grid.layer_size(), list, 0, comm);
 }
 
 }  // namespace
@@ -97,6 +122,11 @@ GridVector SlabDistribution::layers(const Grid<2>& grid, const GridVector& local
 }
 GridVector SlabDistribution::layers(const Grid<3>& grid, const GridVector& local, Slab wanted) const {
   return fetch_layers(grid, local, wanted, comm_);
+}
+
+AlignedVector<double> SlabDistribution::planes(const double* local, Slab mine, std::size_t plane_size,
+                                               const std::vector<int>& wanted, std::size_t zeros) const {
+  return fetch_planes(local, mine, plane_size, wanted, zeros, comm_);
 }
 
 Slab SlabDistribution::slab(int layers) const { return default_slab(layers, comm_.rank(), comm_.size()); }

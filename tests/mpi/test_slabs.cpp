@@ -390,10 +390,21 @@ TEST(SlabGreenTable, CompressedBlocksFromThePartsAreThoseOfTheWholeTable) {
     fictus::set_process_distribution(distribution);
     const fictus::Execution execution(2);
     const fictus::GreenTable<3> part(rows.grid, c, execution);
-    const fictus::CompressedBlocks parts = fictus::compressed_green_blocks(part, {&rows.B, &rows.C}, rows.Q, execution,
-                                                                           fictus::default_far_field_3d, storage);
+    fictus::FarFieldReport report;
+    const fictus::CompressedBlocks parts = fictus::compressed_green_blocks(
+        part, {&rows.B, &rows.C}, rows.Q, execution, fictus::default_far_field_3d, storage, &report);
     fictus::set_process_distribution(nullptr);
     const std::string name = std::string("3-D ") + fictus::to_string(boundary) + ": compressed blocks from planes";
+    // Each near block is one rank's, made from the whole planes it fetched: the ranks' shares add up to
+    // every near pair, about equally.
+    double shares[2] = {report.near_pairs_here, report.near_pairs_here};
+    comm.sum(shares, 1);
+    shares[1] = comm.max(shares[1]);
+    EXPECT_EQ(shares[0], report.near_pairs) << name;
+    if (comm.size() > 1) {
+      EXPECT_GT(report.whole_planes_bytes, 0.0) << name;
+      EXPECT_LT(shares[1], 1.3 * report.near_pairs / comm.size()) << name << ": the near pairs unevenly shared";
+    }
     ASSERT_EQ(parts.blocks.size(), serial.blocks.size()) << name;
     // Each block is one rank's; together the ranks hold what the serial blocks take.
     double counts[3] = {0, 0, parts.bytes()};  // held blocks, of them of low rank, bytes
@@ -421,6 +432,41 @@ TEST(SlabGreenTable, CompressedBlocksFromThePartsAreThoseOfTheWholeTable) {
     first = mine;
     distribution->broadcast(first.data(), first.size());
     EXPECT_EQ(comm.max(mine == first ? 0.0 : 1.0), 0.0) << name << ": the ranks' products differ";
+  }
+}
+
+/// The dense Schur blocks with the far field interpolated, from the ranks' planes of the table: each near
+/// block made by one rank from the whole planes it fetched, each far block's part by every rank. The
+/// ranks' blocks, summed, are those of the whole table to round-off, and the near pairs are shared out.
+TEST(SlabGreenTable, DenseBlocksFromThePartsAreThoseOfTheWholeTable) {
+  const Communicator comm;
+  for (const auto& [boundary, c] : {std::pair{Boundary::dirichlet, 1.0}, std::pair{Boundary::periodic, 0.0}}) {
+    const fictus::test_support::SphereRows rows(boundary, 0.3, 48, 2.0, 1.5);
+    const fictus::GreenTable<3> whole(rows.grid, c, fictus::Execution(1));
+    const std::vector<Eigen::MatrixXd> serial =
+        fictus::green_blocks(whole, {&rows.B, &rows.C}, rows.Q, fictus::Execution(2), fictus::default_far_field_3d);
+    fictus::set_process_distribution(std::make_shared<fictus::mpi::SlabDistribution>(comm));
+    const fictus::Execution execution(2);
+    const fictus::GreenTable<3> part(rows.grid, c, execution);
+    fictus::FarFieldReport report;
+    std::vector<Eigen::MatrixXd> parts =
+        fictus::green_blocks(part, {&rows.B, &rows.C}, rows.Q, execution, fictus::default_far_field_3d, &report);
+    fictus::set_process_distribution(nullptr);
+    const std::string name = std::string("3-D ") + fictus::to_string(boundary) + ": dense blocks from planes";
+    double difference = 0;
+    for (std::size_t s = 0; s < 2; ++s) {
+      comm.sum(parts[s].data(), std::size_t(parts[s].size()));
+      difference = std::max(difference, (parts[s] - serial[s]).norm() / serial[s].norm());
+    }
+    expect_agreement(comm.max(difference), name, comm);
+    double shares[2] = {report.near_pairs_here, report.near_pairs_here};
+    comm.sum(shares, 1);
+    shares[1] = comm.max(shares[1]);
+    EXPECT_EQ(shares[0], report.near_pairs) << name;
+    if (comm.size() > 1) {
+      EXPECT_GT(report.whole_planes_bytes, 0.0) << name;
+      EXPECT_LT(shares[1], 1.3 * report.near_pairs / comm.size()) << name << ": the near pairs unevenly shared";
+    }
   }
 }
 
@@ -581,6 +627,43 @@ TEST(SlabLayers, EachRankGetsTheLayersItAsksFor) {
       EXPECT_EQ(comm.max(difference), 0.0) << fictus::to_string(boundary) << ", layers from " << wanted.first;
     }
   }
+}
+
+/// Distribution::planes: each rank asks for planes of an array split in uneven planes over the ranks (in
+/// any order, with repeats, or none) and gets them whole, in the asked order, followed by the zeros it
+/// asked room for; a plane that no rank holds is an error on every rank.
+TEST(SlabPlanes, EachRankGetsThePlanesItAsksFor) {
+  const Communicator comm;
+  const fictus::mpi::SlabDistribution distribution(comm);
+  const int n_planes = 11;
+  const std::size_t plane = 5;
+  const Slab mine = fictus::mpi::default_slab(n_planes, comm.rank(), comm.size());
+  const auto value = [&](int z, std::size_t k) { return 100.0 * z + double(k) + 0.5; };
+  fictus::AlignedVector<double> local(std::size_t(mine.count) * plane);
+  for (int z = mine.first; z < mine.first + mine.count; ++z)
+    for (std::size_t k = 0; k < plane; ++k) local[std::size_t(z - mine.first) * plane + k] = value(z, k);
+  const std::vector<std::vector<int>> wishes = {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10},
+                                                {10, 3, comm.rank() % n_planes, 3, 0},
+                                                {},
+                                                {n_planes - 1 - comm.rank() % n_planes}};
+  for (const std::vector<int>& wanted : wishes) {
+    const fictus::AlignedVector<double> got = distribution.planes(local.data(), mine, plane, wanted, 3);
+    ASSERT_EQ(got.size(), wanted.size() * plane + 3);
+    double difference = 0;
+    for (std::size_t t = 0; t < wanted.size(); ++t)
+      for (std::size_t k = 0; k < plane; ++k)
+        difference = std::max(difference, std::abs(got[t * plane + k] - value(wanted[t], k)));
+    for (std::size_t k = 0; k < 3; ++k) difference = std::max(difference, std::abs(got[wanted.size() * plane + k]));
+    EXPECT_EQ(comm.max(difference), 0.0) << wanted.size() << " planes asked for";
+  }
+  std::string message;
+  try {
+    distribution.planes(local.data(), mine, plane,
+                        comm.rank() == 0 ? std::vector<int>{2, n_planes} : std::vector<int>{1});
+  } catch (const std::invalid_argument& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("no rank holds"), std::string::npos) << "rank " << comm.rank() << ": " << message;
 }
 
 TEST(SlabSolver, DefaultSlabsCoverTheLayersInOrder) {

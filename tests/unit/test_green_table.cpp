@@ -1,10 +1,12 @@
 // G from the Green's table against columns of A⁻¹ computed with the DST solver.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
 
+#include "fictus/grid/distribution.hpp"
 #include "fictus/grid/dst_solver.hpp"
 #include "fictus/grid/green_table.hpp"
 
@@ -118,6 +120,47 @@ TEST(GreenTableBatch, TensorAndWeightedFormsEqualNodeByNode2d) {
 TEST(GreenTableBatch, TensorAndWeightedFormsEqualNodeByNode3d) {
   expect_batch_forms_match<3>(fictus::Boundary::dirichlet);
   expect_batch_forms_match<3>(fictus::Boundary::periodic);
+}
+
+/// A table of some planes (the near blocks' whole planes in a distributed assembly): with the planes
+/// mark_planes gives for the nodes' ranges along the slowest axis, its weighted sums are the table's to
+/// the last bit; a sum that reads a plane not copied is refused, never a silent zero.
+template <int dim>
+void expect_copied_planes_suffice(fictus::Boundary boundary) {
+  using Index = typename fictus::Grid<dim>::Index;
+  fictus::Box<dim> box;
+  for (int d = 0; d < dim; ++d) box.lower[d] = 0.0, box.upper[d] = 1.0;
+  const fictus::Grid<dim> grid(box, 16, boundary);
+  const fictus::GreenTable<dim> green(grid, 1.0);
+  const int z = dim - 1, lo = boundary == fictus::Boundary::dirichlet ? 1 : 0;
+  std::vector<Index> rows, cols;
+  std::vector<double> w;
+  for (int k = 0; k < 6; ++k) {
+    Index a, b;
+    for (int d = 0; d < dim; ++d) a[d] = lo + (3 * k + d) % 14, b[d] = lo + (5 * k + 2 * d) % 14;
+    a[z] = 9 + k % 3, b[z] = 4 + k % 2;  // a_z in [9, 11], b_z in [4, 5]
+    rows.push_back(a), cols.push_back(b), w.push_back(1.0 - 0.3 * k);
+  }
+  std::vector<char> wanted;
+  green.mark_planes(9, 11, 4, 5, wanted);
+  ASSERT_EQ(int(wanted.size()), green.planes());
+  const int marked = int(std::count(wanted.begin(), wanted.end(), 1));
+  EXPECT_LT(2 * marked, green.planes() + 1);  // minus [4, 7]; plus [13, 16] in a Dirichlet box
+  const fictus::GreenTable<dim> some(green, wanted, fictus::Distribution{});
+  std::vector<double> want(rows.size()), got(rows.size());
+  green.G(rows.data(), rows.size(), cols.data(), w.data(), cols.size(), want.data());
+  some.G(rows.data(), rows.size(), cols.data(), w.data(), cols.size(), got.data());
+  for (std::size_t p = 0; p < rows.size(); ++p) EXPECT_EQ(got[p], want[p]) << "row " << p;
+  EXPECT_EQ(some.memory_bytes(), std::size_t(marked + 1) * green.plane_size() * sizeof(double));  // and a zero plane
+  rows[2][z] = 5;  // the plane of |5 − 4| = 1 was not marked
+  EXPECT_THROW(some.G(rows.data(), rows.size(), cols.data(), w.data(), cols.size(), got.data()), std::logic_error);
+}
+
+TEST(GreenTablePlanes, CopiedPlanesGiveTheTablesSums) {
+  expect_copied_planes_suffice<2>(fictus::Boundary::dirichlet);
+  expect_copied_planes_suffice<2>(fictus::Boundary::periodic);
+  expect_copied_planes_suffice<3>(fictus::Boundary::dirichlet);
+  expect_copied_planes_suffice<3>(fictus::Boundary::periodic);
 }
 
 }  // namespace

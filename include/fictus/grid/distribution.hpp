@@ -94,6 +94,13 @@ class Distribution {
   /// its own layers (count 0: none). Collective. Serial: never asked.
   virtual GridVector layers(const Grid<2>& grid, const GridVector& local, Slab wanted) const;
   virtual GridVector layers(const Grid<3>& grid, const GridVector& local, Slab wanted) const;
+  /// Planes `wanted` (any order, repeats allowed) of an array split in planes of `plane_size` doubles
+  /// along its slowest axis, of which this rank holds `mine` (`local`: those planes, one after the
+  /// other): the wanted planes, one after the other in the wanted order, from the ranks that hold them,
+  /// then `zeros` zeros (room the caller fills). Each rank asks for its own. A plane no rank holds is an
+  /// error on every rank. Collective. Serial: copies of `local`'s planes.
+  virtual AlignedVector<double> planes(const double* local, Slab mine, std::size_t plane_size,
+                                       const std::vector<int>& wanted, std::size_t zeros = 0) const;
   /// The whole grid vector from each rank's layers: on every rank, or (`everywhere` false) on rank 0
   /// only (the others get an empty vector).
   virtual GridVector gather(const Grid<2>& grid, const GridVector& local, bool everywhere = true) const;

@@ -25,11 +25,19 @@
 
 namespace fictus {
 
+class Distribution;
+
 template <int dim>
 class GreenTable {
  public:
   using Index = typename Grid<dim>::Index;
   GreenTable(const Grid<dim>& grid, double c, const Execution& execution = Execution{});
+  /// Whole planes of a table on planes: this rank's copy of `table`'s planes along the slowest axis that
+  /// `wanted` marks (wanted[z] != 0), their whole values fetched from the ranks that hold them (a
+  /// distributed table), or copied (a serial one). The node-weighted sums (the near blocks') on it give
+  /// whole entries where the nodes' pairs read only wanted planes (mark_planes), and throw
+  /// std::logic_error where a pair reads another. Collective where `table` is partial.
+  GreenTable(const GreenTable& table, const std::vector<char>& wanted, const Distribution& distribution);
 
   const Grid<dim>& grid() const { return grid_; }
   double c() const { return c_; }
@@ -68,6 +76,16 @@ class GreenTable {
   /// out[u] = Σ_k G(a_u, b_k)·w_k (k in order) for the nodes a_u, u < n_a, and the weighted nodes
   /// (b_k, w_k), k < n_b: the near blocks' sums in the Schur assembly, the same sums as G's.
   void G(const Index* a, std::size_t n_a, const Index* b, const double* w, std::size_t n_b, double* out) const;
+  /// Marks in `planes` (one per table plane along the slowest axis, planes() of them) the planes that G
+  /// between nodes a and b reads for every a_{dim−1} in [a_lo, a_hi] and b_{dim−1} in [b_lo, b_hi].
+  void mark_planes(int a_lo, int a_hi, int b_lo, int b_hi, std::vector<char>& planes) const;
+  int planes() const { return int(size_[dim - 1]); }
+  /// The table's entries in one plane.
+  std::size_t plane_size() const {
+    std::size_t n = 1;
+    for (int d = 0; d < dim - 1; ++d) n *= size_[d];
+    return n;
+  }
   std::size_t memory_bytes() const { return table_.size() * sizeof(double); }
   /// Whether this rank holds only some planes (a distributed run): its lookups give its part of a sum.
   bool partial() const { return partial_; }
@@ -99,6 +117,8 @@ class GreenTable {
   std::array<int, dim> period_;        // of T along each axis
   std::array<std::size_t, dim> size_;  // table entries along each axis: period/2 + 1
   bool partial_ = false;
+  Slab held_;                       // this rank's planes along the slowest axis (every plane serially)
+  std::size_t missing_ = SIZE_MAX;  // a table of some planes (the copy's): where the planes not copied begin
   std::vector<std::size_t> plane_;  // where plane z of the slowest axis begins in table_ (a zero plane if not held)
   std::size_t zeros_ = SIZE_MAX;    // where the zero plane begins (none serially): the block sums skip its lookups
   AlignedVector<double> table_;

@@ -30,6 +30,8 @@ class SlabDistribution final : public Distribution {
   void dct1(const std::vector<int>& shape, double* local, int threads) const override;
   GridVector layers(const Grid<2>& grid, const GridVector& local, Slab wanted) const override;
   GridVector layers(const Grid<3>& grid, const GridVector& local, Slab wanted) const override;
+  AlignedVector<double> planes(const double* local, Slab mine, std::size_t plane_size, const std::vector<int>& wanted,
+                               std::size_t zeros = 0) const override;
   GridVector gather(const Grid<2>& grid, const GridVector& local, bool everywhere = true) const override;
   GridVector gather(const Grid<3>& grid, const GridVector& local, bool everywhere = true) const override;
 

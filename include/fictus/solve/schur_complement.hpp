@@ -68,6 +68,9 @@ std::vector<int> interpolation_nodes(int lo, int hi, int order);
 struct FarFieldReport {
   double near_pairs = 0, far_pairs = 0;
   int near_blocks = 0, far_blocks = 0;
+  /// This rank's share: the near pairs it made (distributed, each near block is one rank's), and the
+  /// bytes of the table's whole planes it fetched for them (serially: all near pairs, no bytes).
+  double near_pairs_here = 0, whole_planes_bytes = 0;
 };
 
 /// What the storage of S_B and S_C took (results.json `schur_storage`; dense: the m × m blocks).
