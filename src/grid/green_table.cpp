@@ -88,9 +88,11 @@ GreenTable<dim>::GreenTable(const GreenTable& table, const std::vector<char>& wa
     table_ = distribution.planes(table.table_.data(), table.held_, entries, list, entries);
   } else {
     table_.assign((list.size() + 1) * entries, 0.0);
-    for (std::size_t t = 0; t < list.size(); ++t)
-      std::copy_n(table.table_.begin() + std::ptrdiff_t(std::size_t(list[t]) * entries), entries,
-                  table_.begin() + std::ptrdiff_t(t * entries));
+    for (std::size_t t = 0; t < list.size(); ++t) {
+      const std::size_t from = table.plane_[std::size_t(list[t])];
+      if (from == table.missing_) throw std::invalid_argument("GreenTable: a plane the copied table does not hold");
+      std::copy_n(table.table_.begin() + std::ptrdiff_t(from), entries, table_.begin() + std::ptrdiff_t(t * entries));
+    }
   }
   missing_ = list.size() * entries;
   plane_.assign(size_[dim - 1], missing_);

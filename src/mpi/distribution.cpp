@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <climits>
 #include <cstring>
+#include <new>
 #include <numeric>
 #include <stdexcept>
 #include <vector>
@@ -41,11 +42,12 @@ GridVector gather_layers(const Grid<dim>& grid, const GridVector& local, const C
 }
 
 /// Each rank's wanted planes from their holders: every rank learns every rank's held planes and wish,
-/// sends the planes it holds of each wish in the wished order, and the receiver puts each sender's planes
-/// in place. A plane no rank holds is an error on every rank (found before anything is sent).
+/// then in P rounds sends to rank + k what it holds of that rank's wish while it receives from rank − k,
+/// straight from its planes into their places (indexed datatypes: no copies). A plane no rank holds, or
+/// the answer not allocated on one rank, is an error on every rank, found before anything is sent.
 AlignedVector<double> fetch_planes(const double* local, Slab mine, std::size_t plane_size,
                                    const std::vector<int>& wanted, std::size_t zeros, const Communicator& comm) {
-  const int P = comm.size();
+  const int P = comm.size(), me = comm.rank();
   const auto np = static_cast<std::size_t>(P);
   std::vector<int> held(2 * np), counts(np);
   const int slab[2] = {mine.first, mine.count}, count = int(wanted.size());
@@ -55,50 +57,50 @@ AlignedVector<double> fetch_planes(const double* local, Slab mine, std::size_t p
   for (std::size_t r = 1; r < np; ++r) firsts[r] = firsts[r - 1] + counts[r - 1];
   std::vector<int> wishes(std::size_t(firsts.back() + counts.back()));
   MPI_Allgatherv(wanted.data(), count, MPI_INT, wishes.data(), counts.data(), firsts.data(), MPI_INT, comm.get());
-  const auto holder = [&](int plane) {
-    for (std::size_t r = 0; r < np; ++r)
-      if (plane >= held[2 * r] && plane < held[2 * r] + held[2 * r + 1]) return int(r);
-    return -1;
-  };
-  std::vector<int> owner(wishes.size());
-  bool held_somewhere = plane_size <= std::size_t(INT_MAX);  // a plane is one MPI datatype
-  for (std::size_t t = 0; t < wishes.size(); ++t)
-    held_somewhere = held_somewhere && (owner[t] = holder(wishes[t])) >= 0;
-  if (!held_somewhere) throw std::invalid_argument("planes: a wanted plane that no rank holds");  // every rank sees it
-  std::vector<int> send_counts(np, 0), recv_counts(np, 0);
+  if (plane_size > std::size_t(INT_MAX))  // a plane is one MPI datatype; the same on every rank
+    throw std::invalid_argument("planes: a plane of more than INT_MAX numbers");
+  int planes = 0;  // the planes held by some rank: [0, planes)
+  for (std::size_t r = 0; r < np; ++r) planes = std::max(planes, held[2 * r] + held[2 * r + 1]);
+  std::vector<int> holder(std::size_t(planes), -1);
   for (std::size_t r = 0; r < np; ++r)
-    for (int t = firsts[r]; t < firsts[r] + counts[r]; ++t) send_counts[r] += owner[std::size_t(t)] == comm.rank();
-  AlignedVector<double> send(std::size_t(std::accumulate(send_counts.begin(), send_counts.end(), 0)) * plane_size);
-  double* to = send.data();
-  for (std::size_t r = 0; r < np; ++r)  // in r's order, the planes this rank holds
-    for (int t = firsts[r]; t < firsts[r] + counts[r]; ++t)
-      if (owner[std::size_t(t)] == comm.rank())
-        to = std::copy_n(local + std::size_t(wishes[std::size_t(t)] - mine.first) * plane_size, plane_size, to);
-  const int* my_owners = owner.data() + firsts[std::size_t(comm.rank())];
-  for (int t = 0; t < count; ++t) ++recv_counts[std::size_t(my_owners[t])];
-  std::vector<int> send_firsts(np, 0), recv_firsts(np, 0);
-  for (std::size_t r = 1; r < np; ++r) {
-    send_firsts[r] = send_firsts[r - 1] + send_counts[r - 1];
-    recv_firsts[r] = recv_firsts[r - 1] + recv_counts[r - 1];
+    for (int z = held[2 * r]; z < held[2 * r] + held[2 * r + 1]; ++z) holder[std::size_t(z)] = int(r);
+  for (int w : wishes)
+    if (w < 0 || w >= planes || holder[std::size_t(w)] < 0)
+      throw std::invalid_argument("planes: a wanted plane that no rank holds");  // every rank sees it
+  AlignedVector<double> out;
+  bool allocated = true;
+  try {
+    out.assign(wanted.size() * plane_size + zeros, 0.0);
+  } catch (const std::bad_alloc&) {
+    allocated = false;
   }
-  MPI_Datatype plane;  // counted in planes: the counts fit an int
+  if (comm.max(allocated ? 0.0 : 1.0) != 0.0) throw std::bad_alloc();
+  MPI_Datatype plane;
   MPI_Type_contiguous(int(plane_size), MPI_DOUBLE, &plane);
   MPI_Type_commit(&plane);
-  AlignedVector<double> received(wanted.size() * plane_size + zeros, 0.0);
-  MPI_Alltoallv(send.data(), send_counts.data(), send_firsts.data(), plane, received.data(), recv_counts.data(),
-                recv_firsts.data(), plane, comm.get());
-  MPI_Type_free(&plane);
-  send = AlignedVector<double>();
-  // Received by sender, each sender's planes in the wished order: that is the wished order where the
-  // wish goes from holder to holder in rank order (ascending planes do), else each is taken in turn.
-  if (std::is_sorted(my_owners, my_owners + count)) return received;
-  AlignedVector<double> out(received.size(), 0.0);
-  std::vector<int> next = recv_firsts;
-  for (int t = 0; t < count; ++t) {
-    const int from = next[std::size_t(my_owners[t])]++;
-    std::copy_n(received.begin() + std::ptrdiff_t(std::size_t(from) * plane_size), plane_size,
-                out.begin() + std::ptrdiff_t(std::size_t(t) * plane_size));
+  std::vector<int> sent, received;  // in planes: this rank's planes sent to `to`, the places of `from`'s
+  for (int k = 0; k < P; ++k) {
+    const int to = (me + k) % P, from = (me - k + P) % P;
+    sent.clear(), received.clear();
+    for (int t = firsts[std::size_t(to)]; t < firsts[std::size_t(to)] + counts[std::size_t(to)]; ++t)
+      if (const int w = wishes[std::size_t(t)]; holder[std::size_t(w)] == me) sent.push_back(w - mine.first);
+    for (int t = 0; t < count; ++t)
+      if (holder[std::size_t(wanted[std::size_t(t)])] == from) received.push_back(t);
+    MPI_Datatype send_type = plane, receive_type = plane;
+    if (!sent.empty()) {
+      MPI_Type_create_indexed_block(int(sent.size()), 1, sent.data(), plane, &send_type);
+      MPI_Type_commit(&send_type);
+    }
+    if (!received.empty()) {
+      MPI_Type_create_indexed_block(int(received.size()), 1, received.data(), plane, &receive_type);
+      MPI_Type_commit(&receive_type);
+    }
+    MPI_Sendrecv(local, sent.empty() ? 0 : 1, send_type, to, 0, out.data(), received.empty() ? 0 : 1, receive_type,
+                 from, 0, comm.get(), MPI_STATUS_IGNORE);
+    if (!sent.empty()) MPI_Type_free(&send_type);
+    if (!received.empty()) MPI_Type_free(&receive_type);
   }
+  MPI_Type_free(&plane);
   return out;
 }
 

@@ -531,8 +531,9 @@ void BlockAssembly<dim>::core_times_v(const Block& b, const Eigen::MatrixXd& cor
   const Interpolation<dim>&Lx = *x_interp[std::size_t(b.x)], &Ly = *y_interp[std::size_t(b.y)];
   const Eigen::MatrixXd& Vy = V[std::size_t(b.y)];  // q × |L_y|
   const auto nx = Eigen::Index(Lx.nodes[dim - 1].size()), ny = Eigen::Index(Ly.nodes[dim - 1].size());
-  const Eigen::Index rx = Lx.size() / nx, ry = Ly.size() / ny;  // the nodes of one plane
   out.setZero(core.rows(), Vy.rows());
+  if (nx == 0 || ny == 0) return;                               // a cluster without nodes
+  const Eigen::Index rx = Lx.size() / nx, ry = Ly.size() / ny;  // the nodes of one plane
   for (Eigen::Index j = 0; j < ny; ++j)
     for (Eigen::Index i = 0; i < nx; ++i) {
       const auto part = core.block(i * rx, j * ry, rx, ry);
@@ -619,18 +620,24 @@ void BlockAssembly<dim>::near_block(const Block& b, const std::vector<Index<dim>
 /// over the ranks (every block of a dense assembly; a batch of the kept ones): each group's near blocks,
 /// sorted by where their planes lie (the sum of the clusters' centres along the slowest axis), are cut
 /// into one run of equal work per rank, so that a rank's blocks read few planes and every rank has its
-/// share of each group. Only where that pays on every rank: where the visits a rank is spared are at
-/// least near_visits_per_fetched times the doubles it fetches (measured on the sphere: 4.8 lost time,
-/// 47 gained). Far blocks stay every rank's (their cores are linear in the planes held). Collective.
-/// Serially (or without a far field) every block is made here from the table itself.
+/// share of each group. The key is the plane of a_z + b_z (folded into the table), which the pairs of
+/// each run share: a box-centred γ's upper and lower halves read the same planes. Only where that pays
+/// on every rank: where the visits a rank is spared are at least near_visits_per_fetched times the
+/// doubles it fetches (chosen between two measurements on the sphere: 4.8 lost time, 47 gained), and
+/// the planes fetched are at most twice those the rank holds. Far blocks stay every rank's (their cores
+/// are linear in the planes held). Collective. Serially (or without a far field) every block is made
+/// here from the table itself.
 template <int dim>
 void BlockAssembly<dim>::share_near(const std::vector<std::vector<std::size_t>>& groups) {
   const Distribution& distribution = execution.distribution();
   if (!green.partial() || !compress) return;
   constexpr double near_visits_per_fetched = 16;
-  const int P = distribution.size(), z = dim - 1;
-  const auto center = [&](std::size_t k) {
-    return X->clusters[std::size_t(blocks[k].x)].box.center(z) + Y->clusters[std::size_t(blocks[k].y)].box.center(z);
+  const int P = distribution.size(), z = dim - 1, n = green.grid().n(z);
+  const bool periodic = green.grid().periodic();
+  const auto center = [&](std::size_t k) {  // the plane of a_z + b_z at the clusters' centres
+    const double sum =
+        X->clusters[std::size_t(blocks[k].x)].box.center(z) + Y->clusters[std::size_t(blocks[k].y)].box.center(z);
+    return periodic || sum <= n ? sum : 2.0 * n - sum;
   };
   std::vector<char> planes(std::size_t(green.planes()), 0);
   std::vector<std::size_t> near;
@@ -654,7 +661,8 @@ void BlockAssembly<dim>::share_near(const std::vector<std::vector<std::size_t>>&
     }
   }
   const double fetched = double(std::count(planes.begin(), planes.end(), 1)) * double(green.plane_size());
-  if (!distribution.all(visits * (P - 1) / P >= near_visits_per_fetched * fetched)) {
+  const double held = double(green.memory_bytes() / sizeof(double));  // this rank's planes and the zero plane
+  if (!distribution.all(visits * (P - 1) / P >= near_visits_per_fetched * fetched && fetched <= 2 * held)) {
     for (Block& b : blocks) b.here = true;
     return;
   }
@@ -680,13 +688,15 @@ void BlockAssembly<dim>::each(std::size_t n, const Work& work) {
         stop = true;
       }
   }
-  if (failure) std::rethrow_exception(failure);
-  if (stop) throw Interrupted();
+  // Distributed, every rank calls this in step and a collective step follows: a failure or an
+  // interruption on one rank is every rank's (serially: rethrown, or Interrupted).
+  execution.distribution().throw_first_failure(failure, stop);
 }
 
 /// Every block, dearest first, on the threads. The entries are linear in the table's values: with a
-/// partial table (a distributed run) each rank makes its part of every entry, and the dense blocks'
-/// parts are added by ExplicitSchur; the kept ones by fill_kept.
+/// partial table (a distributed run) each rank makes its planes' part of every far entry, and each near
+/// block is one rank's where share_near finds that pays (the others' parts are zeros), else every rank's
+/// part as the far ones. The dense blocks' parts are added by ExplicitSchur; the kept ones by fill_kept.
 template <int dim>
 void BlockAssembly<dim>::fill(std::vector<Eigen::MatrixXd>& out) {
   std::vector<Index<dim>> q_nodes;  // Q's entries' nodes and values, for the near blocks' sums
@@ -709,10 +719,10 @@ void BlockAssembly<dim>::fill(std::vector<Eigen::MatrixXd>& out) {
 }
 
 /// The kept blocks, in batches of them whose numbers (near: the entries; far: the core, G between the
-/// interpolation nodes) take about summed_chunk doubles. A batch's near entries and far cores are made
-/// (with a partial table: this rank's part), and each block is kept by one rank, chosen for equal work:
-/// the ranks' parts are summed onto it alone, and it compresses the block if it is far (cross
-/// approximation is not linear in the entries: it takes the sum).
+/// interpolation nodes, or that times V_yᵀ) take about summed_chunk doubles. A batch's near entries and
+/// far cores are made (with a partial table: this rank's part, as in fill), and each block is kept by
+/// one rank, chosen for equal work: the ranks' parts are summed onto it alone, and it compresses the
+/// block if it is far (cross approximation is not linear in the entries: it takes the sum).
 /// Serially every block is kept and comes out as in one pass.
 template <int dim>
 template <class Piece>

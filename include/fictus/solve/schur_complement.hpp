@@ -68,8 +68,9 @@ std::vector<int> interpolation_nodes(int lo, int hi, int order);
 struct FarFieldReport {
   double near_pairs = 0, far_pairs = 0;
   int near_blocks = 0, far_blocks = 0;
-  /// This rank's share: the near pairs it made (distributed, each near block is one rank's), and the
-  /// bytes of the table's whole planes it fetched for them (serially: all near pairs, no bytes).
+  /// This rank's share: the near pairs it made, and the bytes of the table's whole planes it fetched for
+  /// them. Distributed with a far field, each near block is one rank's where that pays; else (and
+  /// serially) every rank reports every near pair and no bytes.
   double near_pairs_here = 0, whole_planes_bytes = 0;
 };
 
@@ -276,7 +277,9 @@ Eigen::MatrixXd green_block(const GreenTable<dim>& green, const SparseRows& R, c
                             const Execution& execution = Execution{}, const FarField& far_field = {});
 /// The blocks R_k G Qᵀ of several row sets with the same number of rows at once: (G Qᵀ) is evaluated
 /// once per distinct node of the R_k (B_γ's nodes of x_i lie in C_γ's), so the exact cost is
-/// (distinct nodes)·nnz(Q) lookups.
+/// (distinct nodes)·nnz(Q) lookups. With a partial table (a distributed run) each rank gets its part
+/// of every entry (the ranks' parts add up to the entries), and the call is collective: every rank
+/// calls it with the same rows.
 template <int dim>
 std::vector<Eigen::MatrixXd> green_blocks(const GreenTable<dim>& green, const std::vector<const SparseRows*>& row_sets,
                                           const SparseRows& Q, const Execution& execution = Execution{},
