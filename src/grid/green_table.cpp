@@ -80,8 +80,7 @@ GreenTable<dim>::GreenTable(const GreenTable& table, const std::vector<char>& wa
   std::vector<int> list;
   for (std::size_t z = 0; z < wanted.size(); ++z)
     if (wanted[z]) list.push_back(int(z));
-  std::size_t entries = 1;
-  for (int d = 0; d < dim - 1; ++d) entries *= size_[d];
+  const std::size_t entries = plane_size();
   held_ = Slab{0, int(size_[dim - 1])};
   // The planes, then one of zeros: the planes not copied read it, and the node sums refuse them.
   if (table.partial_) {
