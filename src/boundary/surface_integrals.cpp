@@ -82,9 +82,29 @@ double area(const Triangle3& t) { return 0.5 * norm(cross(t.b - t.a, t.c - t.a))
 
 std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Triangle3>& triangles,
                                          const std::vector<int>& patch_of, int n_patches, const SurfaceMap& onto,
-                                         int threads) {
+                                         int threads, const Distribution& distribution) {
   if (patch_of.size() != triangles.size())
     throw std::invalid_argument("patch_integrals: one patch per triangle is needed");
+  for (int patch : patch_of)
+    if (patch < 0 || patch >= n_patches) throw std::invalid_argument("patch_integrals: patch out of range");
+  // The triangles this rank integrates, in order: all of them, or (distributed) those of its run of
+  // patches. A node's sum takes only its patch's triangles, so each rank's sums are the serial ones.
+  std::vector<std::size_t> mine;
+  if (!distribution.distributed()) {
+    mine.resize(triangles.size());
+    for (std::size_t t = 0; t < mine.size(); ++t) mine[t] = t;
+  } else {
+    std::vector<std::size_t> below(std::size_t(n_patches) + 1, 0);  // triangles of the patches before
+    for (int patch : patch_of) ++below[std::size_t(patch) + 1];
+    for (std::size_t p = 0; p < std::size_t(n_patches); ++p) below[p + 1] += below[p];
+    const auto first_patch = [&](int rank) {  // the first patch whose triangles start at or after rank's share
+      const std::size_t share = triangles.size() * std::size_t(rank) / std::size_t(distribution.size());
+      return int(std::lower_bound(below.begin(), below.end() - 1, share) - below.begin());
+    };
+    const int first = first_patch(distribution.rank()), last = first_patch(distribution.rank() + 1);
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      if (patch_of[t] >= first && patch_of[t] < last) mine.push_back(t);
+  }
   const double h = grid.h();
   const Box<3>& box = grid.box();
   // (patch, k, j, i) and value, for every piece's corner; sorted and merged at the end. Each thread
@@ -96,7 +116,6 @@ std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Tr
   };
   const auto add_triangle = [&](std::size_t t, auto& items) {
     const int patch = patch_of[t];
-    if (patch < 0 || patch >= n_patches) throw std::invalid_argument("patch_integrals: patch out of range");
     const Triangle3& tri = triangles[t];
     for (const Point3& p : {tri.a, tri.b, tri.c})
       for (int d = 0; d < 3; ++d)
@@ -147,14 +166,16 @@ std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Tr
 #pragma omp parallel for num_threads(teams) schedule(static, 1)
   for (int team = 0; team < teams; ++team) try {
       std::vector<Item>& items = items_of[std::size_t(team)];
-      const std::size_t first = triangles.size() * std::size_t(team) / std::size_t(teams),
-                        last = triangles.size() * std::size_t(team + 1) / std::size_t(teams);
-      for (std::size_t t = first; t < last; ++t) add_triangle(t, items);
+      const std::size_t first = mine.size() * std::size_t(team) / std::size_t(teams),
+                        last = mine.size() * std::size_t(team + 1) / std::size_t(teams);
+      for (std::size_t t = first; t < last; ++t) add_triangle(mine[t], items);
     } catch (...) {
       failure[std::size_t(team)] = std::current_exception();
     }
+  std::exception_ptr first_failure;
   for (const std::exception_ptr& e : failure)
-    if (e) std::rethrow_exception(e);
+    if (e && !first_failure) first_failure = e;
+  distribution.throw_first_failure(first_failure, false);  // on every rank: none goes on to the others' runs
   std::vector<Item> items;
   for (std::vector<Item>& run : items_of) items.insert(items.end(), run.begin(), run.end());
   // Sorted by patch, then by the node with i fastest; the sums over equal keys in a fixed order.
@@ -168,7 +189,7 @@ std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Tr
     if (value != 0.0) out.push_back({std::get<0>(key), {std::get<3>(key), std::get<2>(key), std::get<1>(key)}, value});
     k = e;
   }
-  return out;
+  return distribution.distributed() ? distribution.concatenate(out) : out;  // the runs in patch order
 }
 
 }  // namespace fictus

@@ -198,7 +198,7 @@ void SurfaceDiscretization::make_trace_rows(const SolverOptions& options, const 
       grid_,
       patch_integrals(grid_, Gamma_patches_.triangles, Gamma_patches_.patch_of, m,
                       options.variant == Variant::nonsmooth ? onto_surface(*gamma_, 1e-13 * h) : SurfaceMap{},
-                      execution_.threads()),
+                      execution_.threads(), execution_.distribution()),
       m);
   mark("geometry");
   execution_.throw_if_interrupted();

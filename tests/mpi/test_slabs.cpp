@@ -11,6 +11,7 @@
 #include "fictus/boundary/curve.hpp"
 #include "fictus/boundary/curve_grid_intersection.hpp"
 #include "fictus/boundary/surface.hpp"
+#include "fictus/boundary/surface_integrals.hpp"
 #include "fictus/boundary/surface_kink.hpp"
 #include "fictus/boundary/trace_operators.hpp"
 #include "fictus/grid/green_table.hpp"
@@ -572,6 +573,37 @@ TEST(SlabKink, RanksMakeTheSerialKinkRows) {
   const Eigen::SparseMatrix<double> difference = parts.direct(B) - serial.direct(B);
   EXPECT_GT(serial.direct(B).nonZeros(), 0);
   EXPECT_EQ(comm.max(difference.cwiseAbs().sum()), 0.0) << "the band differs from the serial one";
+}
+
+/// B_Γ's patch integrals with the patches shared out over the ranks (mapped onto γ, as in the non-smooth
+/// variant): the serial weights, bit for bit, on every rank; a triangle outside the box is an error on
+/// every rank, whichever rank integrates it.
+TEST(SlabPatchIntegrals, RanksMakeTheSerialWeights) {
+  const Communicator comm;
+  const fictus::Grid3 grid(fictus::Box3{{0, 0, 0}, {1, 1, 1}}, 24);
+  const fictus::Ellipsoid gamma({0.5, 0.48, 0.52}, {0.3, 0.25, 0.28});
+  const fictus::PatchedSurface patches = gamma.patches(40, grid.h());
+  const fictus::SurfaceMap onto = fictus::onto_surface(gamma, 1e-15);
+  const auto serial = fictus::patch_integrals(grid, patches.triangles, patches.patch_of, patches.m, onto, 2);
+  const fictus::mpi::SlabDistribution slabs(comm);
+  const auto parts = fictus::patch_integrals(grid, patches.triangles, patches.patch_of, patches.m, onto, 1, slabs);
+  ASSERT_GT(serial.size(), std::size_t(patches.m));
+  bool same = parts.size() == serial.size();
+  for (std::size_t k = 0; same && k < serial.size(); ++k)
+    same = parts[k].patch == serial[k].patch && parts[k].node == serial[k].node && parts[k].value == serial[k].value;
+  EXPECT_EQ(comm.max(same ? 0.0 : 1.0), 0.0) << "the patch integrals differ from the serial ones";
+  // The last patch's first triangle moved out of the box: the last rank's run holds it.
+  std::vector<fictus::Triangle3> broken = patches.triangles;
+  const auto last = std::find(patches.patch_of.begin(), patches.patch_of.end(), patches.m - 1);
+  ASSERT_NE(last, patches.patch_of.end());
+  broken[std::size_t(last - patches.patch_of.begin())].a.x = 1.5;
+  std::string message;
+  try {
+    fictus::patch_integrals(grid, broken, patches.patch_of, patches.m, onto, 1, slabs);
+  } catch (const std::invalid_argument& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("leaves the box"), std::string::npos) << "rank " << comm.rank() << ": " << message;
 }
 
 /// A sphere whose level gradient vanishes near one layer of nodes (z = 13/24 on a grid of 24 cells): the

@@ -7,6 +7,7 @@
 #include <functional>
 #include <vector>
 
+#include "fictus/grid/distribution.hpp"
 #include "fictus/grid/grid.hpp"
 #include "fictus/grid/point.hpp"
 
@@ -31,10 +32,12 @@ struct PatchWeight {
 /// maps a point x of a triangle with unit normal n to the surface and sets factor = dS_surface/dS_triangle
 /// there (the quadrature stays the pieces' rule: exact no longer, but free of the triangles' O(h²) offset).
 /// `threads` share the triangles (and may call `onto` at once); the answer does not depend on their number.
+/// Distributed, each rank integrates the triangles of one run of patches (of about equal triangle counts)
+/// and every rank takes all runs (collective): the answer is the serial one, bit for bit, on every rank.
 using SurfaceMap = std::function<Point3(const Point3& x, const Point3& normal, double& factor)>;
 std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Triangle3>& triangles,
                                          const std::vector<int>& patch_of, int n_patches, const SurfaceMap& onto = {},
-                                         int threads = 1);
+                                         int threads = 1, const Distribution& distribution = Distribution{});
 
 /// The area of a triangle.
 double area(const Triangle3& t);
