@@ -8,6 +8,7 @@
 #include <cmath>
 #include <vector>
 
+#include "fictus/grid/distribution.hpp"
 #include "fictus/grid/q1_element.hpp"
 #include "fictus/grid/quadrature.hpp"
 
@@ -220,18 +221,24 @@ GridVector omega_load(const Grid3& grid, const Surface& gamma, int q, const Exec
 double omega_integral(const Grid3& grid, const Surface& gamma, const VectorizedField3& f, int q,
                       const Execution& execution) {
   // One sum per voxel row, added in row order afterwards: the same total on any number of threads.
+  // Distributed, each rank sums the rows of its slab's voxel layers and the ranks' rows are added (each
+  // row one rank's, the others' zeros): the same total on every rank, and the serial one.
+  const Distribution& distribution = execution.distribution();
   const std::size_t rows_per_layer = std::size_t(grid.ny() + 1);
   std::vector<double> per_row(rows_per_layer * std::size_t(grid.nz() + 1), 0.0);
   std::vector<std::array<std::vector<double>, 4>> buffers(std::size_t(execution.threads()));
-  for_each_omega_row(grid, gamma, q, execution, [&](int thread, const std::vector<OmegaPoint>& row) {
-    auto& [x, y, z, value] = buffers[std::size_t(thread)];
-    x.resize(row.size()), y.resize(row.size()), z.resize(row.size()), value.resize(row.size());
-    for (std::size_t p = 0; p < row.size(); ++p) x[p] = row[p].x.x, y[p] = row[p].x.y, z[p] = row[p].x.z;
-    f(row.size(), x.data(), y.data(), z.data(), value.data());
-    double sum = 0;
-    for (std::size_t p = 0; p < row.size(); ++p) sum += row[p].weight * value[p];
-    per_row[std::size_t(row[0].cell[2]) * rows_per_layer + std::size_t(row[0].cell[1])] = sum;
-  });
+  for_each_omega_row(grid, gamma, q, execution, distribution.slab(grid),
+                     [&](int thread, const std::vector<OmegaPoint>& row) {
+                       auto& [x, y, z, value] = buffers[std::size_t(thread)];
+                       x.resize(row.size()), y.resize(row.size()), z.resize(row.size()), value.resize(row.size());
+                       for (std::size_t p = 0; p < row.size(); ++p)
+                         x[p] = row[p].x.x, y[p] = row[p].x.y, z[p] = row[p].x.z;
+                       f(row.size(), x.data(), y.data(), z.data(), value.data());
+                       double sum = 0;
+                       for (std::size_t p = 0; p < row.size(); ++p) sum += row[p].weight * value[p];
+                       per_row[std::size_t(row[0].cell[2]) * rows_per_layer + std::size_t(row[0].cell[1])] = sum;
+                     });
+  distribution.sum(per_row);
   double total = 0;
   for (double s : per_row) total += s;
   return total;

@@ -10,6 +10,7 @@
 
 #include "fictus/boundary/curve.hpp"
 #include "fictus/boundary/curve_grid_intersection.hpp"
+#include "fictus/boundary/omega_quadrature.hpp"
 #include "fictus/boundary/surface.hpp"
 #include "fictus/boundary/surface_integrals.hpp"
 #include "fictus/boundary/surface_kink.hpp"
@@ -323,6 +324,18 @@ TEST(SlabSteps, IntegralsOverOmegaMatchOneProcess) {
     check_omega<3>(grid3, [&](const GridVector& v, const fictus::OmegaSampleVisitor<3>& visit, std::optional<Slab> s) {
       fictus::for_each_omega_sample(v, grid3, ellipsoid, 3, execution, visit, s);
     });
+    // ∫_ω f with each rank's voxel layers: the serial total, bit for bit, on every rank.
+    const fictus::VectorizedField3 f = [](std::size_t n, const double* x, const double* y, const double* z,
+                                          double* out) {
+      for (std::size_t p = 0; p < n; ++p) out[p] = std::exp(x[p] - 0.3 * y[p]) * std::cos(2 * z[p]);
+    };
+    const double whole = fictus::omega_integral(grid3, ellipsoid, f, 3, execution);
+    fictus::set_process_distribution(std::make_shared<fictus::mpi::SlabDistribution>(Communicator()));
+    const double parts = fictus::omega_integral(grid3, ellipsoid, f, 3, fictus::Execution(1));
+    fictus::set_process_distribution(nullptr);
+    EXPECT_NE(whole, 0.0);
+    EXPECT_EQ(Communicator().max(parts == whole ? 0.0 : 1.0), 0.0)
+        << "integral of f over omega: " << parts << " on this rank, " << whole << " serially";
   }
 }
 

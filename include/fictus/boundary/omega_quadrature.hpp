@@ -51,7 +51,8 @@ GridVector omega_load(const Grid3& grid, const Surface& gamma, int q = 3, const 
                       std::optional<Slab> slab = std::nullopt);
 
 /// ∫_ω f by that rule, f evaluated one voxel row at a time and the rows summed in order (the same
-/// result on any number of threads).
+/// result on any number of threads). Distributed (`execution`'s distribution), each rank evaluates its
+/// slab's voxel layers and every rank gets the serial total (collective).
 double omega_integral(const Grid3& grid, const Surface& gamma, const VectorizedField3& f, int q = 3,
                       const Execution& execution = Execution{});
 
