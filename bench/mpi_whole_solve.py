@@ -4,8 +4,9 @@ and the agreement of λ and the force, from results.json and points.csv of `fict
   python3 bench/mpi_whole_solve.py [build] [case ...] [--against OTHER_BUILD] > bench/results/<date>-mpi-whole-solve.md
 
 (cases by their N: 4096, 128, 192, 256, 384; 384c and 512c for the compressed Schur complement, 192m for
-it with many points; 4096, 128 and 192 when none is given. With --against, every run on ranks of a
-compressed case is made with both builds, one after the other.)
+it with many points, 256n for the non-smooth variant; 4096, 128 and 192 when none is given. With
+--against, every run on ranks of the 384c, 512c, 192m and 256n cases is made with both builds, one after
+the other.)
 
 Cases: 2-D h = 1/4096 (the manufactured circle) and the 3-D sphere of bench/sphere_contact.toml at
 N = 128, 192, 256 and 384 (where a grid array is 429 MiB); serially with 2 threads (with the Schur complement
@@ -62,6 +63,10 @@ for N in ("384", "512"):
 CASES.append(("3-D sphere, N = 192, m = 6000, compressed", os.path.join(here, "sphere_contact.toml"),
               ["--N", "192", "--multipliers", "6000"], "m"))
 MANY_POINTS_RUNS = [COMPRESSED_RUNS[0], COMPRESSED_RUNS[1], ("3 ranks, compressed S (oversubscribed)", 3, 1, COMPRESSED)]
+# The non-smooth variant (kink rows, flux balance, ∫_ω f): its boundary setup is the largest.
+CASES.append(("3-D sphere, N = 256, non-smooth", os.path.join(here, "sphere_contact.toml"),
+              ["--N", "256", "--variant", "nonsmooth"], "n"))
+NONSMOOTH_RUNS = [RUNS[0], RUNS[2], RUNS[3]]
 chosen = args[1:] or ["4096", "128", "192"]
 CASES = [c for c in CASES if c[2][1] + (c[3] if len(c) > 3 else "") in chosen]
 
@@ -95,12 +100,12 @@ print("  ranks. Time: results.json's total; memory: each rank's peak (VmHWM), th
 print("- λ and the force against the first serial run: max |Δλ| / max |λ|, and |ΔF| / |F|.\n")
 if other:
     print(f"- Runs marked {other} are that build's, the others {build}'s.")
-print("| case | run | m | Schur | Newton steps | time [s] | schur, newton [s] | peak of a rank [MiB] "
+print("| case | run | m | Schur | Newton steps | time [s] | geometry, schur, newton [s] | peak of a rank [MiB] "
       "| peaks summed [MiB] | Δλ | ΔF |")
 print("|---|---|---|---|---|---|---|---|---|---|---|")
 for n_case, (case, problem, flags, *kind) in enumerate(CASES):
     reference = None
-    runs = {(): RUNS, ("c",): COMPRESSED_RUNS, ("m",): MANY_POINTS_RUNS}[tuple(kind)]
+    runs = {(): RUNS, ("c",): COMPRESSED_RUNS, ("m",): MANY_POINTS_RUNS, ("n",): NONSMOOTH_RUNS}[tuple(kind)]
     if other and kind:
         runs = [(r[0] + (f", {other}" if b else ""), *r[1:], b) for r in runs for b in ([0, 1] if r[1] else [0])]
     for n_run, (name, ranks, threads, extra, *by_other) in enumerate(runs):
@@ -116,5 +121,6 @@ for n_case, (case, problem, flags, *kind) in enumerate(CASES):
         storage = ((results.get("inner") or {}).get("schur_storage") or {}).get("kind", "")
         print(f"| {case} | {name}, {max(ranks, 1)} × {threads} | {results['multipliers']} | {storage} "
               f"| {results['newton']['iterations']} | {results['timings']['total']:.2f} "
-              f"| {results['timings']['schur']:.1f}, {results['timings']['newton']:.1f} "
+              f"| {results['timings'].get('geometry', 0):.1f}, {results['timings']['schur']:.1f}, "
+              f"{results['timings']['newton']:.1f} "
               f"| {max(peaks) / 2**20:.0f} | {sum(peaks) / 2**20:.0f} | {dl:.1e} | {df:.1e} |", flush=True)
