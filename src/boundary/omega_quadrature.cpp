@@ -6,6 +6,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <exception>
 #include <vector>
 
 #include "fictus/grid/distribution.hpp"
@@ -227,17 +228,22 @@ double omega_integral(const Grid3& grid, const Surface& gamma, const VectorizedF
   const std::size_t rows_per_layer = std::size_t(grid.ny() + 1);
   std::vector<double> per_row(rows_per_layer * std::size_t(grid.nz() + 1), 0.0);
   std::vector<std::array<std::vector<double>, 4>> buffers(std::size_t(execution.threads()));
-  for_each_omega_row(grid, gamma, q, execution, distribution.slab(grid),
-                     [&](int thread, const std::vector<OmegaPoint>& row) {
-                       auto& [x, y, z, value] = buffers[std::size_t(thread)];
-                       x.resize(row.size()), y.resize(row.size()), z.resize(row.size()), value.resize(row.size());
-                       for (std::size_t p = 0; p < row.size(); ++p)
-                         x[p] = row[p].x.x, y[p] = row[p].x.y, z[p] = row[p].x.z;
-                       f(row.size(), x.data(), y.data(), z.data(), value.data());
-                       double sum = 0;
-                       for (std::size_t p = 0; p < row.size(); ++p) sum += row[p].weight * value[p];
-                       per_row[std::size_t(row[0].cell[2]) * rows_per_layer + std::size_t(row[0].cell[1])] = sum;
-                     });
+  const OmegaRowVisitor sum_row = [&](int thread, const std::vector<OmegaPoint>& row) {
+    auto& [x, y, z, value] = buffers[std::size_t(thread)];
+    x.resize(row.size()), y.resize(row.size()), z.resize(row.size()), value.resize(row.size());
+    for (std::size_t p = 0; p < row.size(); ++p) x[p] = row[p].x.x, y[p] = row[p].x.y, z[p] = row[p].x.z;
+    f(row.size(), x.data(), y.data(), z.data(), value.data());
+    double sum = 0;
+    for (std::size_t p = 0; p < row.size(); ++p) sum += row[p].weight * value[p];
+    per_row[std::size_t(row[0].cell[2]) * rows_per_layer + std::size_t(row[0].cell[1])] = sum;
+  };
+  std::exception_ptr failure;  // (an interruption on one rank is thrown on every rank, before the sum)
+  try {
+    for_each_omega_row(grid, gamma, q, execution, distribution.slab(grid), sum_row);
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  distribution.throw_first_failure(failure, false);
   distribution.sum(per_row);
   double total = 0;
   for (double s : per_row) total += s;

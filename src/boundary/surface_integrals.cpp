@@ -85,6 +85,7 @@ std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Tr
                                          int threads, const Distribution& distribution) {
   if (patch_of.size() != triangles.size())
     throw std::invalid_argument("patch_integrals: one patch per triangle is needed");
+  if (n_patches < 0) throw std::invalid_argument("patch_integrals: a negative number of patches");
   for (int patch : patch_of)
     if (patch < 0 || patch >= n_patches) throw std::invalid_argument("patch_integrals: patch out of range");
   // The triangles this rank integrates, in order: all of them, or (distributed) those of its run of

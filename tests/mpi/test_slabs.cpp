@@ -605,6 +605,18 @@ TEST(SlabPatchIntegrals, RanksMakeTheSerialWeights) {
   for (std::size_t k = 0; same && k < serial.size(); ++k)
     same = parts[k].patch == serial[k].patch && parts[k].node == serial[k].node && parts[k].value == serial[k].value;
   EXPECT_EQ(comm.max(same ? 0.0 : 1.0), 0.0) << "the patch integrals differ from the serial ones";
+  // Runs over patches without triangles (every other one, and the last three), and over fewer patches
+  // than ranks (one: the other ranks' runs are empty).
+  std::vector<int> spread = patches.patch_of, one(patches.patch_of.size(), 0);
+  for (int& p : spread) p *= 2;
+  for (const auto& [labels, count] : {std::pair{spread, 2 * patches.m + 2}, std::pair{one, 1}}) {
+    const auto want = fictus::patch_integrals(grid, patches.triangles, labels, count, onto, 2);
+    const auto got = fictus::patch_integrals(grid, patches.triangles, labels, count, onto, 1, slabs);
+    bool equal = got.size() == want.size();
+    for (std::size_t k = 0; equal && k < want.size(); ++k)
+      equal = got[k].patch == want[k].patch && got[k].node == want[k].node && got[k].value == want[k].value;
+    EXPECT_EQ(comm.max(equal ? 0.0 : 1.0), 0.0) << count << " patches: the weights differ from the serial ones";
+  }
   // The last patch's first triangle moved out of the box: the last rank's run holds it.
   std::vector<fictus::Triangle3> broken = patches.triangles;
   const auto last = std::find(patches.patch_of.begin(), patches.patch_of.end(), patches.m - 1);

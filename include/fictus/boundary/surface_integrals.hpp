@@ -34,6 +34,7 @@ struct PatchWeight {
 /// `threads` share the triangles (and may call `onto` at once); the answer does not depend on their number.
 /// Distributed, each rank integrates the triangles of one run of patches (of about equal triangle counts)
 /// and every rank takes all runs (collective): the answer is the serial one, bit for bit, on every rank.
+/// The triangles and `patch_of` must then be the same on every rank.
 using SurfaceMap = std::function<Point3(const Point3& x, const Point3& normal, double& factor)>;
 std::vector<PatchWeight> patch_integrals(const Grid3& grid, const std::vector<Triangle3>& triangles,
                                          const std::vector<int>& patch_of, int n_patches, const SurfaceMap& onto = {},
