@@ -58,19 +58,17 @@ std::vector<Triangle3> offset_triangles(const std::vector<Triangle3>& triangles,
   return out;
 }
 
-/// Whether x, projected onto the plane of t, falls inside t (edges included) and lies within t's longest
-/// edge of that plane.
+/// Whether x, projected onto the plane of t, falls inside t (edges included) and lies no farther from that
+/// plane than t's longest edge.
 bool lies_over(const Triangle3& t, const Point3& x) {
-  const Point3 u = t.b - t.a, v = t.c - t.a, q = x - t.a;
-  const double uu = dot(u, u), uv = dot(u, v), vv = dot(v, v), qu = dot(q, u), qv = dot(q, v);
-  const double det = uu * vv - uv * uv;
-  if (!(det > 0)) return false;
-  const double b = (vv * qu - uv * qv) / det, c = (uu * qv - uv * qu) / det;
+  const Point3 u = t.b - t.a, v = t.c - t.a, q = x - t.a, n = cross(u, v);
+  const double nn = dot(n, n);
+  if (!(nn > 1e-24 * dot(u, u) * dot(v, v))) return false;  // degenerate, or not finite
+  const double along_u = dot(cross(q, v), n) / nn, along_v = dot(cross(u, q), n) / nn;
   constexpr double slack = 1e-12;
-  if (b < -slack || c < -slack || b + c > 1 + slack) return false;
-  const Point3 n = cross(u, v);
-  const double height = std::abs(dot(q, n)) / norm(n);
-  return height <= std::sqrt(std::max({uu, vv, dot(t.c - t.b, t.c - t.b)}));
+  if (!(along_u >= -slack && along_v >= -slack && along_u + along_v <= 1 + slack)) return false;
+  const double longest = std::max({dot(u, u), dot(v, v), dot(t.c - t.b, t.c - t.b)});
+  return dot(q, n) * dot(q, n) <= longest * nn;
 }
 
 }  // namespace
@@ -160,31 +158,32 @@ void SurfaceDiscretization::place_points(const SolverOptions& options, const Par
       std::any_of(part_layout_.begin(), part_layout_.end(), [&](int c) { return c != part_layout_[0]; })) {
     split_ = true;
     if (keep_unsplit && !unsplit_) unsplit_ = std::make_shared<const PatchedSurface>(gamma_patches_);
-    // The patches again, each in one part. A patch's point: the foot on γ of its centroid, as without
-    // parts, where the centroid lies over one of the patch's own triangles; else (a patch bent round a
-    // junction) the foot of the centroid of its triangle nearest to its centroid, so that the point
-    // stays inside the patch. (Every point at a triangle's centroid moved it by up to half an edge from
-    // the centroid: the patch-area rule Σ a_i g(x_i) of the flux balance lost its second order.)
+    // The patches again, each in one part. A patch's point: the foot on γ of its centroid where the
+    // centroid lies over one of the patch's own triangles and the foot is in the patch's part; else (e.g.
+    // a patch bent round a junction) the foot of the centroid of its triangle nearest to its centroid,
+    // which stays inside the patch. (Every point at such a triangle's centroid, up to half an edge from
+    // the patch's centroid, cost the patch-area rule Σ a_i g(x_i) of the flux balance its second order.)
     std::vector<int> patch_labels;
     const std::vector<Point3> seeds = split_into_patches(gamma_patches_, plan_.m, part_layout_, &patch_labels);
     const std::vector<Triangle3>& triangles = gamma_patches_.triangles;
-    std::vector<Point3> start(std::size_t(plan_.m));
+    std::vector<Point3> nearest(std::size_t(plan_.m));
     std::vector<double> best(std::size_t(plan_.m), 1e300);
     std::vector<char> over_own(std::size_t(plan_.m), 0);
     for (std::size_t t = 0; t < triangles.size(); ++t) {
       const std::size_t p = std::size_t(gamma_patches_.patch_of[t]);
-      const Point3 c = (1.0 / 3) * (triangles[t].a + triangles[t].b + triangles[t].c);
-      if (const double d = norm(c - seeds[p]); d < best[p]) best[p] = d, start[p] = c;
+      const Point3 centroid = (1.0 / 3) * (triangles[t].a + triangles[t].b + triangles[t].c);
+      if (const double d = norm(centroid - seeds[p]); d < best[p]) best[p] = d, nearest[p] = centroid;
       if (!over_own[p] && lies_over(triangles[t], seeds[p])) over_own[p] = 1;
     }
-    for (std::size_t p = 0; p < start.size(); ++p)
-      if (over_own[p]) start[p] = seeds[p];
     const Box3 bounds = gamma.bounds();
     const double tolerance = 1e-13 * std::max({bounds.width(0), bounds.width(1), bounds.width(2)});
-    for (int p = 0; p < plan_.m; ++p) {
-      const SurfaceFoot foot = nearest_point(gamma, start[std::size_t(p)], start[std::size_t(p)], tolerance);
-      gamma_patches_.point[std::size_t(p)] = foot.foot;
-      gamma_patches_.normal[std::size_t(p)] = foot.normal;
+    for (std::size_t p = 0; p < nearest.size(); ++p) {
+      SurfaceFoot foot;
+      if (over_own[p]) foot = nearest_point(gamma, seeds[p], seeds[p], tolerance);
+      if (!over_own[p] || parts.label(foot.foot) != patch_labels[p])
+        foot = nearest_point(gamma, nearest[p], nearest[p], tolerance);
+      gamma_patches_.point[p] = foot.foot;
+      gamma_patches_.normal[p] = foot.normal;
     }
     point_parts_.assign(patch_labels.size(), PointCondition::signorini);
     for (std::size_t p = 0; p < patch_labels.size(); ++p)

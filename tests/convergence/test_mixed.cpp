@@ -280,7 +280,8 @@ void mixed_3d(const std::string& name, const std::vector<int>& sizes, fictus::Va
   for (const fictus::LevelResult& r : rows) {
     fictus::SurfaceProblem q = signorini;
     q.N = r.N;
-    const double e = fictus::solve(q, options<3>(variant)).errors->rel_l2_omega;
+    const double e =
+        r.N == pure.grid.nx() ? pure.errors->rel_l2_omega : fictus::solve(q, options<3>(variant)).errors->rel_l2_omega;
     std::cout << "N = " << r.N << ": " << r.l2_omega << " with the caps, " << e << " without (ratio " << r.l2_omega / e
               << ")\n";
     EXPECT_NEAR(r.l2_omega / e, 1.0, spread) << "N = " << r.N << ": " << r.l2_omega << " against " << e;
@@ -291,7 +292,8 @@ void mixed_3d(const std::string& name, const std::vector<int>& sizes, fictus::Va
 // Measured against the Signorini problem on all of γ (ratios at the three N): sphere smooth 1.22, 0.85,
 // 0.99, non-smooth 1.00, 0.96, 1.04; torus smooth 1.06, 1.00, 1.10, non-smooth 1.05, 0.94, 1.17. With
 // every point at its nearest triangle's centroid the non-smooth sphere's were 1.04, 1.24, 1.67 (order
-// 1.49) and the torus's 1.14, 2.08, 7.4 (its error grew with N, order −2.3).
+// 1.49) and the torus's 1.14, 2.08, 7.4 (its error grew with N, order −2.25). The smooth sphere's 1.22
+// is at N = 64, before its errors settle (order 3.8 over the three N).
 TEST(Mixed3d, SphereSmooth) { mixed_3d("sphere", {64, 96, 128}, fictus::Variant::smooth, 1.8, 0.3); }
 TEST(Mixed3d, SphereNonSmooth) { mixed_3d("sphere", {64, 96, 128}, fictus::Variant::nonsmooth, 1.8, 0.3); }
 // The torus (several minutes) carries the label slow.
