@@ -216,7 +216,8 @@ json solution_to_json(const BasicProblem<dim>& problem, const BasicSolution<dim>
                                {"min_normal_derivative", s.check->min_normal_derivative},
                                {"max_complementarity", s.check->max_complementarity},
                                {"max_difference", s.check->max_difference},
-                               {"rms_difference", s.check->rms_difference}};
+                               {"rms_difference", s.check->rms_difference},
+                               {"relative_difference", s.check->relative_difference}};
   const ContactSummary contact = contact_summary(s);
   j["contact"] = {{"points", contact.points},
                   {"measure", contact.measure},

@@ -438,6 +438,8 @@ void write_surface_vtp(std::ostream& out, const SurfaceSolution& s) {
   std::vector<std::pair<std::string, const std::vector<double>*>> values = {
       {"g", &s.g},   {"u", &s.trace},       {"dudn", &s.normal_derivative},
       {"gap", &gap}, {"contact", &contact}, {"condition", &condition}};
+  if (s.check && s.check->normal_derivative.size() == s.trace.size())
+    values.push_back({"dudn_check", &s.check->normal_derivative});
   if (s.options.variant == Variant::nonsmooth) values.push_back({"lambda", &s.lambda});
   write_patched(out, s.gamma, values, s.options.threads);
 }

@@ -116,6 +116,7 @@ py::dict signorini(const BasicSolution<dim>& s) {
     check["max_complementarity"] = k->max_complementarity;
     check["max_difference"] = k->max_difference;
     check["rms_difference"] = k->rms_difference;
+    check["relative_difference"] = k->relative_difference;
     d["check"] = check;
   }
   return d;

@@ -152,8 +152,11 @@ def test_trace_rule_and_independent_check():
     assert new.errors["rel_l2_omega"] < 0.1 * old.errors["rel_l2_omega"]  # 5.8e-4 vs 2.0e-2
     for s in (new, old):
         check = s.signorini["check"]
-        assert set(check) == {"rule", "min_normal_derivative", "max_complementarity", "max_difference", "rms_difference"}
+        assert set(check) == {"rule", "min_normal_derivative", "max_complementarity", "max_difference",
+                              "rms_difference", "relative_difference"}
         assert check["max_difference"] >= check["rms_difference"] >= 0
+        assert 0 < check["relative_difference"] == pytest.approx(
+            check["rms_difference"] / np.max(np.abs(s.dudn)), rel=1e-12)
     assert "kink-corrected" in new.signorini["check"]["rule"]
     assert new.errors["max_normal_derivative_at_points"] < old.errors["max_normal_derivative_at_points"]
 

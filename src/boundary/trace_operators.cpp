@@ -8,6 +8,7 @@
 
 #include <Eigen/Dense>
 
+#include "fictus/boundary/surface.hpp"
 #include "fictus/grid/q1_element.hpp"
 #include "fictus/grid/quadrature.hpp"
 
@@ -138,59 +139,102 @@ SparseRows normal_derivative_rows_centered(const Grid2& grid, const std::vector<
   return rows;
 }
 
-SparseRows one_sided_rows(const CurveGridIntersection& gamma, const std::vector<Point2>& points,
-                          const std::vector<Point2>& normals, OneSidedTrace trace, int degree, double radius) {
+namespace {
+
+/// The one-sided least-squares rows of one_sided_rows (trace_operators.hpp) on a grid of either
+/// dimension; `inside(node)` says whether a node lies in ω.
+template <int dim, class Inside>
+SparseRows one_sided_fit(const Grid<dim>& grid, const Inside& inside, const std::vector<Point<dim>>& points,
+                         const std::vector<Point<dim>>& normals, OneSidedTrace trace, int degree, double radius) {
   if (points.size() != normals.size()) throw std::invalid_argument("one_sided_rows: size mismatch");
   if (degree < 1 || degree > 2) throw std::invalid_argument("one_sided_rows: degree must be 1 or 2");
-  const Grid2& grid = gamma.grid();
   const double h = grid.h();
-  const int n_terms = degree == 1 ? 3 : 6;  // 1, ξ, η (+ ξ²/2, ξη, η²/2), ξ = (x − x_i)/h
+  // 1, ξ_d (+ ξ_a ξ_b, halved where a = b, for a ≤ b), ξ = (x − x_i)/h; in 2-D 1, ξ, η, ξ²/2, ξη, η²/2
+  const int n_terms = degree == 1 ? 1 + dim : 1 + dim + dim * (dim + 1) / 2;
   SparseRows rows;
   RowBuilder builder(grid, rows);
-  std::vector<std::array<int, 2>> nodes;
-  std::vector<double> dx, dy, w;
+  std::vector<typename Grid<dim>::Index> nodes;
+  std::vector<Point<dim>> offsets;
+  std::vector<double> w;
   Eigen::MatrixXd M;
   Eigen::VectorXd W;
   for (std::size_t r = 0; r < points.size(); ++r) {
-    const Point2 p = points[r], n = normals[r];
-    // Nodes of ω in a disc around x_i; the disc grows by ½ cell until the fit is well posed.
+    const Point<dim> p = points[r], n = normals[r];
+    // Nodes of ω in a ball around x_i; the ball grows by ½ cell until the fit is well posed.
     for (double R = radius;; R += 0.5) {
       if (R > radius + 8) throw std::runtime_error("one_sided_rows: too few nodes of ω near a collocation point");
-      nodes.clear(), dx.clear(), dy.clear(), w.clear();
-      const double cx = (p.x - grid.box().lower.x) / h, cy = (p.y - grid.box().lower.y) / h;
-      for (int j = std::max(int(std::floor(cy - R)), 0); j <= std::min(int(std::ceil(cy + R)), grid.ny()); ++j)
-        for (int i = std::max(int(std::floor(cx - R)), 0); i <= std::min(int(std::ceil(cx + R)), grid.nx()); ++i) {
-          const double ex = (grid.x(i) - p.x) / h, ey = (grid.y(j) - p.y) / h;
-          const double d2 = ex * ex + ey * ey;
-          if (d2 > R * R || !gamma.node_inside(i, j)) continue;
-          nodes.push_back({i, j});
-          dx.push_back(ex), dy.push_back(ey);
+      nodes.clear(), offsets.clear(), w.clear();
+      typename Grid<dim>::Index lo, hi, node;
+      bool empty = false;
+      for (int d = 0; d < dim; ++d) {
+        const double c = std::clamp((p[d] - grid.box().lower[d]) / h, -R - 1, grid.n(d) + R + 1);  // NaN stays NaN
+        if (!std::isfinite(c)) {
+          empty = true;
+          break;
+        }
+        lo[d] = std::max(int(std::floor(c - R)), 0), hi[d] = std::min(int(std::ceil(c + R)), grid.n(d));
+        empty = empty || lo[d] > hi[d];
+      }
+      if (empty) break;  // p not finite or outside the box: refused below
+      node = lo;
+      for (;;) {  // the first axis fastest
+        Point<dim> e;
+        double d2 = 0;
+        for (int d = 0; d < dim; ++d) e[d] = (grid.coordinate(d, node[d]) - p[d]) / h, d2 += e[d] * e[d];
+        if (d2 <= R * R && inside(node)) {
+          nodes.push_back(node);
+          offsets.push_back(e);
           const double q = 1.0 - d2 / (R * R);
           w.push_back(std::sqrt(q * q + 1e-3));  // square root of the weight
         }
+        int d = 0;
+        while (d < dim && node[d] == hi[d]) node[d] = lo[d], ++d;
+        if (d == dim) break;
+        ++node[d];
+      }
       const int K = int(nodes.size());
       if (K < 2 * n_terms) continue;
       M.resize(K, n_terms);
       W.resize(K);
       for (int k = 0; k < K; ++k) {
-        M(k, 0) = w[k], M(k, 1) = w[k] * dx[k], M(k, 2) = w[k] * dy[k];
+        const Point<dim>& e = offsets[std::size_t(k)];
+        int t = 0;
+        M(k, t++) = w[k];
+        for (int d = 0; d < dim; ++d) M(k, t++) = w[k] * e[d];
         if (degree == 2)
-          M(k, 3) = w[k] * 0.5 * dx[k] * dx[k], M(k, 4) = w[k] * dx[k] * dy[k], M(k, 5) = w[k] * 0.5 * dy[k] * dy[k];
+          for (int a = 0; a < dim; ++a)
+            for (int b = a; b < dim; ++b) M(k, t++) = w[k] * (a == b ? 0.5 : 1.0) * e[a] * e[b];
         W(k) = w[k];
       }
       const Eigen::JacobiSVD<Eigen::MatrixXd> svd(M);
       const auto& sv = svd.singularValues();
       if (sv(n_terms - 1) > 1e-3 * sv(0)) break;
     }
+    if (int(nodes.size()) < 2 * n_terms)
+      throw std::runtime_error("one_sided_rows: too few nodes of ω near a collocation point");
     // Coefficients of the fit as linear functionals of the nodal values: (WM)⁺W.
     const Eigen::MatrixXd coefficients = M.completeOrthogonalDecomposition().pseudoInverse() * W.asDiagonal();
-    for (int k = 0; k < int(nodes.size()); ++k)
-      builder.add(nodes[k][0], nodes[k][1],
-                  trace == OneSidedTrace::value ? coefficients(0, k)
-                                                : (n.x * coefficients(1, k) + n.y * coefficients(2, k)) / h);
+    for (int k = 0; k < int(nodes.size()); ++k) {
+      double value = coefficients(0, k);
+      if (trace == OneSidedTrace::normal_derivative) {
+        value = 0;
+        for (int d = 0; d < dim; ++d) value += n[d] * coefficients(1 + d, k);
+        value /= h;
+      }
+      builder.add(nodes[std::size_t(k)], value);
+    }
     builder.end_row();
   }
   return rows;
+}
+
+}  // namespace
+
+SparseRows one_sided_rows(const CurveGridIntersection& gamma, const std::vector<Point2>& points,
+                          const std::vector<Point2>& normals, OneSidedTrace trace, int degree, double radius) {
+  return one_sided_fit<2>(
+      gamma.grid(), [&](const Grid2::Index& node) { return gamma.node_inside(node[0], node[1]); }, points, normals,
+      trace, degree, radius);
 }
 
 SparseRows arc_integral_rows(const CurveGridIntersection& geometry, const std::vector<double>& arc_begin,
@@ -287,6 +331,14 @@ SparseRows normal_derivative_rows_centered(const Grid3& grid, const std::vector<
     builder.end_row();
   }
   return rows;
+}
+
+SparseRows one_sided_rows(const Grid3& grid, const Surface& gamma, const std::vector<Point3>& points,
+                          const std::vector<Point3>& normals, OneSidedTrace trace, int degree, double radius) {
+  const auto inside = [&](const Grid3::Index& node) {
+    return gamma.level({grid.coordinate(0, node[0]), grid.coordinate(1, node[1]), grid.coordinate(2, node[2])}) < 0;
+  };
+  return one_sided_fit<3>(grid, inside, points, normals, trace, degree, radius);
 }
 
 SparseRows patch_integral_rows(const Grid3& grid, const std::vector<PatchWeight>& weights, int n_patches) {

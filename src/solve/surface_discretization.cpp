@@ -311,9 +311,19 @@ void SurfaceDiscretization::finish_readings(const std::vector<double>& lambda,
       kink_->balance * Eigen::Map<const Eigen::VectorXd>(lambda.data(), m);
 }
 
-std::optional<std::vector<double>> SurfaceDiscretization::independent_normal_derivative(const GridVector&,
-                                                                                        std::string&) const {
-  return std::nullopt;
+std::optional<std::vector<double>> SurfaceDiscretization::independent_normal_derivative(const GridVector& u,
+                                                                                        std::string& rule) const {
+  // Both variants: only nodes of ω enter, so the kink of the non-smooth field on γ does not.
+  rule = "one-sided quadratic least-squares fit through the nodes of omega";
+  std::optional<SparseRows> rows;
+  try {  // the same on every rank: the rows are made from γ alone
+    rows.emplace(one_sided_rows(grid_, *gamma_, points(), normals(), OneSidedTrace::normal_derivative, 2, 2.5));
+  } catch (const std::runtime_error&) {  // ω too thin for the fit: no check, not a failed solve
+    return std::nullopt;
+  }
+  std::vector<double> d;
+  read_rows(*rows, grid_, u, execution_.distribution(), d);
+  return d;
 }
 
 void SurfaceDiscretization::for_each_omega_sample(const GridVector& u, int quadrature,

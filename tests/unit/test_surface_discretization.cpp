@@ -75,6 +75,34 @@ TEST(SurfaceRows, CenteredNormalDerivativeIsExactForQuadratics) {
     EXPECT_NEAR(apply_row(shifted, r, grid, linear), fictus::dot(normals[r], Point3{1, -2, 4}), 1e-11);
 }
 
+TEST(SurfaceRows, OneSidedRowsUseNodesOfOmegaOnlyAndReproduceQuadratics) {
+  // The independent check's ∂u/∂n (docs/math.md, "Checks"): a quadratic inside ω and anything outside.
+  const fictus::Ellipsoid ellipsoid({0.52, 0.49, 0.5}, {0.3, 0.25, 0.2});
+  const fictus::Grid3 fine(fictus::Box3{}, 32);
+  const fictus::PatchedSurface patches = ellipsoid.patches(60, fine.h());
+  const auto D =
+      fictus::one_sided_rows(fine, ellipsoid, patches.point, patches.normal, fictus::OneSidedTrace::normal_derivative);
+  const auto V = fictus::one_sided_rows(fine, ellipsoid, patches.point, patches.normal, fictus::OneSidedTrace::value);
+  ASSERT_EQ(D.n_rows(), 60);
+  auto inside = [&](const auto& e) { return ellipsoid.level({fine.x(e.i), fine.y(e.j), fine.z(e.k)}) < 0; };
+  for (const auto& e : D.entries) EXPECT_TRUE(inside(e));
+  auto u = [](double x, double y, double z) { return x * x + y * z - 2 * z * z + x - 3 * x * y + 0.5 * y * y; };
+  auto gradient = [](const Point3& p) { return Point3{2 * p.x + 1 - 3 * p.y, p.z - 3 * p.x + p.y, p.y - 4 * p.z}; };
+  for (int r = 0; r < 60; ++r) {
+    const Point3 p = patches.point[r];
+    EXPECT_NEAR(apply_row(V, r, fine, u), u(p.x, p.y, p.z), 1e-11);
+    EXPECT_NEAR(apply_row(D, r, fine, u), fictus::dot(patches.normal[r], gradient(p)), 1e-9);
+    EXPECT_GE(D.row_begin[r + 1] - D.row_begin[r], 20u);  // at least twice the 10 terms
+  }
+  // A point with no node of ω near it: no fit, an error the check turns into "no check".
+  const std::vector<Point3> far = {{0.05, 0.05, 0.05}};
+  EXPECT_THROW(fictus::one_sided_rows(fine, ellipsoid, far, {{1, 0, 0}}, fictus::OneSidedTrace::value),
+               std::runtime_error);
+  const std::vector<Point3> nan = {{std::nan(""), 0.5, 0.5}};
+  EXPECT_THROW(fictus::one_sided_rows(fine, ellipsoid, nan, {{1, 0, 0}}, fictus::OneSidedTrace::value),
+               std::runtime_error);
+}
+
 TEST(SurfaceRows, PatchRowsAddUpToThePatchAreas) {
   const fictus::Ellipsoid ellipsoid({0.5, 0.5, 0.5}, {0.3, 0.25, 0.2});
   const fictus::PatchedSurface patches = ellipsoid.patches(20, grid.h());

@@ -15,6 +15,8 @@
 
 namespace fictus {
 
+class Surface;
+
 SparseRows point_value_rows(const Grid2& grid, const std::vector<Point2>& points);
 
 /// shift: distance (length units) from x_i into ω along −n_i where the gradient is taken.
@@ -50,6 +52,10 @@ SparseRows normal_derivative_rows(const Grid3& grid, const std::vector<Point3>& 
                                   const std::vector<Point3>& normals, double shift);
 SparseRows normal_derivative_rows_centered(const Grid3& grid, const std::vector<Point3>& points,
                                            const std::vector<Point3>& normals);
+/// One-sided traces from the nodes of ω only (level < 0), as the 2-D rows above: p the weighted
+/// least-squares polynomial of `degree` in x, y, z (10 terms for degree 2) within `radius` cells of x_i.
+SparseRows one_sided_rows(const Grid3& grid, const Surface& gamma, const std::vector<Point3>& points,
+                          const std::vector<Point3>& normals, OneSidedTrace trace, int degree = 2, double radius = 2.5);
 /// Rows from patch_integrals' weights (sorted by patch); nodes without an unknown are dropped.
 SparseRows patch_integral_rows(const Grid3& grid, const std::vector<PatchWeight>& weights, int n_patches);
 

@@ -46,6 +46,9 @@ inline constexpr int minimum_nested_grid = 8;
 inline constexpr int quantity_quadrature = 2;
 /// A warning when the estimated error of û passes this fraction of ‖û‖_{L²(ω)} (solver.error_estimate).
 inline constexpr double estimate_warning = 0.01;
+/// A warning when the root mean square of D_γû − C_γû (the independent check) passes this fraction of
+/// the largest |C_γû| (docs/math.md, "Checks").
+inline constexpr double check_warning = 0.05;
 
 template <int dim>
 class FictitiousDomainSolver {
