@@ -147,10 +147,10 @@ template <int dim, class Inside>
 SparseRows one_sided_fit(const Grid<dim>& grid, const Inside& inside, const std::vector<Point<dim>>& points,
                          const std::vector<Point<dim>>& normals, OneSidedTrace trace, int degree, double radius) {
   if (points.size() != normals.size()) throw std::invalid_argument("one_sided_rows: size mismatch");
-  if (degree < 1 || degree > 2) throw std::invalid_argument("one_sided_rows: degree must be 1 or 2");
+  if (degree < 1 || degree > 3) throw std::invalid_argument("one_sided_rows: degree must be 1, 2 or 3");
   const double h = grid.h();
   // 1, ξ_d (+ ξ_a ξ_b, halved where a = b, for a ≤ b), ξ = (x − x_i)/h; in 2-D 1, ξ, η, ξ²/2, ξη, η²/2
-  const int n_terms = degree == 1 ? 1 + dim : 1 + dim + dim * (dim + 1) / 2;
+  const int n_terms = degree == 1 ? 1 + dim : degree == 2 ? 1 + dim + dim * (dim + 1) / 2 : (dim == 2 ? 10 : 20);
   SparseRows rows;
   RowBuilder builder(grid, rows);
   std::vector<typename Grid<dim>::Index> nodes;
@@ -201,9 +201,13 @@ SparseRows one_sided_fit(const Grid<dim>& grid, const Inside& inside, const std:
         int t = 0;
         M(k, t++) = w[k];
         for (int d = 0; d < dim; ++d) M(k, t++) = w[k] * e[d];
-        if (degree == 2)
+        if (degree >= 2)
           for (int a = 0; a < dim; ++a)
             for (int b = a; b < dim; ++b) M(k, t++) = w[k] * (a == b ? 0.5 : 1.0) * e[a] * e[b];
+        if (degree == 3)
+          for (int a = 0; a < dim; ++a)
+            for (int b = a; b < dim; ++b)
+              for (int c = b; c < dim; ++c) M(k, t++) = w[k] * e[a] * e[b] * e[c];
         W(k) = w[k];
       }
       const Eigen::JacobiSVD<Eigen::MatrixXd> svd(M);

@@ -312,10 +312,11 @@ std::optional<std::vector<double>> CurveDiscretization::independent_normal_deriv
     read_rows(normal_derivative_rows_centered(grid, points(), normals(), 3), grid, u, distribution, d);
     return d;
   }
-  rule = "one-sided quadratic least-squares fit through the nodes of omega";
+  rule = "one-sided cubic least-squares fit through the nodes of omega";
   std::optional<SparseRows> rows;
   try {  // the same on every rank: the rows are made from γ alone
-    rows.emplace(one_sided_rows(*gamma_geometry_, points(), normals(), OneSidedTrace::normal_derivative, 2, 2.5));
+    rows.emplace(one_sided_rows(*gamma_geometry_, points(), normals(), OneSidedTrace::normal_derivative,
+                                check_fit_degree, check_fit_radius));
   } catch (const std::runtime_error&) {  // ω too thin for the fit: no check, not a failed solve
     return std::nullopt;
   }

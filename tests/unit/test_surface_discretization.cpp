@@ -94,6 +94,20 @@ TEST(SurfaceRows, OneSidedRowsUseNodesOfOmegaOnlyAndReproduceQuadratics) {
     EXPECT_NEAR(apply_row(D, r, fine, u), fictus::dot(patches.normal[r], gradient(p)), 1e-9);
     EXPECT_GE(D.row_begin[r + 1] - D.row_begin[r], 20u);  // at least twice the 10 terms
   }
+  // The independent check's cubic fit reproduces cubics (at least twice its 20 terms in nodes).
+  const auto D3 =
+      fictus::one_sided_rows(fine, ellipsoid, patches.point, patches.normal, fictus::OneSidedTrace::normal_derivative,
+                             fictus::check_fit_degree, fictus::check_fit_radius);
+  for (const auto& e : D3.entries) EXPECT_TRUE(inside(e));
+  auto c = [](double x, double y, double z) { return x * x * x - 2 * x * y * z + y * y * z + z - 0.5 * y * y * y; };
+  auto c_gradient = [](const Point3& p) {
+    return Point3{3 * p.x * p.x - 2 * p.y * p.z, -2 * p.x * p.z + 2 * p.y * p.z - 1.5 * p.y * p.y,
+                  -2 * p.x * p.y + p.y * p.y + 1};
+  };
+  for (int r = 0; r < 60; ++r) {
+    EXPECT_NEAR(apply_row(D3, r, fine, c), fictus::dot(patches.normal[r], c_gradient(patches.point[r])), 1e-8);
+    EXPECT_GE(D3.row_begin[r + 1] - D3.row_begin[r], 40u);
+  }
   // A point with no node of ω near it: no fit, an error the check turns into "no check".
   const std::vector<Point3> far = {{0.05, 0.05, 0.05}};
   EXPECT_THROW(fictus::one_sided_rows(fine, ellipsoid, far, {{1, 0, 0}}, fictus::OneSidedTrace::value),

@@ -163,6 +163,22 @@ TEST(TraceOperators, OneSidedRowsUseNodesOfOmegaOnlyAndReproduceQuadratics) {
     EXPECT_NEAR(value[i], q(p.x, p.y), 1e-10);
     EXPECT_NEAR(derivative[i], n.x * (1 + 6 * p.x - p.y) + n.y * (-2 - p.x + p.y), 1e-9);
   }
+  // The independent check's cubic fit reproduces cubics.
+  const auto D3 =
+      fictus::one_sided_rows(geometry, s.points.point, s.points.normal, fictus::OneSidedTrace::normal_derivative,
+                             fictus::check_fit_degree, fictus::check_fit_radius);
+  for (const auto& e : D3.entries) EXPECT_TRUE(geometry.node_inside(e.i, e.j));
+  auto c = [](double x, double y) { return 1 + x - 2 * y + 3 * x * x * x - 2 * x * x * y + 0.5 * y * y * y; };
+  fictus::GridVector v = s.sample(c);
+  for (int j = 1; j < s.grid.ny(); ++j)
+    for (int i = 1; i < s.grid.nx(); ++i)
+      if (!geometry.node_inside(i, j)) v[s.grid.index(i, j)] -= 5.0;
+  D3.multiply(v, derivative);
+  for (int i = 0; i < s.points.m; ++i) {
+    const fictus::Point2 p = s.points.point[i], n = s.points.normal[i];
+    EXPECT_NEAR(derivative[i], n.x * (1 + 9 * p.x * p.x - 4 * p.x * p.y) + n.y * (-2 - 2 * p.x * p.x + 1.5 * p.y * p.y),
+                1e-8);
+  }
 }
 
 TEST(KinkCorrection, TracesOfAKinkedFieldAreThoseOfItsSmoothPart) {

@@ -30,11 +30,14 @@ SparseRows normal_derivative_rows_centered(const Grid2& grid, const std::vector<
                                            const std::vector<Point2>& normals, int degree = 2);
 
 /// One-sided traces from the nodes of ω only: row i = p(x_i) (value) or n_i·∇p(x_i) (normal
-/// derivative), p the weighted least-squares polynomial of `degree` (1 or 2) through u at the nodes
-/// of ω within `radius` cells of x_i (weights (1 − d²/R²)², the disc grows by ½ cell until the fit is
-/// well posed). For a û kinked on γ: no node outside ω enters. Orders for smooth u: value h^(p+1),
-/// derivative h^p.
+/// derivative), p the weighted least-squares polynomial of `degree` (1, 2 or 3) through u at the nodes
+/// of ω within `radius` cells of x_i (weights (1 − d²/R²)², the disc grows by ½ cell until the fit
+/// has at least twice as many nodes as terms and is well posed). For a û kinked on γ: no node outside ω
+/// enters. Orders for smooth u: value h^(p+1), derivative h^p.
 enum class OneSidedTrace { value, normal_derivative };
+/// The independent check's fit (docs/math.md, "Checks"), both dimensions: cubic, within 3.5 cells.
+inline constexpr int check_fit_degree = 3;
+inline constexpr double check_fit_radius = 3.5;
 SparseRows one_sided_rows(const CurveGridIntersection& gamma, const std::vector<Point2>& points,
                           const std::vector<Point2>& normals, OneSidedTrace trace, int degree = 2, double radius = 2.5);
 
@@ -53,7 +56,8 @@ SparseRows normal_derivative_rows(const Grid3& grid, const std::vector<Point3>& 
 SparseRows normal_derivative_rows_centered(const Grid3& grid, const std::vector<Point3>& points,
                                            const std::vector<Point3>& normals);
 /// One-sided traces from the nodes of ω only (level < 0), as the 2-D rows above: p the weighted
-/// least-squares polynomial of `degree` in x, y, z (10 terms for degree 2) within `radius` cells of x_i.
+/// least-squares polynomial of `degree` in x, y, z (10 terms for degree 2, 20 for 3) within `radius`
+/// cells of x_i.
 SparseRows one_sided_rows(const Grid3& grid, const Surface& gamma, const std::vector<Point3>& points,
                           const std::vector<Point3>& normals, OneSidedTrace trace, int degree = 2, double radius = 2.5);
 /// Rows from patch_integrals' weights (sorted by patch); nodes without an unknown are dropped.
