@@ -196,8 +196,9 @@ void print_summary(const fictus::BasicSolution<dim>& s) {
   if (s.check)
     std::printf(
         "  with an independent du/dn (%s): min du/dn %.2e, max |complementarity| %.2e, "
-        "max |difference| %.2e\n",
-        s.check->rule.c_str(), s.check->min_normal_derivative, s.check->max_complementarity, s.check->max_difference);
+        "max |difference| %.2e (rms %.2g %% of max |du/dn|)\n",
+        s.check->rule.c_str(), s.check->min_normal_derivative, s.check->max_complementarity, s.check->max_difference,
+        100 * s.check->relative_difference);
   std::printf("contact: %ld points, %s %.6g (whole points %.6g), force %.9g (%s; patch sum %.9g)\n", c.points, measure,
               c.measure, c.measure_points, c.force, c.force_from_domain ? "c int u - int f over omega" : "patch sum",
               c.force_patches);

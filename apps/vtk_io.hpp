@@ -54,8 +54,8 @@ template <int dim>
 void write_pvti(std::ostream& out, const BasicProblem<dim>& problem, const BasicSolution<dim>& solution,
                 const std::vector<std::pair<std::array<int, 2>, std::string>>& pieces);
 /// 3-D: γ's triangles (points shared), cell data patch, normal (the patch's outward normal), g, u,
-/// dudn, gap, contact (and lambda in the non-smooth variant), point data the area-weighted means of
-/// the same over the triangles at a point.
+/// dudn, gap, contact, condition (and dudn_check where the solve made the independent check, lambda in
+/// the non-smooth variant), point data the area-weighted means of the same over the triangles at a point.
 void write_surface_vtp(std::ostream& out, const SurfaceSolution& solution);
 /// 3-D, smooth variant: Γ's triangles, cell data patch, normal and lambda, point data lambda.
 void write_offset_surface_vtp(std::ostream& out, const SurfaceSolution& solution);

@@ -283,6 +283,11 @@ def test_surface_problem_matches_the_cli(tmp_path):
     assert np.allclose(s.lambda_, [float(p["lambda"]) for p in points], rtol=1e-12, atol=1e-12)
     assert s.u.shape == (65, 65, 65) and s.points.shape == (129, 3)
     assert list(s.contact) == [p["contact"] == "1" for p in points]
+    check = s.signorini["check"]  # the independent ∂u/∂n, in 3-D as in 2-D
+    assert check["rule"] == results["signorini"]["check"]["rule"]
+    for key in ("max_difference", "rms_difference", "relative_difference"):
+        assert check[key] == pytest.approx(results["signorini"]["check"][key], rel=1e-9)
+    assert 0 < check["relative_difference"] < 0.05 and "one-sided" in check["rule"]
     from vtkmodules.util.numpy_support import vtk_to_numpy
     from vtkmodules.vtkIOXML import vtkXMLImageDataReader
     reader = vtkXMLImageDataReader()

@@ -148,8 +148,10 @@ SparseRows one_sided_fit(const Grid<dim>& grid, const Inside& inside, const std:
                          const std::vector<Point<dim>>& normals, OneSidedTrace trace, int degree, double radius) {
   if (points.size() != normals.size()) throw std::invalid_argument("one_sided_rows: size mismatch");
   if (degree < 1 || degree > 3) throw std::invalid_argument("one_sided_rows: degree must be 1, 2 or 3");
+  if (!(radius > 0 && radius <= 64)) throw std::invalid_argument("one_sided_rows: radius must be in (0, 64] cells");
   const double h = grid.h();
-  // 1, ξ_d (+ ξ_a ξ_b, halved where a = b, for a ≤ b), ξ = (x − x_i)/h; in 2-D 1, ξ, η, ξ²/2, ξη, η²/2
+  // 1, ξ_d (+ ξ_a ξ_b, halved where a = b, for a ≤ b; + ξ_a ξ_b ξ_c, a ≤ b ≤ c, unscaled: only the
+  // linear coefficients are read), ξ = (x − x_i)/h; in 2-D, degree 2: 1, ξ, η, ξ²/2, ξη, η²/2
   const int n_terms = degree == 1 ? 1 + dim : degree == 2 ? 1 + dim + dim * (dim + 1) / 2 : (dim == 2 ? 10 : 20);
   SparseRows rows;
   RowBuilder builder(grid, rows);
@@ -165,17 +167,16 @@ SparseRows one_sided_fit(const Grid<dim>& grid, const Inside& inside, const std:
       if (R > radius + 8) throw std::runtime_error("one_sided_rows: too few nodes of ω near a collocation point");
       nodes.clear(), offsets.clear(), w.clear();
       typename Grid<dim>::Index lo, hi, node;
-      bool empty = false;
+      bool finite = true, empty = false;
       for (int d = 0; d < dim; ++d) {
         const double c = std::clamp((p[d] - grid.box().lower[d]) / h, -R - 1, grid.n(d) + R + 1);  // NaN stays NaN
-        if (!std::isfinite(c)) {
-          empty = true;
-          break;
-        }
+        finite = finite && std::isfinite(c);
+        if (!finite) break;
         lo[d] = std::max(int(std::floor(c - R)), 0), hi[d] = std::min(int(std::ceil(c + R)), grid.n(d));
         empty = empty || lo[d] > hi[d];
       }
-      if (empty) break;  // p not finite or outside the box: refused below
+      if (!finite) break;   // refused below
+      if (empty) continue;  // p outside the box, farther than R: a larger ball may reach it
       node = lo;
       for (;;) {  // the first axis fastest
         Point<dim> e;

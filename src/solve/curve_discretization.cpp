@@ -312,7 +312,7 @@ std::optional<std::vector<double>> CurveDiscretization::independent_normal_deriv
     read_rows(normal_derivative_rows_centered(grid, points(), normals(), 3), grid, u, distribution, d);
     return d;
   }
-  rule = "one-sided cubic least-squares fit through the nodes of omega";
+  rule = check_fit_rule;
   std::optional<SparseRows> rows;
   try {  // the same on every rank: the rows are made from γ alone
     rows.emplace(one_sided_rows(*gamma_geometry_, points(), normals(), OneSidedTrace::normal_derivative,

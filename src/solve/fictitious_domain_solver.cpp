@@ -759,18 +759,17 @@ void signorini_checks(const BoundaryDiscretization<dim>& boundary, bool with_fie
   }
   if (!std::isfinite(check.min_normal_derivative)) check.min_normal_derivative = 0;
   check.rms_difference = std::sqrt(sum / m);
-  double scale = 0;  // the largest |C_γû|
-  for (double v : sol.normal_derivative) scale = std::max(scale, std::abs(v));
+  const double scale = max_abs(sol.normal_derivative);  // the largest |C_γû|
   check.relative_difference = scale > 0 ? check.rms_difference / scale : 0.0;
   check.normal_derivative = std::move(*d);
   if (check.relative_difference > check_warning) {
-    char line[400];
-    std::snprintf(
-        line, sizeof line,
-        "signorini.check: the enforced du/dn and an independent one differ by %.2g %% of the largest "
-        "|du/dn| (root mean square; at most %.2g %%): the normal derivative is not resolved at N = %d, refine "
-        "the grid (docs/math.md, \"Checks\")",
-        100 * check.relative_difference, scale > 0 ? 100 * check.max_difference / scale : 0.0, sol.grid.nx());
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "signorini.check: the readings du/dn and du/dn of the field near gamma (%s) differ by %.3g %% of "
+                  "the largest |du/dn| (root mean square; at most %.3g %%), more than %g %%: one of them is not "
+                  "resolved at N = %d; refine the grid (docs/math.md, \"Checks\")",
+                  check.rule.c_str(), 100 * check.relative_difference, 100 * check.max_difference / scale,
+                  100 * check_warning, sol.grid.nx());
     sol.warnings.push_back(line);
   }
   sol.check = std::move(check);

@@ -314,7 +314,7 @@ void SurfaceDiscretization::finish_readings(const std::vector<double>& lambda,
 std::optional<std::vector<double>> SurfaceDiscretization::independent_normal_derivative(const GridVector& u,
                                                                                         std::string& rule) const {
   // Both variants: only nodes of ω enter, so the kink of the non-smooth field on γ does not.
-  rule = "one-sided cubic least-squares fit through the nodes of omega";
+  rule = check_fit_rule;
   std::optional<SparseRows> rows;
   try {  // the same on every rank: the rows are made from γ alone
     rows.emplace(one_sided_rows(grid_, *gamma_, points(), normals(), OneSidedTrace::normal_derivative, check_fit_degree,

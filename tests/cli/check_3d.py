@@ -34,6 +34,7 @@ def main():
     assert len(rows) == m, (len(rows), m)
     header = "i x y z nx ny nz weight g u dudn lambda contact condition Gamma_x Gamma_y Gamma_z dudn_check"
     assert list(rows[0].keys()) == header.split(), rows[0].keys()
+    assert all(row["dudn_check"] != "" for row in rows)  # the independent check, in 3-D too
     assert sum(int(row["contact"]) for row in rows) == r["contact"]["points"]
     assert abs(sum(float(row["weight"]) for row in rows) - r["boundary"]["measure"]) < 1e-9
     force = sum(float(row["dudn"]) * float(row["weight"]) for row in rows if row["contact"] == "1")
@@ -69,7 +70,7 @@ def main():
         clean.GetOutput().GetNumberOfPoints(), surface.GetNumberOfPoints())
     # point data beside the cell data: the means at the points lie within the patches' range
     points = surface.GetPointData()
-    for name in ("u", "g", "dudn", "gap", "contact"):
+    for name in ("u", "g", "dudn", "gap", "contact", "dudn_check"):
         at_points, per_cell = vtk_to_numpy(points.GetArray(name)), vtk_to_numpy(cells.GetArray(name))
         assert len(at_points) == surface.GetNumberOfPoints(), name
         assert per_cell.min() - 1e-12 <= at_points.min() and at_points.max() <= per_cell.max() + 1e-12, name

@@ -72,6 +72,7 @@ struct Bands {
 void converges(const std::string& name, const std::vector<int>& sizes, fictus::Variant variant, const Bands& bands,
                double largest_finest_error = 1.0) {
   std::vector<fictus::LevelResult> rows;
+  std::vector<double> check_differences;
   for (int N : sizes) {
     const fictus::SurfaceSolution s = solve_with_defaults(name, N, variant);
     ASSERT_TRUE(s.newton.converged) << "N = " << N << ": " << s.newton.failure;
@@ -81,8 +82,16 @@ void converges(const std::string& name, const std::vector<int>& sizes, fictus::V
     for (char a : s.newton.active) active += a;
     EXPECT_GT(10 * active, s.options.multipliers * bands.fewest_active_tenths);  // both parts of γ are there
     EXPECT_LT(active, s.options.multipliers * 4 / 5);
+    // The independent check (docs/math.md, "Checks"): under its warning, and within 6× of the readings'
+    // true largest error either way (measured 0.2–3.5× on the sphere and the ellipsoid, both variants).
+    ASSERT_TRUE(s.check.has_value() && s.point_errors.has_value()) << "N = " << N;
+    EXPECT_LT(s.check->relative_difference, fictus::check_warning) << "N = " << N;
+    EXPECT_LT(s.check->max_difference, 6 * s.point_errors->max_normal_derivative) << "N = " << N;
+    EXPECT_GT(s.check->max_difference, s.point_errors->max_normal_derivative / 6) << "N = " << N;
+    check_differences.push_back(s.check->relative_difference);
     rows.push_back(level_of(s));
   }
+  EXPECT_LT(check_differences.back(), check_differences.front());  // the check falls with h
   const char* label = variant == fictus::Variant::smooth ? ", smooth, 3-D" : ", non-smooth, 3-D";
   std::cout << fictus::format_convergence_table(name + label, rows, std::nullopt);
   const auto fit = fictus::fitted_rates(rows);

@@ -38,6 +38,7 @@ enum class OneSidedTrace { value, normal_derivative };
 /// The independent check's fit (docs/math.md, "Checks"), both dimensions: cubic, within 3.5 cells.
 inline constexpr int check_fit_degree = 3;
 inline constexpr double check_fit_radius = 3.5;
+inline constexpr const char* check_fit_rule = "one-sided cubic least-squares fit through the nodes of omega";
 SparseRows one_sided_rows(const CurveGridIntersection& gamma, const std::vector<Point2>& points,
                           const std::vector<Point2>& normals, OneSidedTrace trace, int degree = 2, double radius = 2.5);
 

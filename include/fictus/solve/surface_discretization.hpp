@@ -64,7 +64,7 @@ class SurfaceDiscretization final : public BoundaryDiscretization<3> {
   void finish_field(const std::vector<double>& lambda, GridVector& u) const override;
   /// + Xλ with the flux balance.
   void finish_readings(const std::vector<double>& lambda, std::vector<double>& normal_derivative) const override;
-  /// ∂u/∂n from the one-sided quadratic fit through the nodes of ω (one_sided_rows), both variants.
+  /// ∂u/∂n from the one-sided cubic fit through the nodes of ω (one_sided_rows), both variants.
   std::optional<std::vector<double>> independent_normal_derivative(const GridVector& u,
                                                                    std::string& rule) const override;
   void for_each_omega_sample(const GridVector& u, int quadrature, const OmegaSampleVisitor<3>& visit) const override;
