@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
      << "- machine: " << machine << "\n- compiler: g++ " << __VERSION__ << " -O3 (Release), FFTW 3.3\n"
      << "- commit: " << command_output("git rev-parse --short HEAD 2>/dev/null") << "\n- threads: " << threads
      << "\n- problem: the manufactured sphere (r = 0.3, contact boundary a plane section in general position, "
-        "∂²u/∂n² ≠ 0 on the free part), default m (patches of 8h smooth, 4h non-smooth) and δ = 1.5 s; one run per "
+        "∂²u/∂n² ≠ 0 on the free part), default m (patches of 5h smooth, 4h non-smooth) and δ = 1.5 s; one run per "
         "row; peak memory: see the end of the report\n\n";
 
   // The non-smooth variant stops at N = 256: with patches of 4h its m is 18 530 at N = 512, where the
@@ -98,7 +98,6 @@ int main(int argc, char** argv) {
       fictus::SolverOptions o;
       o.threads = threads;
       o.variant = variant;
-      if (smooth && N == 64) o.multipliers = 129;  // patches of 6h: the default δ = 12h leaves no room at N = 64
       const fictus::SurfaceSolution s = run(N, o);
       md << format("| %d | %zu | %d | %d | %d | %d | %zu | %.1f %% | %.2f", N, s.grid.n_unknowns(),
                    s.options.multipliers, s.newton.iterations, s.far_field ? s.far_field->exact_steps : 0,

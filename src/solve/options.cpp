@@ -206,7 +206,7 @@ void formulation_specs(std::vector<OptionSpec>& specs) {
     OptionSpec m = integer("formulation", "multipliers", &SolverOptions::multipliers, 0, 1000000,
                            "m, the points (2-D) or patches (3-D) on γ; 0 = the default rule: spacing s = c·h, m = "
                            "max(8, round(L/s)) on a curve of length L, c = 8 (smooth) or 12 (non-smooth), "
-                           "max(8, round(A/s²)) on a surface of area A, c = 8 (smooth) or 4 (non-smooth); a given m "
+                           "max(8, round(A/s²)) on a surface of area A, c = 5 (smooth) or 4 (non-smooth); a given m "
                            "needs 8 <= m and s >= 2h");
     m.aliases = {"m"};
     specs.push_back(m);

@@ -103,7 +103,7 @@ void converges(const std::string& name, const std::vector<int>& sizes, fictus::V
   EXPECT_LE(rows.back().it0, rows.front().it0 + 2);  // Newton does not grow with N
 }
 
-// At these N the contact set (patches of 8h) is still being resolved and the L²(ω) rate is above its
+// At these N the contact set (patches of 5h) is still being resolved and the L²(ω) rate is above its
 // asymptotic 2 (sphere: 2.5 over N = 96 … 160, 2.02 over 128 … 256 in the benchmark).
 void converges(const std::string& name, const std::vector<int>& sizes, double highest_rate) {
   converges(name, sizes, fictus::Variant::smooth, {1.8, highest_rate, 0.85, 1.8, 2});

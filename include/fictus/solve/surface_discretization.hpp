@@ -15,7 +15,7 @@
 namespace fictus {
 
 /// Default patch size s (the side of a square of the patch's area) in cells: m = area/(s·h)².
-inline constexpr double default_patch_cells_smooth_3d = 8.0;
+inline constexpr double default_patch_cells_smooth_3d = 5.0;
 inline constexpr double default_patch_cells_nonsmooth_3d = 4.0;
 /// Default m for a surface of `area` on a grid of cell h.
 int default_patches(double area, double h, Variant variant);
