@@ -184,7 +184,7 @@ TEST(MixedConditions, LinearProblemsSolveInOneStep2d) {
   linear_in_one_step<2>({256, 512, 1024}, 5e-4, {{1.8, 1.8}, {1.8, 0.8}, {1.6, 0.8}});
 }
 TEST(MixedConditions, LinearProblemsSolveInOneStep3d) {
-  linear_in_one_step<3>({48, 96}, 3e-3, {{1.8, 1.8}, {1.8, 0.9}, {1.8, 1.5}});
+  linear_in_one_step<3>({64, 96, 128}, 3e-3, {{1.8, 1.8}, {1.8, 0.9}, {1.8, 1.5}});
 }
 
 /// The points are placed part by part: the parts' measures are those of γ's parts (the plane x = 0.5

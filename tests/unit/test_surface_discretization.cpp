@@ -165,7 +165,7 @@ TEST(Torus, PatchesQuadratureAndOffsetLimit) {
   p.f = [](double, double, double) { return 1.0; };
   p.g = [](double, double, double) { return 0.0; };
   fictus::SolverOptions o;
-  o.offset = 1.5;
+  o.offset = 2.5;  // δ = 2.5·s = 12.5h ≈ 0.195 with the default patches of 5h, past R − r − 2h ≈ 0.119
   EXPECT_EQ(error_of(p, o).rfind("formulation.offset: Γ at δ = offset·s", 0), 0u) << error_of(p, o);
   EXPECT_NE(error_of(p, o).find("has no room"), std::string::npos) << error_of(p, o);
   EXPECT_THROW(fictus::Torus({0.5, 0.5, 0.5}, 0.1, 0.2), std::invalid_argument);
