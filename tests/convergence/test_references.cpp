@@ -295,7 +295,8 @@ TEST(References3d, EllipsoidConvergesToTheFittedMeshSolution) {
     // fictus is at 2.8e-4 and 3.5e-4 at N = 128 and 160 (1.1e-3 at 96).
     EXPECT_LT(pointwise, std::max(0.75 * previous_pointwise, 2 * reference_pointwise));
     EXPECT_GE(agree, finest ? 280 : 265);
-    EXPECT_LT(std::abs(s.contact_measure / ref_area - 1), 0.02);
+    // Measured 0.42 %, 0.09 %, 0.09 %; the reference's finest level is itself about 0.6 % above its limit.
+    EXPECT_LT(std::abs(s.contact_measure / ref_area - 1), 0.01);
     previous_pointwise = pointwise;
   }
   EXPECT_LT(previous_pointwise, 8e-4);
@@ -375,7 +376,8 @@ TEST(References3d, SpheroidContactSetAndForce) {
       std::cout << fictus::to_string(variant) << " N = " << N << ", m = " << s.options.multipliers << ": contact area "
                 << area << " (whole patches " << whole << "), ends within " << farthest << " s of the circle, force "
                 << force << ", int u " << integral_u << " (relative)\n";
-      EXPECT_LT(std::abs(area), N == 128 ? (smooth ? 0.012 : 0.005) : (smooth ? 0.025 : 0.012));
+      // Measured 0.02 % and 0.29 % (smooth, patches of 5h; with 8h −1.7 % and −0.8 %), −0.76 % and +0.15 %.
+      EXPECT_LT(std::abs(area), N == 128 ? 0.005 : 0.012);
       if (N == 128) EXPECT_LT(std::abs(area), std::abs(whole));
       EXPECT_FALSE(s.contact_boundary.empty());
       EXPECT_LT(farthest, 0.3);
