@@ -48,7 +48,7 @@ RUNS = [  # (name, ranks, threads, extra flags)
     ("2 ranks", 2, 1, []),
     ("4 ranks (oversubscribed)", 4, 1, []),
 ]
-# The compressed Schur complement (chosen from m = 5000 on; asked for here at smaller m) on the ranks,
+# The compressed Schur complement (chosen from m = 5000 on; asked for here wherever m is smaller) on the ranks,
 # against the serial compressed solve and the dense blocks on the same ranks.
 COMPRESSED = ["--schur_storage", "hierarchical"]
 COMPRESSED_RUNS = [

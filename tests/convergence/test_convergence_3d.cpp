@@ -104,7 +104,8 @@ void converges(const std::string& name, const std::vector<int>& sizes, fictus::V
 }
 
 // At these N the contact set (patches of 5h) is still being resolved and the L²(ω) rate is above its
-// asymptotic 2 (sphere: 2.5 over N = 96 … 160, 2.02 over 128 … 256 in the benchmark).
+// asymptotic 2 (sphere, with the earlier patches of 8h: 2.5 over N = 96 … 160, 2.02 over 128 … 256 in the
+// benchmark).
 void converges(const std::string& name, const std::vector<int>& sizes, double highest_rate) {
   converges(name, sizes, fictus::Variant::smooth, {1.8, highest_rate, 0.85, 1.8, 2});
 }
@@ -121,7 +122,7 @@ TEST(Manufactured3d, GreenAndKrylovAgree) {
   fictus::SolverOptions o;
   o.threads = 2;
   o.error_estimate = false;  // rates of the solve itself; the estimate: test_quantities.cpp
-  o.multipliers = 129;       // patches of 6h: Γ at δ = 9h fits the box at N = 64
+  o.multipliers = 129;       // patches of 6h (chosen when the default 8h left Γ no room at N = 64)
   const fictus::SurfaceSolution green = fictus::solve(problem("sphere", 64), o);
   o.inner = fictus::InnerSolver::krylov;
   o.krylov_tolerance = 1e-12;
@@ -162,8 +163,8 @@ TEST(Manufactured3d, NestedStartGivesTheSameAnswerInFewerSteps) {
   // solver.nested_start: Newton starts from the active set of the same problem solved on the grid of
   // N/2. It solves the same discrete problem, so the answer is the plain start's (λ to GMRES's
   // tolerance, the same active set), in fewer steps on this grid. The smooth variant's m is given (150,
-  // patches of 8.3h): the coarse solve takes m/4 = 38 (the default m there would be 41), with Γ at
-  // the same distance from γ, inside the box (the coarse default m and offset would put Γ beyond it).
+  // patches of 8.3h): the coarse solve takes m/4 = 38, with Γ at the same distance from γ, inside the
+  // box (chosen when the default patches were 8h; the default m at N = 48 is now 104).
   for (const auto variant : {fictus::Variant::smooth, fictus::Variant::nonsmooth}) {
     const bool smooth = variant == fictus::Variant::smooth;
     const int N = smooth ? 96 : 80;
@@ -337,7 +338,7 @@ TEST(Manufactured3d, SphereFromAMeshSolvesLikeTheSphere) {
   fictus::SolverOptions o;
   o.threads = 2;
   o.error_estimate = false;  // rates of the solve itself; the estimate: test_quantities.cpp
-  o.multipliers = 129;       // δ = 1.5·s must leave room to the box at N = 64
+  o.multipliers = 129;       // patches of 6h (chosen when the default 8h left Γ no room at N = 64)
   fictus::SurfaceProblem p = problem("sphere", 64);
   const fictus::SurfaceSolution exact_shape = fictus::solve(p, o);
   p.gamma = std::make_shared<fictus::MeshSurface>(fictus::icosphere({0.5, 0.5, 0.5}, 0.3, 5));

@@ -9,6 +9,7 @@
 
 #include "fictus/boundary/collocation.hpp"
 #include "fictus/solve/spacing_rule.hpp"
+#include "fictus/solve/surface_discretization.hpp"
 
 namespace {
 
@@ -34,7 +35,7 @@ SpacingInput sphere(double r, int N) {
           A,
           h,
           1.0,
-          [A](double k) { return std::max(8, int(std::lround(A / (64 * k * k)))); },
+          [A](double k) { return fictus::default_patches(A, k, fictus::Variant::smooth); },
           [r](double k) { return 0.5 - r - 2 * k; }};
 }
 
@@ -59,11 +60,11 @@ TEST(SpacingRule, TheDefaultRuleWhereItFits) {
 }
 
 // A circle of radius 0.3 at N = 64 (the default δ of 16h leaves the box's margin) and a sphere
-// of radius 0.3 at N = 32 … 56: the default rule shrinks to fit, with a warning naming the N from
+// of radius 0.3 at N = 32 … 44 (δ = 1.5·5h fits from N = 48): the default rule shrinks to fit, with a warning naming the N from
 // which it fits unchanged; at that N it does, one below it does not.
 TEST(SpacingRule, CoarseGridsRunWithTheNearestFittingOffset) {
   for (const auto& [make, N] :
-       {std::pair{&circle, 64}, std::pair{&sphere, 32}, std::pair{&sphere, 40}, std::pair{&sphere, 56}}) {
+       {std::pair{&circle, 64}, std::pair{&sphere, 32}, std::pair{&sphere, 40}, std::pair{&sphere, 44}}) {
     const SpacingInput in = make(0.3, N);
     const SpacingPlan plan = fictus::plan_spacing(in, SolverOptions{});
     ASSERT_NE(plan.warning, "") << "N = " << N;
