@@ -292,10 +292,11 @@ void mixed_3d(const std::string& name, const std::vector<int>& sizes, fictus::Va
 }
 
 // Measured against the Signorini problem on all of γ (ratios at the three N): sphere smooth 0.97, 0.99,
-// 0.99 with the smooth patches of 5h (1.22, 0.85, 0.99 with 8h), non-smooth 1.00, 0.96, 1.04; torus smooth 1.06, 1.00, 1.10, non-smooth 1.05, 0.94, 1.17. With
-// every point at its nearest triangle's centroid the non-smooth sphere's were 1.04, 1.24, 1.67 (order
-// 1.49) and the torus's 1.14, 2.08, 7.4 (its error grew with N, order −2.25). The smooth sphere's 1.22
-// with 8h was at N = 64, before its errors settled (order 3.8 over the three N; 2.02 with 5h).
+// 0.99 with the smooth patches of 5h (1.22, 0.85, 0.99 with 8h), non-smooth 1.00, 0.96, 1.04; torus
+// smooth 1.06, 1.00, 1.10, non-smooth 1.05, 0.94, 1.17. With every point at its nearest triangle's centroid the
+// non-smooth sphere's were 1.04, 1.24, 1.67 (order 1.49) and the torus's 1.14, 2.08, 7.4 (its error grew with N, order
+// −2.25). The smooth sphere's 1.22 with 8h was at N = 64, before its errors settled (order 3.8 over the three N; 2.02
+// with 5h).
 TEST(Mixed3d, SphereSmooth) { mixed_3d("sphere", {64, 96, 128}, fictus::Variant::smooth, 1.8, 0.3); }
 TEST(Mixed3d, SphereNonSmooth) { mixed_3d("sphere", {64, 96, 128}, fictus::Variant::nonsmooth, 1.8, 0.3); }
 // The torus (several minutes) carries the label slow.

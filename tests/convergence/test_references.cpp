@@ -455,7 +455,8 @@ TEST(References3d, MixedEllipsoidConvergesToTheFittedMeshSolution) {
     // Measured (docs/math.md, "Mixed conditions"): the patches follow the junction curves to within a
     // triangle, so the caps' areas are right to 1e-3; the fluxes through them and the contact area are
     // still first-order (the junctions are singular points of u) and far off at these N (contact area
-    // +10 %, +5.3 % with the smooth patches of 5h; +24 %, +18 % with 8h); they fall with N, and so does the largest pointwise error (beside the junction curves).
+    // +10 %, +5.3 % with the smooth patches of 5h; +24 %, +18 % with 8h); they fall with N, and so does the largest
+    // pointwise error (beside the junction curves).
     const nlohmann::json& parts = reference["conditions"];
     EXPECT_NEAR(c.dirichlet.measure / double(parts["dirichlet_part"]["measure"]), 1, 2e-3);
     EXPECT_NEAR(c.neumann.measure / double(parts["neumann_part"]["measure"]), 1, 2e-3);

@@ -60,8 +60,8 @@ TEST(SpacingRule, TheDefaultRuleWhereItFits) {
 }
 
 // A circle of radius 0.3 at N = 64 (the default δ of 16h leaves the box's margin) and a sphere
-// of radius 0.3 at N = 32 … 44 (δ = 1.5·5h fits from N = 48): the default rule shrinks to fit, with a warning naming the N from
-// which it fits unchanged; at that N it does, one below it does not.
+// of radius 0.3 at N = 32 … 44 (δ = 1.5·5h fits from N = 48): the default rule shrinks to fit, with a warning naming
+// the N from which it fits unchanged; at that N it does, one below it does not.
 TEST(SpacingRule, CoarseGridsRunWithTheNearestFittingOffset) {
   for (const auto& [make, N] :
        {std::pair{&circle, 64}, std::pair{&sphere, 32}, std::pair{&sphere, 40}, std::pair{&sphere, 44}}) {
