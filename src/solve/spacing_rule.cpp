@@ -17,6 +17,14 @@ std::string format(const char* pattern, double a, double b = 0, double c = 0, do
   return buffer;
 }
 
+/// v to three significant digits, rounded up (or down): a bound printed so that the printed value itself
+/// still lies within it.
+double three_digits(double v, bool up) {
+  if (!(v > 0) || !std::isfinite(v)) return v;
+  const double unit = std::pow(10.0, std::floor(std::log10(v)) - 2);
+  return (up ? std::ceil(v / unit) : std::floor(v / unit)) * unit;
+}
+
 /// The most multipliers whose spacing is at least 2h.
 long most_multipliers(int dim, double measure, double h) {
   const double m = dim == 2 ? measure / (2 * h) : measure / (4 * h * h);
@@ -96,11 +104,11 @@ SpacingPlan plan_spacing(const SpacingInput& in, const SolverOptions& options) {
     plan.delta = delta_of(options.offset);
     if (plan.delta < lower || plan.delta > upper)
       throw std::invalid_argument(
-          format("formulation.offset: Γ at δ = offset·s = %.3g (%.2f h) ", plan.delta, plan.delta / h) +
+          format("formulation.offset: Γ at δ = offset·s = %.4g (%.3f h) ", plan.delta, plan.delta / h) +
           (plan.delta < lower ? format("is within reach of the C_γ stencil (need δ >= 4h = %.3g)", lower)
                               : format("has no room (the box's 2h margin and Γ's folds allow δ <= %.3g)", upper)) +
           format("; with m = %.0f (s = %.3g) offsets in [%.3g, %.3g] fit", plan.m, plan.spacing,
-                 std::max(lower / plan.spacing, 1e-3), upper / plan.spacing));
+                 three_digits(std::max(lower / plan.spacing, 1e-3), true), three_digits(upper / plan.spacing, false)));
     return plan;
   }
   // The default rule, δ = default_offset·s, moved to the nearest δ that fits; the default m follows so

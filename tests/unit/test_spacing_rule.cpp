@@ -103,9 +103,32 @@ TEST(SpacingRule, AGivenOffsetThatDoesNotFitNamesTheOffsetsThatDo) {
     EXPECT_EQ(what.rfind("formulation.offset: ", 0), 0u) << what;
     const double low = std::stod(match[1]), high = std::stod(match[2]);
     EXPECT_TRUE(offset < low || offset > high) << what;
-    o.offset = (low + high) / 2;  // the range it names fits
-    EXPECT_NO_THROW(fictus::plan_spacing(in, o)) << what;
+    for (double fits : {low, (low + high) / 2, high}) {  // the range it names fits, its printed ends too
+      o.offset = fits;
+      EXPECT_NO_THROW(fictus::plan_spacing(in, o)) << fits << ": " << what;
+    }
   }
+}
+
+// The printed lower end fits where the stencil's bound lies a hair above a round offset: 3-D, m = 510
+// at N = 96 on a surface of area 0.8849 puts 4h at 1.0003 s (a refusal once named [1, …] and refused 1).
+TEST(SpacingRule, TheNamedOffsetsFitToTheLastPrintedDigit) {
+  SpacingInput in = sphere(0.3, 96);
+  in.measure = 0.884917604224;
+  SolverOptions o;
+  o.multipliers = 510;
+  o.offset = 1.0;
+  std::string what;
+  try {
+    fictus::plan_spacing(in, o);
+  } catch (const std::invalid_argument& e) {
+    what = e.what();
+  }
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(what, match, std::regex(R"(offsets in \[([0-9.e+-]+), ([0-9.e+-]+)\] fit)"))) << what;
+  EXPECT_GT(std::stod(match[1]), 1.0) << what;
+  o.offset = std::stod(match[1]);
+  EXPECT_NO_THROW(fictus::plan_spacing(in, o)) << what;
 }
 
 // Nothing fits: the refusal names an N that runs, and N − 1 does not.
