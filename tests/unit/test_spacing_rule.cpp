@@ -2,10 +2,12 @@
 // with a warning where it does not, and refusals that name what would fit.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <regex>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "fictus/boundary/collocation.hpp"
 #include "fictus/solve/spacing_rule.hpp"
@@ -86,22 +88,29 @@ TEST(SpacingRule, CoarseGridsRunWithTheNearestFittingOffset) {
   }
 }
 
+/// The refusal of a given offset that does not fit, and the range of offsets it names ({-1, -1} if none).
+std::pair<std::string, std::array<double, 2>> refused_offset(const SpacingInput& in, const SolverOptions& o) {
+  std::string what;
+  try {
+    fictus::plan_spacing(in, o);
+  } catch (const std::invalid_argument& e) {
+    what = e.what();
+  }
+  std::smatch match;
+  if (!std::regex_search(what, match, std::regex(R"(offsets in \[([0-9.e+-]+), ([0-9.e+-]+)\] fit)")))
+    return {what, {-1, -1}};
+  return {what, {std::stod(match[1]), std::stod(match[2])}};
+}
+
 TEST(SpacingRule, AGivenOffsetThatDoesNotFitNamesTheOffsetsThatDo) {
   const SpacingInput in = circle(0.3, 64);
   SolverOptions o;
   for (double offset : {0.3, 1.5, 3.0}) {  // too near (δ < 4h), too far (beyond the box margin)
     o.offset = offset;
-    std::string what;
-    try {
-      fictus::plan_spacing(in, o);
-    } catch (const std::invalid_argument& e) {
-      what = e.what();
-    }
-    std::smatch match;
-    ASSERT_TRUE(std::regex_search(what, match, std::regex(R"(offsets in \[([0-9.e+-]+), ([0-9.e+-]+)\] fit)")))
-        << offset << ": " << what;
+    const auto [what, range] = refused_offset(in, o);
+    const auto [low, high] = range;
+    ASSERT_GT(low, 0) << offset << ": " << what;
     EXPECT_EQ(what.rfind("formulation.offset: ", 0), 0u) << what;
-    const double low = std::stod(match[1]), high = std::stod(match[2]);
     EXPECT_TRUE(offset < low || offset > high) << what;
     for (double fits : {low, (low + high) / 2, high}) {  // the range it names fits, its printed ends too
       o.offset = fits;
@@ -118,16 +127,9 @@ TEST(SpacingRule, TheNamedOffsetsFitToTheLastPrintedDigit) {
   SolverOptions o;
   o.multipliers = 510;
   o.offset = 1.0;
-  std::string what;
-  try {
-    fictus::plan_spacing(in, o);
-  } catch (const std::invalid_argument& e) {
-    what = e.what();
-  }
-  std::smatch match;
-  ASSERT_TRUE(std::regex_search(what, match, std::regex(R"(offsets in \[([0-9.e+-]+), ([0-9.e+-]+)\] fit)"))) << what;
-  EXPECT_GT(std::stod(match[1]), 1.0) << what;
-  o.offset = std::stod(match[1]);
+  const auto [what, range] = refused_offset(in, o);
+  EXPECT_GT(range[0], 1.0) << what;
+  o.offset = range[0];
   EXPECT_NO_THROW(fictus::plan_spacing(in, o)) << what;
 }
 
