@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
+#include <string>
 
 #include "fictus/boundary/collocation.hpp"
 
@@ -17,12 +19,27 @@ std::string format(const char* pattern, double a, double b = 0, double c = 0, do
   return buffer;
 }
 
-/// v to three significant digits, rounded up (or down): a bound printed so that the printed value itself
-/// still lies within it.
-double three_digits(double v, bool up) {
-  if (!(v > 0) || !std::isfinite(v)) return v;
-  const double unit = std::pow(10.0, std::floor(std::log10(v)) - 2);
+/// v rounded up (or down) to `digits` significant digits.
+double round_to_digits(double v, int digits, bool up) {
+  const double unit = std::pow(10.0, std::floor(std::log10(v)) + 1 - digits);
+  if (!(unit > 0) || !std::isfinite(unit)) return v;
   return (up ? std::ceil(v / unit) : std::floor(v / unit)) * unit;
+}
+
+/// "[low, high]" with the fewest significant digits (at least three) whose printed ends, read back,
+/// still lie within [low, high]: moved inward by a relative 1e-9 before rounding, so that the offset
+/// a user copies from the message passes the check that refused the first one.
+std::string printed_range(double low, double high) {
+  const double lo = low * (1 + 1e-9), hi = high * (1 - 1e-9);
+  char a[40], b[40];
+  for (int digits = 3; digits <= 15 && lo > 0 && lo <= hi; ++digits) {
+    std::snprintf(a, sizeof a, "%.*g", digits, round_to_digits(lo, digits, true));
+    std::snprintf(b, sizeof b, "%.*g", digits, round_to_digits(hi, digits, false));
+    const double read_a = std::strtod(a, nullptr), read_b = std::strtod(b, nullptr);
+    if (lo <= read_a && read_a <= read_b && read_b <= hi) return std::string("[") + a + ", " + b + "]";
+  }
+  std::snprintf(a, sizeof a, "%.17g", 0.5 * (low + high));  // a range too narrow to print: its middle
+  return std::string("[") + a + ", " + a + "]";
 }
 
 /// The most multipliers whose spacing is at least 2h.
@@ -107,8 +124,8 @@ SpacingPlan plan_spacing(const SpacingInput& in, const SolverOptions& options) {
           format("formulation.offset: Γ at δ = offset·s = %.4g (%.3f h) ", plan.delta, plan.delta / h) +
           (plan.delta < lower ? format("is within reach of the C_γ stencil (need δ >= 4h = %.3g)", lower)
                               : format("has no room (the box's 2h margin and Γ's folds allow δ <= %.3g)", upper)) +
-          format("; with m = %.0f (s = %.3g) offsets in [%.3g, %.3g] fit", plan.m, plan.spacing,
-                 three_digits(std::max(lower / plan.spacing, 1e-3), true), three_digits(upper / plan.spacing, false)));
+          format("; with m = %.0f (s = %.3g) offsets in ", plan.m, plan.spacing) +
+          printed_range(std::max(lower / plan.spacing, 1e-3), upper / plan.spacing) + " fit");
     return plan;
   }
   // The default rule, δ = default_offset·s, moved to the nearest δ that fits; the default m follows so

@@ -128,9 +128,30 @@ TEST(SpacingRule, TheNamedOffsetsFitToTheLastPrintedDigit) {
   o.multipliers = 510;
   o.offset = 1.0;
   const auto [what, range] = refused_offset(in, o);
-  EXPECT_GT(range[0], 1.0) << what;
+  ASSERT_GT(range[0], 1.0) << what;
   o.offset = range[0];
   EXPECT_NO_THROW(fictus::plan_spacing(in, o)) << what;
+}
+
+// Both printed ends fit, on either side, over many grids (their fourth digits run through 0 … 9).
+TEST(SpacingRule, BothNamedEndsFitOnEveryGrid) {
+  int named = 0;
+  for (const auto& make : {&circle, &sphere})
+    for (int N = 40; N <= 240; ++N)
+      for (double offset : {0.05, 50.0}) {  // too near, too far
+        const SpacingInput in = make(0.3, N);
+        SolverOptions o;
+        o.offset = offset;
+        const auto [what, range] = refused_offset(in, o);
+        if (range[0] < 0) continue;  // no range named (nothing fits at this N)
+        ++named;
+        ASSERT_LE(range[0], range[1]) << what;
+        for (double end : range) {
+          o.offset = end;
+          EXPECT_NO_THROW(fictus::plan_spacing(in, o)) << "N = " << N << ", offset " << end << ": " << what;
+        }
+      }
+  EXPECT_GT(named, 600);
 }
 
 // Nothing fits: the refusal names an N that runs, and N − 1 does not.
