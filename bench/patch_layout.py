@@ -1,11 +1,13 @@
 """How a 3-D reference problem's quantities move with the layout of the patches on γ (issue 33).
 
 The problem, the grid and N stay; only the patches change: m = round(f·m₀), m₀ the default rule's
-(|γ|/(c·h)², c = 5 smooth, 4 non-smooth), for the factors f of LAYOUTS (default 0.91 … 1.06 in steps of
+(|γ|/(c·h)², c = 5 smooth, 4 non-smooth, |γ| the reference's area_gamma, so m₀ may differ by one
+from the solver's own), for the factors f of LAYOUTS (default 0.91 … 1.06 in steps of
 0.03, which keeps s within 5 % of the default's). Each m gives another partition of γ by Lloyd's
 iteration, so the patch borders fall elsewhere against the contact boundary. (Shifting the box by a
 fraction of a cell moves the grid but not the patches: the quantities then move 3–23 times less;
-MOVE=box runs six such shifts, uniform in [−h/2, h/2] per axis, seed 20261207, instead of the layouts.)
+MOVE=box runs six such shifts of the box [0, 1]³ (h = 1/N; the references' box), uniform in
+[−h/2, h/2] per axis, seed 20261207, instead of the layouts.)
 Per N: the mean, the standard deviation and the largest of the relative errors over the layouts,
 against the fitted-mesh reference of tests/references/NAME.json (contact area: the exact cap where
 the reference gives one, else contact_fraction × area_gamma).
@@ -16,8 +18,8 @@ the reference gives one, else contact_fraction × area_gamma).
   LAYOUTS="1.0" … for the default layout alone.
 
 Runs `build/apps/fictus solve tests/references/NAME.toml --N N --variant VARIANT --multipliers m
---error_estimate false --threads 2 --files results.json --quiet` (plus the options given) into a
-temporary folder; prints one line per run and a table.
+--error_estimate false --threads 2 --out FOLDER --files results.json --quiet` (plus the options
+given), FOLDER a temporary one; prints one line per run and a table.
 """
 import json, os, subprocess, sys, tempfile
 import numpy as np
@@ -29,7 +31,7 @@ move_box = os.environ.get("MOVE", "layout") == "box"
 shifts = np.random.default_rng(20261207).uniform(-0.5, 0.5, size=(6, 3))
 cases = shifts if move_box else factors
 ref = json.load(open(os.path.join(root, "tests", "references", name + ".json")))["values"]
-area = ref.get("contact_area", ref["contact_fraction"] * ref["area_gamma"])
+area = ref["contact_area"] if "contact_area" in ref else ref["contact_fraction"] * ref["area_gamma"]
 quantities = ("contact area", "∫û", "∫|∇û|²", "force")
 rows = {}
 with tempfile.TemporaryDirectory() as folder:
