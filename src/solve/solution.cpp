@@ -412,15 +412,25 @@ std::function<double(const Point<dim>&)> contact_side(const BasicSolution<dim>& 
   };
 }
 
+/// What to change when a GMRES stopped at its cap, by the solve that ran it: the implicit Schur
+/// complement (schur = krylov), the compressed one's iterations, or the refinement on the exact S after
+/// the interpolated far field (green, dense).
+template <int dim>
+std::string krylov_advice(const BasicSolution<dim>& s) {
+  if (s.options.inner == InnerSolver::krylov) return "raise the cap, or use schur = green";
+  if (s.schur_storage && s.schur_storage->kind == "hierarchical")
+    return "raise the cap, or store S dense with schur_storage = dense where the memory allows";
+  return "raise the cap, or assemble every pair of S exactly with far_field = false";
+}
+
 template <int dim>
 std::string describe_newton_failure(const BasicSolution<dim>& s) {
   // Blame the setting at fault: a Krylov solve stopped short makes Newton wander, whatever its cap.
   std::string line =
       s.newton.inner_failed
           ? "solver.krylov_max_iterations: GMRES stopped at its cap of " +
-                std::to_string(s.options.krylov_max_iterations) +
-                " iterations before solver.krylov_tolerance (raise the cap, or use schur = green); then Newton: " +
-                s.newton.failure + "; history (active points, residual):"
+                std::to_string(s.options.krylov_max_iterations) + " iterations before solver.krylov_tolerance (" +
+                krylov_advice(s) + "); then Newton: " + s.newton.failure + "; history (active points, residual):"
           : "solver.max_newton: Newton did not converge: " + s.newton.failure + "; history (active points, residual):";
   for (const NewtonStep& step : s.newton.history) {
     char buffer[64];
