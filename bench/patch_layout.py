@@ -5,7 +5,7 @@ The problem, the grid and N stay; only the patches change: m = round(f·m₀), m
 from the solver's own), for the factors f of LAYOUTS (default 0.91 … 1.06 in steps of
 0.03, which keeps s within 5 % of the default's). Each m gives another partition of γ by Lloyd's
 iteration, so the patch borders fall elsewhere against the contact boundary. (Shifting the box by a
-fraction of a cell moves the grid but not the patches: the quantities then move 3–23 times less;
+fraction of a cell moves the grid but not the patches: ∫û then moves 3–24 times less;
 MOVE=box runs six such shifts of the box [0, 1]³ (h = 1/N; the references' box), uniform in
 [−h/2, h/2] per axis, seed 20261207, instead of the layouts.)
 Per N: the mean, the standard deviation and the largest of the relative errors over the layouts,
