@@ -242,7 +242,8 @@ std::pair<int, int> parse_levels(const std::string& text) {
   static const std::regex pattern(R"((\d+)(?:-(\d+))?)");
   std::smatch match;
   if (!std::regex_match(text, match, pattern)) throw std::invalid_argument("--levels: expected A-B, e.g. 7-10");
-  const int a = std::stoi(match[1]), b = match[2].matched ? std::stoi(match[2]) : a;
+  const auto level = [](const std::string& digits) { return digits.size() > 3 ? 999 : std::stoi(digits); };
+  const int a = level(match[1]), b = match[2].matched ? level(match[2]) : a;
   if (a < 3 || b > 14 || a > b) throw std::invalid_argument("--levels: need 3 <= A <= B <= 14 (h = 2^-level)");
   return {a, b};
 }
@@ -251,12 +252,13 @@ std::pair<int, int> parse_levels(const std::string& text) {
 struct SolveCommand {
   std::string problem_path, out = "results/solve";
   std::string mesh_file;                       // --file: geometry.file of a 3-D mesh problem
-  double mesh_resolution = -1;                 // --resolution: geometry.resolution (-1: the file's)
+  double mesh_resolution = 0;                  // --resolution: geometry.resolution (where given)
   std::vector<std::string> files, parameters;  // parameters: NAME=VALUE
   bool quiet = false;
   fictus::cli::OptionFlags flags;
   CLI::Option* out_option = nullptr;
   CLI::Option* files_option = nullptr;
+  CLI::Option* resolution_option = nullptr;
 };
 
 /// Progress on stderr, flushed (also when redirected): each step of a long solve as it ends, with
@@ -333,11 +335,14 @@ std::vector<fictus::cli::OutputFile> output_files(const fictus::BasicProblemSpec
 /// or the paper's problem, the flags applied; --out and --files.
 template <int dim>
 fictus::BasicProblemSpec<dim> solve_spec(std::string text, const SolveCommand& command) {
-  if (command.mesh_file.size() || command.mesh_resolution >= 0) {
+  const bool resolution_given = command.resolution_option->count() > 0;
+  if (command.mesh_file.size() || resolution_given) {
     if (dim != 3)
       throw std::invalid_argument(std::string(command.mesh_file.size() ? "--file" : "--resolution") +
                                   ": applies to a mesh, the geometry of 3-D problems only ([domain] dim = 3)");
-    text = fictus::with_mesh_overrides(text, command.problem_path, command.mesh_file, command.mesh_resolution);
+    text =
+        fictus::with_mesh_overrides(text, command.problem_path, command.mesh_file,
+                                    resolution_given ? std::optional<double>(command.mesh_resolution) : std::nullopt);
   }
   fictus::BasicProblemSpec<dim> spec = fictus::cli::problem_from_text<dim>(text, command.problem_path, command.flags,
                                                                            parameter_values(command.parameters));
@@ -497,7 +502,7 @@ int run_solve_in(const std::string& text, const SolveCommand& command) {
     if (pieces) field_files = pieces->files(spec.problem, s);
 #endif
     const std::vector<fictus::cli::OutputFile> files = output_files(spec, s, input, field_files);
-    fictus::cli::write_output_set(spec.output.dir, files);
+    fictus::cli::write_output_set(spec.output.dir, files, fictus::cli::solve_output_name);
     if (command.quiet) return;
     std::uintmax_t bytes = 0;
     std::error_code error;
@@ -537,7 +542,9 @@ int run_plot(const std::string& folder, bool with_lambda) {
   int status = 0;
   while (waitpid(child, &status, 0) < 0)
     if (errno != EINTR) return 2;
-  return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? 0 : 1;
+  // The script's own codes: 0, 1 (what it reads is bad) and 3 (a plot cannot be written).
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+  return code == 0 || code == 3 ? code : 1;
 }
 
 int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out, const std::string& table,
@@ -602,7 +609,11 @@ int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out,
   if (!out.empty()) {
     std::vector<fictus::cli::OutputFile> set;
     for (const auto& [name, text] : files) set.push_back({name, [&text](std::ostream& o) { o << text; }});
-    fictus::cli::on_rank_0(distribution, [&] { fictus::cli::write_output_set(out, set); });
+    const auto reproduced = [](const std::string& name) {  // an earlier reproduction's tables and plot
+      static const std::regex table(R"(table[12]\.(csv|json)|convergence\.png)");
+      return std::regex_match(name, table);
+    };
+    fictus::cli::on_rank_0(distribution, [&] { fictus::cli::write_output_set(out, set, reproduced); });
     std::printf("wrote %zu files to %s/\n", files.size(), out.c_str());
   }
   return status;
@@ -666,8 +677,9 @@ int main(int argc, char** argv) {
   solve_cmd->add_option("--dir", solve.out, "alias of --out")->group("");
   solve_cmd->add_option("--file", solve.mesh_file,
                         "geometry.file of a 3-D mesh problem: a .off, .stl, .obj or .ply file (relative to here)");
-  solve_cmd->add_option("--resolution", solve.mesh_resolution,
-                        "geometry.resolution of a 3-D mesh problem: lattice cells across the mesh (0: automatic)");
+  solve.resolution_option =
+      solve_cmd->add_option("--resolution", solve.mesh_resolution,
+                            "geometry.resolution of a 3-D mesh problem: lattice cells across the mesh (0: automatic)");
   solve_cmd
       ->add_option("--parameter", solve.parameters,
                    "NAME=VALUE: a value for an entry of the problem file's [parameters] (repeatable)")
@@ -735,8 +747,18 @@ int main(int argc, char** argv) {
   if (argc > 1 && argv[1][0] != '-' && !commands.count(argv[1]))
     return fail(std::string(argv[1]) + ": not a command (solve, plot, reproduce, sweep, options; see fictus --help)",
                 exit_bad_input);
+  // "--key=" gives key the empty value: CLI11 would take the next argument as its value instead.
+  std::vector<std::string> arguments;
+  for (int k = argc - 1; k >= 1; --k) {  // CLI11 takes the arguments last first
+    const std::string a = argv[k];
+    if (a.size() > 3 && a.compare(0, 2, "--") == 0 && a.back() == '=' && a.find('=') == a.size() - 1)
+      arguments.insert(arguments.end(), {"", a.substr(0, a.size() - 1)});
+    else
+      arguments.push_back(a);
+  }
+  app.name("fictus");  // (parse(argc, argv) would take argv[0])
   try {
-    app.parse(argc, argv);
+    app.parse(arguments);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {

@@ -195,8 +195,7 @@ def plot_solution(folder):
     ax.set_ylabel("y")
     ax.legend(loc="upper right", fontsize=8)
     ax.set_title(title, fontsize=10)
-    fig.savefig(os.path.join(folder, "solution.png"), dpi=120)
-    plt.close(fig)
+    save(fig, folder, "solution.png", 120)
 
 
 def lambda_label(variant):
@@ -239,8 +238,7 @@ def plot_profiles(folder, with_lambda):
     axes[-1].set_xlabel("arc length s along γ from s = 0 (red: contact" +
                         ("; blue squares: Dirichlet, green triangles: Neumann)" if mixed else ")"))
     fig.suptitle("Signorini conditions along γ" + (f" ({variant} variant)" if variant else ""))
-    fig.savefig(os.path.join(folder, "profiles.png"), dpi=120)
-    plt.close(fig)
+    save(fig, folder, "profiles.png", 120)
 
 
 PAPER = {  # relative L2(ω), L2(γ) of the paper's Tables 1 and 2, h = 1/128 … 1/4096
@@ -291,8 +289,7 @@ def plot_convergence(folder):
     ax.legend(fontsize=7, ncol=2)
     ax.set_title("fictus convergence; dotted: the paper (its H¹ column is not a relative error)\n"
                  "triangles: slopes 1 (Table 1) and 2 (Table 2)", fontsize=9)
-    fig.savefig(os.path.join(folder, "convergence.png"), dpi=120)
-    plt.close(fig)
+    save(fig, folder, "convergence.png", 120)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -316,8 +313,7 @@ def plot_slices(folder):
     bar = fig.colorbar(image, ax=axes, label="û in ω", shrink=0.8)
     plain(bar.ax.yaxis)
     fig.suptitle("fictus: û on three planes through the centre of ω")
-    fig.savefig(os.path.join(folder, "slices.png"), dpi=110)
-    plt.close(fig)
+    save(fig, folder, "slices.png", 110)
 
 
 def view_basis(elevation, azimuth):
@@ -386,8 +382,7 @@ def plot_surface(folder, with_lambda):
     mixed = "condition" in cells and np.any(cells["condition"] > 0)
     fig.suptitle("fictus: γ coloured by the contact pressure and the gap" + (f" ({variant} variant)" if variant else "") +
                  ("\nparts of γ: 0 Signorini (S), 1 Dirichlet (D), 2 Neumann (N)" if mixed else ""))
-    fig.savefig(os.path.join(folder, "surface.png"), dpi=110)
-    plt.close(fig)
+    save(fig, folder, "surface.png", 110)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -414,8 +409,20 @@ def plot_sweep(folder):
     axes[-1].set_xlabel(name)
     title = sweep.get("problem", {}).get("name") or "the paper's problem"
     fig.suptitle(f"fictus sweep of {name}: {title}")
-    fig.savefig(os.path.join(folder, "sweep.png"), dpi=120)
-    plt.close(fig)
+    save(fig, folder, "sweep.png", 120)
+
+
+class WriteError(Exception):
+    """A plot that could not be written (exit code 3, as an output file of the other commands)."""
+
+
+def save(fig, folder, name, dpi):
+    try:
+        fig.savefig(os.path.join(folder, name), dpi=dpi)
+    except OSError as e:
+        raise WriteError(f"cannot write {os.path.join(folder, name)}: {e.strerror or e}") from e
+    finally:
+        plt.close(fig)
 
 
 def main(folder, with_lambda=False):
@@ -455,4 +462,14 @@ if __name__ == "__main__":
     if len(arguments) != 1:
         print("usage: plot.py DIR [--lambda]", file=sys.stderr)
         sys.exit(1)
-    sys.exit(main(arguments[0], "--lambda" in sys.argv[1:]))
+    folder = arguments[0]
+    try:
+        sys.exit(main(folder, "--lambda" in sys.argv[1:]))
+    except WriteError as e:
+        print(f"fictus: error: plot: {e}"[:240], file=sys.stderr)
+        sys.exit(3)
+    except (OSError, ValueError, TypeError, KeyError, IndexError, AttributeError, zlib.error) as e:
+        # A file that is missing, truncated or not one fictus wrote: one line, not a traceback.
+        reason = " ".join(f"{type(e).__name__}: {e}".split())
+        print(f"fictus: error: plot: cannot read the results in {folder}: {reason}"[:240], file=sys.stderr)
+        sys.exit(1)

@@ -11,6 +11,8 @@
 #include <fstream>
 #include <limits>
 #include <optional>
+#include <regex>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <variant>
@@ -352,7 +354,17 @@ void check_output_folder(const fs::path& dir, const std::vector<std::string>& na
       throw OutputError("output.dir: " + (dir / name).string().substr(0, 120) + " is a folder, not a file");
 }
 
-void write_output_set(const fs::path& dir, const std::vector<OutputFile>& files) {
+bool solve_output_name(const std::string& name) {
+  static const std::set<std::string> names = {
+      "results.json", "points.csv",       "solution.vti",       "solution.pvti", "curves.vtp",
+      "surface.vtp",  "offset_curve.vtp", "offset_surface.vtp", "solution.vtm",  "contact_boundary.vtp",
+      "solution.png", "profiles.png",     "slices.png",         "surface.png"};
+  static const std::regex piece(R"(solution_\d+\.vti)");  // a rank's part of the field
+  return names.count(name) > 0 || std::regex_match(name, piece);
+}
+
+void write_output_set(const fs::path& dir, const std::vector<OutputFile>& files,
+                      const std::function<bool(const std::string&)>& superseded) {
   std::vector<std::string> names;
   for (const OutputFile& f : files) names.push_back(f.name);
   check_output_folder(dir, names);
@@ -393,6 +405,20 @@ void write_output_set(const fs::path& dir, const std::vector<OutputFile>& files)
       fs::rename(tmp / f.name, dir / f.name, error);
       if (error) throw OutputError("output: cannot move " + f.name + " into place: " + reason(error));
       placed.push_back(f.name);
+    }
+    if (superseded) {  // 3. an earlier run's files that this set does not replace by name: aside as well
+      std::vector<std::string> stale;
+      for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
+        const std::string name = entry.path().filename().string();
+        if (superseded(name) && std::find(names.begin(), names.end(), name) == names.end() &&
+            !fs::is_directory(entry.path(), error))
+          stale.push_back(name);
+      }
+      for (const std::string& name : stale) {
+        fs::rename(dir / name, tmp / (name + ".earlier"), error);
+        if (error) throw OutputError("output: cannot remove the earlier " + name + ": " + reason(error));
+        kept.push_back(name);
+      }
     }
     fs::remove_all(tmp, error);
   } catch (const fs::filesystem_error& e) {

@@ -65,8 +65,16 @@ void agree_on_threads(const Distribution& distribution, SolverOptions& options);
 /// Writes the files as one set: all into a temporary folder inside `dir` (one file system, also when
 /// `dir` is a mount point), then each earlier file set aside and the new one renamed into place; on
 /// any failure the earlier files are put back, the new ones and the temporary folder removed, and
-/// folders this call made removed: `dir` is as it was. Throws OutputError "output: …".
-void write_output_set(const std::filesystem::path& dir, const std::vector<OutputFile>& files);
+/// folders this call made removed: `dir` is as it was. Files of `dir` that `superseded` names and the
+/// set does not hold (an earlier run's outputs of the same command, and plots made from them) go with
+/// the earlier files: removed when the set is in place, put back on failure. Throws OutputError
+/// "output: …".
+void write_output_set(const std::filesystem::path& dir, const std::vector<OutputFile>& files,
+                      const std::function<bool(const std::string&)>& superseded = {});
+
+/// The names `fictus solve` may write (any dimension, serial or on several ranks) and the plots
+/// `fictus plot` makes from them: an earlier solve's files that a new solve into the folder supersedes.
+bool solve_output_name(const std::string& name);
 
 /// points.csv: one row per point of γ, the same columns in both dimensions (docs/usage.md).
 template <int dim>

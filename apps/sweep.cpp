@@ -3,6 +3,7 @@
 #include "sweep.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -19,23 +20,35 @@
 
 namespace fictus::cli {
 
+namespace {
+
+/// The whole text as a number (std::stod alone stops at the first character it cannot read).
+double whole_number(const std::string& text) {
+  std::size_t used = 0;
+  const double v = std::stod(text, &used);
+  if (used != text.size()) throw std::invalid_argument(text);
+  return v;
+}
+
+}  // namespace
+
 std::vector<double> parse_values(const std::string& text, const std::string& option) {
   std::vector<double> values;
   try {
     const auto colon = std::count(text.begin(), text.end(), ':');
     if (colon == 2) {  // start:stop:count
       const auto a = text.find(':'), b = text.rfind(':');
-      const double start = std::stod(text.substr(0, a)), stop = std::stod(text.substr(a + 1, b - a - 1));
-      const int count = std::stoi(text.substr(b + 1));
-      if (count < 1 || count > 100000) throw std::invalid_argument("count");
+      const double start = whole_number(text.substr(0, a)), stop = whole_number(text.substr(a + 1, b - a - 1));
+      const double count_value = whole_number(text.substr(b + 1));
+      if (!(count_value >= 1 && count_value <= 100000) || count_value != std::floor(count_value))
+        throw std::invalid_argument("count");
+      const int count = int(count_value);
       for (int k = 0; k < count; ++k) values.push_back(count == 1 ? start : start + (stop - start) * k / (count - 1));
     } else {
       std::stringstream in(text);
       std::string item;
       while (std::getline(in, item, ',')) {
-        std::size_t used = 0;
-        values.push_back(std::stod(item, &used));
-        if (used != item.size()) throw std::invalid_argument(item);
+        values.push_back(whole_number(item));
       }
     }
   } catch (const std::exception&) {
@@ -267,8 +280,10 @@ int run_sweep_in(const std::string& text, const SweepArguments& args, const Opti
     if (family.kind == "rotate" && dim == 3) j["sweep"]["axis"] = std::string(1, char('x' + axis_of(args.axis)));
     j["problem"]["name"] = base.problem.name;
     on_rank_0(distribution, [&] {
-      write_output_set(args.out, {{"sweep.csv", [&](std::ostream& out) { out << csv.str(); }},
-                                  {"sweep.json", [&](std::ostream& out) { out << j.dump(2) << '\n'; }}});
+      write_output_set(args.out,
+                       {{"sweep.csv", [&](std::ostream& out) { out << csv.str(); }},
+                        {"sweep.json", [&](std::ostream& out) { out << j.dump(2) << '\n'; }}},
+                       [](const std::string& name) { return name == "sweep.png"; });  // the earlier sweep's plot
       std::printf("wrote sweep.csv and sweep.json to %s/\n", args.out.c_str());
     });
   }

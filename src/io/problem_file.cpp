@@ -497,7 +497,7 @@ const std::vector<std::string> sections = {"domain",     "geometry", "formulatio
 }  // namespace
 
 std::string with_mesh_overrides(const std::string& text, const std::string& source, const std::string& file,
-                                double resolution) {
+                                std::optional<double> resolution) {
   toml::table root = parse_toml(text, source);
   toml::node* node = root.get("geometry");
   if (!node || !node->is_table()) fail("geometry", "missing section [geometry]");
@@ -506,9 +506,9 @@ std::string with_mesh_overrides(const std::string& text, const std::string& sour
   if (!shape || shape->get() != "mesh")
     fail(file.empty() ? "--resolution" : "--file", "--file and --resolution need geometry.shape = \"mesh\"");
   if (!file.empty()) geometry.insert_or_assign("file", std::filesystem::absolute(file).lexically_normal().string());
-  if (resolution >= 0) {
-    check_mesh_resolution(resolution);
-    geometry.insert_or_assign("resolution", std::int64_t(resolution));
+  if (resolution) {
+    check_mesh_resolution(*resolution);
+    geometry.insert_or_assign("resolution", std::int64_t(*resolution));
   }
   std::ostringstream out;
   out << root;

@@ -116,6 +116,7 @@ NewtonResult solve_semismooth_newton(const SchurComplement& schur, const Eigen::
       } else {
         char residual[32];
         std::snprintf(residual, sizeof residual, "%.3e", result.residual);
+        result.stalled = true;
         result.failure = std::string("the active set repeats but the residual ") + residual +
                          " is above the tolerance (inner solver " +
                          (linear.converged ? "converged" : "did not converge") + ")";

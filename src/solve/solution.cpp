@@ -425,12 +425,17 @@ std::string krylov_advice(const BasicSolution<dim>& s) {
 
 template <int dim>
 std::string describe_newton_failure(const BasicSolution<dim>& s) {
-  // Blame the setting at fault: a Krylov solve stopped short makes Newton wander, whatever its cap.
+  // Blame the setting at fault: a Krylov solve stopped short makes Newton wander, whatever its cap; a
+  // set that repeats with the residual above the tolerance cannot gain from more steps.
   std::string line =
       s.newton.inner_failed
           ? "solver.krylov_max_iterations: GMRES stopped at its cap of " +
                 std::to_string(s.options.krylov_max_iterations) + " iterations before solver.krylov_tolerance (" +
                 krylov_advice(s) + "); then Newton: " + s.newton.failure + "; history (active points, residual):"
+      : s.newton.stalled
+          ? "solver.newton_tolerance: Newton stopped short of the tolerance (raise it, or lower formulation.rho "
+            "where it is large: round-off sets the least residual): " +
+                s.newton.failure + "; history (active points, residual):"
           : "solver.max_newton: Newton did not converge: " + s.newton.failure + "; history (active points, residual):";
   for (const NewtonStep& step : s.newton.history) {
     char buffer[64];

@@ -2,6 +2,7 @@
 // Problem files (TOML). Every key, its default and unit: docs/problem_files.md.
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -65,9 +66,9 @@ std::string read_problem_text(const std::string& path);
 const std::vector<std::string>& output_file_names(int dim = 2);
 
 /// The text of a 3-D mesh problem file with [geometry] file (made absolute against the working folder;
-/// "" keeps the file's) and resolution (< 0 keeps the file's) replaced: the flags --file and --resolution.
+/// "" keeps the file's) and resolution (none keeps the file's) replaced: the flags --file and --resolution.
 std::string with_mesh_overrides(const std::string& text, const std::string& source, const std::string& file,
-                                double resolution);
+                                std::optional<double> resolution);
 
 /// `[domain] dim` of a problem file's text: 2 (the default) or 3; throws naming domain.dim otherwise.
 int problem_dimension(const std::string& text, const std::string& source = "problem");

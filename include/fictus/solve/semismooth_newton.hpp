@@ -72,6 +72,7 @@ struct NewtonResult {
   bool handed_on = false;     // stopped by hand_on_at_changes
   std::string failure;        // why not, when not converged
   bool inner_failed = false;  // some step's inner (Krylov) solve stopped at its cap or tolerance short
+  bool stalled = false;       // the active set repeated with the residual above the tolerance
   double residual = 0.0;
   std::vector<NewtonStep> history;
 };
