@@ -736,7 +736,8 @@ int main(int argc, char** argv) {
   sweep_flags.add(*sweep_cmd, [](const fictus::OptionSpec&) { return true; },
                   {{"multipliers", "without a problem file: the paper's m"},
                    {"offset", "without a problem file: 1 (the paper's δ = L/m)"},
-                   {"condition_number", "here: false"}});
+                   {"condition_number", "here: false"},
+                   {"error_estimate", "here: false"}});
 
   CLI::App* options_cmd = app.add_subcommand("options", "list every option: key, default, allowed values, meaning");
   bool markdown = false, as_json = false;

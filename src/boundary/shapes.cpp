@@ -6,6 +6,7 @@
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "fictus/grid/quadrature.hpp"
 
@@ -101,6 +102,34 @@ bool segments_meet(Point2 a, Point2 b, Point2 c, Point2 d, double closeness) {
   return std::min({distance_to_segment(a, c, d), distance_to_segment(b, c, d), distance_to_segment(c, a, b),
                    distance_to_segment(d, a, b)}) <= closeness;
 }
+
+namespace {
+
+/// Where two segments that meet (segments_meet) do so, for the message: their crossing, or the middle
+/// between the nearest end of one and its nearest point on the other.
+Point2 meeting_point(Point2 a, Point2 b, Point2 c, Point2 d) {
+  const Point2 ab = b - a, cd = d - c, ac = c - a;
+  const double det = cross(ab, cd);
+  if (det != 0) {
+    const double t = cross(ac, cd) / det, u = cross(ac, ab) / det;
+    if (t >= 0 && t <= 1 && u >= 0 && u <= 1) return a + t * ab;
+  }
+  const auto nearest_on = [](Point2 x, Point2 p, Point2 q) {
+    const Point2 pq = q - p;
+    const double length2 = pq.x * pq.x + pq.y * pq.y;
+    const double t = length2 > 0 ? std::clamp(((x - p).x * pq.x + (x - p).y * pq.y) / length2, 0.0, 1.0) : 0.0;
+    return p + t * pq;
+  };
+  Point2 best = a;
+  double least = std::numeric_limits<double>::infinity();
+  for (const auto& [x, p, q] : {std::tuple{a, c, d}, std::tuple{b, c, d}, std::tuple{c, a, b}, std::tuple{d, a, b}}) {
+    const Point2 y = nearest_on(x, p, q);
+    if (const double gap = norm(x - y); gap < least) least = gap, best = 0.5 * (x + y);
+  }
+  return best;
+}
+
+}  // namespace
 
 PolygonCurve::PolygonCurve(std::vector<Point2> vertices) : vertices_(std::move(vertices)) {
   const std::size_t n = vertices_.size();
@@ -248,6 +277,14 @@ double checked_extent(const std::vector<Point2>& p, const std::string& what) {
     x0 = std::min(x0, q.x), x1 = std::max(x1, q.x), y0 = std::min(y0, q.y), y1 = std::max(y1, q.y);
   }
   const double size = std::max(x1 - x0, y1 - y0);
+  // Far from the origin beside its size the curve's points lose their digits (a centre at 1e308).
+  const double far = std::max({std::abs(x0), std::abs(x1), std::abs(y0), std::abs(y1)});
+  if (size <= 1e100 && size < 1e-9 * far) {
+    std::ostringstream msg;
+    msg << what << ": the curve lies at " << far << " from the origin, too far for its points to keep their digits "
+        << "(its extent there: " << size << "); move it nearer the origin";
+    throw std::invalid_argument(msg.str());
+  }
   if (!(size > 0 && size <= 1e100))  // an extent that overflows (semi-axes of 1e308) or a point
     throw std::invalid_argument(what + ": the curve's extent is " + (size > 0 ? "beyond 1e100" : "zero"));
   return size;
@@ -284,7 +321,8 @@ void check_simple_polyline(const std::vector<Point2>& p, double closeness, const
       for (std::size_t v = u + 1; v < edges.size(); ++v) {
         const std::size_t a = edges[u], b = edges[v];
         if (a == b || (a + 1) % n == b || (b + 1) % n == a) continue;
-        if (segments_meet(p[a], p[(a + 1) % n], p[b], p[(b + 1) % n], closeness)) touches_itself(what, p[a]);
+        if (segments_meet(p[a], p[(a + 1) % n], p[b], p[(b + 1) % n], closeness))
+          touches_itself(what, meeting_point(p[a], p[(a + 1) % n], p[b], p[(b + 1) % n]));
       }
 }
 

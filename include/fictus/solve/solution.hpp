@@ -37,7 +37,8 @@ struct IndependentCheck {
   double max_complementarity = 0;         // max_i |(D_γ û)_i (B_γ û − g)_i|
   double max_difference = 0;              // max_i |D_γ û − C_γ û|_i
   double rms_difference = 0;              // root mean square of the same
-  double relative_difference = 0;         // rms_difference / max_i |C_γ û|_i (0 where every reading is 0)
+  double relative_difference = 0;  // rms_difference / max_i |C_γ û|_i, or / the trace's slope along γ where the
+                                   // readings carry no flux (0 where both are 0)
   std::vector<double> normal_derivative;  // (D_γ û)_i at every point
 };
 
