@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -242,6 +243,12 @@ int run_sweep_in(const std::string& text, const SweepArguments& args, const Opti
               "force", "min gap", "max gap", "time[s]");
   double total = 0;
   int failures = 0;
+  // A member's warnings that the base problem did not give: each text once, the first few on stderr
+  // (with the member), every member's own in its row of sweep.json.
+  std::set<std::string> said(first.warnings.begin(), first.warnings.end());
+  said.insert(base.warnings.begin(), base.warnings.end());
+  constexpr int warnings_shown = 5;
+  int warnings_new = 0;
   std::optional<std::pair<double, std::string>> first_failure;
   for (const double v : family.values) {
     const auto start = std::chrono::steady_clock::now();
@@ -261,7 +268,18 @@ int run_sweep_in(const std::string& text, const SweepArguments& args, const Opti
     failures += !s.newton.converged;
     if (!s.newton.converged && !first_failure) first_failure = std::pair{v, describe_newton_failure(s)};
     record(family, v, s, seconds, csv, rows);
+    rows.back()["warnings"] = s.warnings;
+    for (const std::string& w : s.warnings)
+      if (said.insert(w).second && ++warnings_new <= warnings_shown) {
+        std::ostringstream at;
+        at.precision(12);
+        at << " (at " << family.name << " = " << v << ")";
+        std::fprintf(stderr, "fictus: warning: %s%s\n", w.c_str(), at.str().c_str());
+      }
   }
+  if (warnings_new > warnings_shown)
+    std::fprintf(stderr, "fictus: warning: %d more members' warnings: the rows of sweep.json hold them\n",
+                 warnings_new - warnings_shown);
   std::printf("grid setup and the base problem %.3f s; then %.4f s per problem (%s%s), %.1f problems per second\n",
               setup, total / family.values.size(),
               family.changes_load  ? "new u0 and Newton"
