@@ -242,7 +242,10 @@ std::pair<int, int> parse_levels(const std::string& text) {
   static const std::regex pattern(R"((\d+)(?:-(\d+))?)");
   std::smatch match;
   if (!std::regex_match(text, match, pattern)) throw std::invalid_argument("--levels: expected A-B, e.g. 7-10");
-  const auto level = [](const std::string& digits) { return digits.size() > 3 ? 999 : std::stoi(digits); };
+  const auto level = [](std::string digits) {
+    digits.erase(0, std::min(digits.find_first_not_of('0'), digits.size() - 1));  // "0009" is 9
+    return digits.size() > 3 ? 999 : std::stoi(digits);
+  };
   const int a = level(match[1]), b = match[2].matched ? level(match[2]) : a;
   if (a < 3 || b > 14 || a > b) throw std::invalid_argument("--levels: need 3 <= A <= B <= 14 (h = 2^-level)");
   return {a, b};
@@ -502,7 +505,7 @@ int run_solve_in(const std::string& text, const SolveCommand& command) {
     if (pieces) field_files = pieces->files(spec.problem, s);
 #endif
     const std::vector<fictus::cli::OutputFile> files = output_files(spec, s, input, field_files);
-    fictus::cli::write_output_set(spec.output.dir, files, fictus::cli::solve_output_name);
+    fictus::cli::write_output_set(spec.output.dir, files, fictus::cli::earlier_solve_outputs(spec.output.dir));
     if (command.quiet) return;
     std::uintmax_t bytes = 0;
     std::error_code error;
@@ -609,9 +612,12 @@ int run_reproduce(const fictus::cli::OptionFlags& flags, const std::string& out,
   if (!out.empty()) {
     std::vector<fictus::cli::OutputFile> set;
     for (const auto& [name, text] : files) set.push_back({name, [&text](std::ostream& o) { o << text; }});
-    const auto reproduced = [](const std::string& name) {  // an earlier reproduction's tables and plot
+    // An earlier reproduction's tables and plot, where its table<k>.json says it was one.
+    const bool earlier = fictus::cli::written_by_fictus(fs::path(out) / "table1.json", "observed_rates") ||
+                         fictus::cli::written_by_fictus(fs::path(out) / "table2.json", "observed_rates");
+    const auto reproduced = [earlier](const std::string& name) {
       static const std::regex table(R"(table[12]\.(csv|json)|convergence\.png)");
-      return std::regex_match(name, table);
+      return earlier && std::regex_match(name, table);
     };
     fictus::cli::on_rank_0(distribution, [&] { fictus::cli::write_output_set(out, set, reproduced); });
     std::printf("wrote %zu files to %s/\n", files.size(), out.c_str());
@@ -748,16 +754,22 @@ int main(int argc, char** argv) {
   if (argc > 1 && argv[1][0] != '-' && !commands.count(argv[1]))
     return fail(std::string(argv[1]) + ": not a command (solve, plot, reproduce, sweep, options; see fictus --help)",
                 exit_bad_input);
-  // "--key=" gives key the empty value: CLI11 would take the next argument as its value instead.
-  std::vector<std::string> arguments;
-  for (int k = argc - 1; k >= 1; --k) {  // CLI11 takes the arguments last first
-    const std::string a = argv[k];
-    if (a.size() > 3 && a.compare(0, 2, "--") == 0 && a.back() == '=' && a.find('=') == a.size() - 1)
-      arguments.insert(arguments.end(), {"", a.substr(0, a.size() - 1)});
-    else
-      arguments.push_back(a);
-  }
-  app.name("fictus");  // (parse(argc, argv) would take argv[0])
+  // "--key=" gives an option that takes a value the empty value: CLI11 would take the next argument
+  // as its value instead. (Flags, and everything after a bare "--", pass as they are.)
+  std::set<std::string> valued;
+  for (const CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; }))
+    for (const CLI::Option* option : command->get_options())
+      if (option->get_items_expected_max() > 0)
+        for (const std::string& name : option->get_lnames()) valued.insert("--" + name + "=");
+  std::vector<std::string> arguments(argv + 1, argv + argc);
+  for (std::size_t k = 0; k < arguments.size() && arguments[k] != "--"; ++k)
+    if (valued.count(arguments[k])) {
+      arguments[k].pop_back();
+      arguments.insert(arguments.begin() + std::ptrdiff_t(k) + 1, "");
+      ++k;
+    }
+  std::reverse(arguments.begin(), arguments.end());  // CLI11 takes the arguments last first
+  app.name("fictus");                                // (parse(argc, argv) would take argv[0])
   try {
     app.parse(arguments);
   } catch (const CLI::CallForHelp& e) {

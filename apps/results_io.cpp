@@ -354,13 +354,28 @@ void check_output_folder(const fs::path& dir, const std::vector<std::string>& na
       throw OutputError("output.dir: " + (dir / name).string().substr(0, 120) + " is a folder, not a file");
 }
 
-bool solve_output_name(const std::string& name) {
-  static const std::set<std::string> names = {
-      "results.json", "points.csv",       "solution.vti",       "solution.pvti", "curves.vtp",
-      "surface.vtp",  "offset_curve.vtp", "offset_surface.vtp", "solution.vtm",  "contact_boundary.vtp",
-      "solution.png", "profiles.png",     "slices.png",         "surface.png"};
-  static const std::regex piece(R"(solution_\d+\.vti)");  // a rank's part of the field
-  return names.count(name) > 0 || std::regex_match(name, piece);
+bool written_by_fictus(const fs::path& file, const std::string& key) {
+  std::error_code error;
+  if (!fs::is_regular_file(file, error)) return false;
+  std::ifstream in(file, std::ios::binary);
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);  // no exception: discarded when bad
+  return j.is_object() && j.contains(key);
+}
+
+std::function<bool(const std::string&)> earlier_solve_outputs(const fs::path& dir) {
+  if (!written_by_fictus(dir / "results.json", "options")) return {};
+  std::string pieces;  // the earlier solution.pvti, which names the ranks' parts of the field
+  if (std::ifstream in(dir / "solution.pvti", std::ios::binary); in)
+    pieces.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return [pieces](const std::string& name) {
+    static const std::set<std::string> names = {
+        "results.json", "points.csv",       "solution.vti",       "solution.pvti", "curves.vtp",
+        "surface.vtp",  "offset_curve.vtp", "offset_surface.vtp", "solution.vtm",  "contact_boundary.vtp",
+        "solution.png", "profiles.png",     "slices.png",         "surface.png"};
+    static const std::regex piece(R"(solution_\d+\.vti)");
+    return names.count(name) > 0 ||
+           (std::regex_match(name, piece) && pieces.find('"' + name + '"') != std::string::npos);
+  };
 }
 
 void write_output_set(const fs::path& dir, const std::vector<OutputFile>& files,

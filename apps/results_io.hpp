@@ -72,9 +72,14 @@ void agree_on_threads(const Distribution& distribution, SolverOptions& options);
 void write_output_set(const std::filesystem::path& dir, const std::vector<OutputFile>& files,
                       const std::function<bool(const std::string&)>& superseded = {});
 
-/// The names `fictus solve` may write (any dimension, serial or on several ranks) and the plots
-/// `fictus plot` makes from them: an earlier solve's files that a new solve into the folder supersedes.
-bool solve_output_name(const std::string& name);
+/// Whether `file` is a JSON object with `key`: a file fictus wrote (results.json: "options").
+bool written_by_fictus(const std::filesystem::path& file, const std::string& key);
+
+/// Where `dir` holds an earlier solve (its results.json), the names of that solve's files that a new
+/// solve into `dir` supersedes: what `fictus solve` may write in either dimension, the ranks' parts
+/// of the field its solution.pvti names, and the plots `fictus plot` makes from them. Otherwise none
+/// (an empty function): a user's own files of those names stay.
+std::function<bool(const std::string&)> earlier_solve_outputs(const std::filesystem::path& dir);
 
 /// points.csv: one row per point of γ, the same columns in both dimensions (docs/usage.md).
 template <int dim>

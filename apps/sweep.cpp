@@ -278,8 +278,8 @@ int run_sweep_in(const std::string& text, const SweepArguments& args, const Opti
       }
   }
   if (warnings_new > warnings_shown)
-    std::fprintf(stderr, "fictus: warning: %d more members' warnings: the rows of sweep.json hold them\n",
-                 warnings_new - warnings_shown);
+    std::fprintf(stderr, "fictus: warning: %d more members' warnings%s\n", warnings_new - warnings_shown,
+                 args.out.empty() ? " not shown" : ": sweep.json's rows hold them");
   std::printf("grid setup and the base problem %.3f s; then %.4f s per problem (%s%s), %.1f problems per second\n",
               setup, total / family.values.size(),
               family.changes_load  ? "new u0 and Newton"
@@ -301,7 +301,8 @@ int run_sweep_in(const std::string& text, const SweepArguments& args, const Opti
       write_output_set(args.out,
                        {{"sweep.csv", [&](std::ostream& out) { out << csv.str(); }},
                         {"sweep.json", [&](std::ostream& out) { out << j.dump(2) << '\n'; }}},
-                       [](const std::string& name) { return name == "sweep.png"; });  // the earlier sweep's plot
+                       [earlier = written_by_fictus(std::filesystem::path(args.out) / "sweep.json", "rows")](
+                           const std::string& name) { return earlier && name == "sweep.png"; });  // its plot
       std::printf("wrote sweep.csv and sweep.json to %s/\n", args.out.c_str());
     });
   }

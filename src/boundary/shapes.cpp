@@ -279,7 +279,7 @@ double checked_extent(const std::vector<Point2>& p, const std::string& what) {
   const double size = std::max(x1 - x0, y1 - y0);
   // Far from the origin beside its size the curve's points lose their digits (a centre at 1e308).
   const double far = std::max({std::abs(x0), std::abs(x1), std::abs(y0), std::abs(y1)});
-  if (size <= 1e100 && size < 1e-9 * far) {
+  if (size <= 1e100 && (size > 0 ? size < 1e-13 * far : far > 1e12)) {
     std::ostringstream msg;
     msg << what << ": the curve lies at " << far << " from the origin, too far for its points to keep their digits "
         << "(its extent there: " << size << "); move it nearer the origin";

@@ -423,9 +423,10 @@ std::string did_you_mean(std::string_view name, const std::vector<std::string>& 
     if (candidate.empty() || candidate.size() > a.size() + allowed + 1 || candidate == name) continue;
     const std::size_t d = distance(lower(candidate));
     // Not one that changes every letter ("g" for "f"): a near spelling keeps some of the name. A
-    // one-letter key is kept by a name that only repeats or adds to it ("NN" for "N").
+    // one-letter key is kept by a name that only repeats it ("NN" for "N"; not "xy" for "x").
     const std::string c = lower(candidate);
-    const bool keeps = d < std::min(a.size(), c.size()) || (c.size() == 1 && a.find(c) != std::string::npos);
+    const bool keeps =
+        d < std::min(a.size(), c.size()) || (c.size() == 1 && a.find_first_not_of(c) == std::string::npos);
     if (d < best && keeps) best = d, nearest = candidate;
   }
   return nearest.empty() ? "" : " (did you mean \"" + nearest + "\"?)";

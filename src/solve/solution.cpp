@@ -433,8 +433,9 @@ std::string describe_newton_failure(const BasicSolution<dim>& s) {
                 std::to_string(s.options.krylov_max_iterations) + " iterations before solver.krylov_tolerance (" +
                 krylov_advice(s) + "); then Newton: " + s.newton.failure + "; history (active points, residual):"
       : s.newton.stalled
-          ? "solver.newton_tolerance: Newton stopped short of the tolerance (raise it, or lower formulation.rho "
-            "where it is large: round-off sets the least residual): " +
+          ? "solver.newton_tolerance: the active set repeats but the residual stays above the tolerance, so more "
+            "steps cannot lower it (raise the tolerance where the residual is near round-off; lower formulation.rho "
+            "where it is large): " +
                 s.newton.failure + "; history (active points, residual):"
           : "solver.max_newton: Newton did not converge: " + s.newton.failure + "; history (active points, residual):";
   for (const NewtonStep& step : s.newton.history) {

@@ -32,13 +32,13 @@ struct SignoriniCheck {
 /// The Signorini conditions once more with a normal derivative D_γ û from another stencil than the
 /// solve's C_γ (docs/math.md, "Checks"): where C_γ is wrong, D_γ û − C_γ û shows it.
 struct IndependentCheck {
-  std::string rule;                       // the stencil of D_γ
-  double min_normal_derivative = 0;       // min_i (D_γ û)_i
-  double max_complementarity = 0;         // max_i |(D_γ û)_i (B_γ û − g)_i|
-  double max_difference = 0;              // max_i |D_γ û − C_γ û|_i
-  double rms_difference = 0;              // root mean square of the same
-  double relative_difference = 0;  // rms_difference / max_i |C_γ û|_i, or / the trace's slope along γ where the
-                                   // readings carry no flux (0 where both are 0)
+  std::string rule;                  // the stencil of D_γ
+  double min_normal_derivative = 0;  // min_i (D_γ û)_i
+  double max_complementarity = 0;    // max_i |(D_γ û)_i (B_γ û − g)_i|
+  double max_difference = 0;         // max_i |D_γ û − C_γ û|_i
+  double rms_difference = 0;         // root mean square of the same
+  double relative_difference = 0;    // rms_difference / max_i |C_γ û|_i, or / the trace's slope along γ where the
+                                     // readings carry no flux (0 where both are 0)
   std::vector<double> normal_derivative;  // (D_γ û)_i at every point
 };
 
