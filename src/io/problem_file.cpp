@@ -429,6 +429,7 @@ void read_conditions(TableReader& table, const ExpressionMaker& expression, Basi
     };
   };
   for (const char* key : {"dirichlet", "u", "neumann", "flux"}) table.string(key, "");  // the keys known here
+  table.finish();  // a misspelt key first: "neuman" beside a flux is answered as a misspelling
   PartConditions<dim>& c = p.conditions;
   if (table.has("dirichlet")) c.dirichlet = field("dirichlet");
   if (table.has("neumann")) c.neumann = field("neumann");
@@ -448,7 +449,6 @@ void read_conditions(TableReader& table, const ExpressionMaker& expression, Basi
         return e({x[0], x[1], x[2], n[0], n[1], n[2]});
     };
   }
-  table.finish();
 }
 
 /// [output]: the folder and the files (the names of the dimension).
