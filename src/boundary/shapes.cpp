@@ -28,13 +28,16 @@ bool within(Point2 a, Point2 b, Point2 p) {
          p.y <= std::max(a.y, b.y);
 }
 
-/// Distance from p to the closed segment ab.
-double distance_to_segment(Point2 p, Point2 a, Point2 b) {
+/// The point of the closed segment ab nearest to p.
+Point2 nearest_on_segment(Point2 p, Point2 a, Point2 b) {
   const Point2 d = b - a;
   const double dd = d.x * d.x + d.y * d.y;
   const double t = dd > 0 ? std::clamp(((p.x - a.x) * d.x + (p.y - a.y) * d.y) / dd, 0.0, 1.0) : 0.0;
-  return norm(p - (a + t * d));
+  return a + t * d;
 }
+
+/// Distance from p to the closed segment ab.
+double distance_to_segment(Point2 p, Point2 a, Point2 b) { return norm(p - nearest_on_segment(p, a, b)); }
 
 /// Adds x to the non-overlapping expansion `partials` (increasing magnitude) exactly: Shewchuk's
 /// grow-expansion with zero elimination, as in Python's math.fsum.
@@ -114,16 +117,10 @@ Point2 meeting_point(Point2 a, Point2 b, Point2 c, Point2 d) {
     const double t = cross(ac, cd) / det, u = cross(ac, ab) / det;
     if (t >= 0 && t <= 1 && u >= 0 && u <= 1) return a + t * ab;
   }
-  const auto nearest_on = [](Point2 x, Point2 p, Point2 q) {
-    const Point2 pq = q - p;
-    const double length2 = pq.x * pq.x + pq.y * pq.y;
-    const double t = length2 > 0 ? std::clamp(((x - p).x * pq.x + (x - p).y * pq.y) / length2, 0.0, 1.0) : 0.0;
-    return p + t * pq;
-  };
   Point2 best = a;
   double least = std::numeric_limits<double>::infinity();
   for (const auto& [x, p, q] : {std::tuple{a, c, d}, std::tuple{b, c, d}, std::tuple{c, a, b}, std::tuple{d, a, b}}) {
-    const Point2 y = nearest_on(x, p, q);
+    const Point2 y = nearest_on_segment(x, p, q);
     if (const double gap = norm(x - y); gap < least) least = gap, best = 0.5 * (x + y);
   }
   return best;
