@@ -215,7 +215,7 @@ int run_sweep_in(const std::string& text, const SweepArguments& args, const Opti
   axis_of(args.axis);  // a bad axis before any work
   const BasicProblemSpec<dim> base = problem_from_text<dim>(text, args.problem_path, flags);
   const Family family = family_of(args, base);
-  if (dim == 2 && flags.given("condition_number") && base.options.condition_number)
+  if (flags.given("condition_number") && base.options.condition_number)
     throw std::invalid_argument("solver.condition_number: not computed in a sweep (solve one problem for cond(S))");
   if (flags.given("error_estimate") && base.options.error_estimate)
     throw std::invalid_argument("solver.error_estimate: not computed in a sweep (solve one member for its estimate)");
@@ -225,8 +225,8 @@ int run_sweep_in(const std::string& text, const SweepArguments& args, const Opti
   if (!args.out.empty()) on_rank_0(distribution, [&] { check_output_folder(args.out, {"sweep.csv", "sweep.json"}); });
   SolverOptions options = base.options;
   agree_on_threads(distribution, options);
-  if constexpr (dim == 2) options.condition_number = false;  // not a column of the sweep
-  options.error_estimate = false;  // nor is the estimate: a member's N/2 solve would not reuse the blocks
+  options.condition_number = false;  // not a column of the sweep
+  options.error_estimate = false;    // nor is the estimate: a member's N/2 solve would not reuse the blocks
   on_rank_0(distribution, [&] { check_memory(base.problem, options); });
   const auto setup_start = std::chrono::steady_clock::now();
   FictitiousDomainSolver<dim> solver(base.problem, options);

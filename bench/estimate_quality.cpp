@@ -66,7 +66,7 @@ fictus::BasicProblemSpec<dim> read_spec(const std::string& file, int N, fictus::
   fictus::BasicProblemSpec<dim> spec = fictus::parse_problem<dim>(fictus::read_problem_text(file), file);
   spec.problem.N = N;
   spec.options.variant = variant;
-  if (dim == 2) spec.options.condition_number = false;
+  spec.options.condition_number = false;
   spec.options.threads = 2;
   return spec;
 }

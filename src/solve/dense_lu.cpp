@@ -65,19 +65,19 @@ void DenseLu::compute(Eigen::MatrixXd&& A) {
   norm1_ = norm1;
 }
 
-void DenseLu::solve_in_place(Eigen::MatrixXd& B) const {
+void DenseLu::solve_in_place(Eigen::MatrixXd& B, bool transposed) const {
   if (B.rows() != size()) throw std::invalid_argument("DenseLu::solve: the right-hand side has the wrong size");
   if (empty() || B.cols() == 0) return;
   const int n = int(size()), nrhs = lapack_size(B.cols(), "right-hand side");
   int info = 0;
   const LapackThreads threads;
-  dgetrs_("N", &n, &nrhs, factors_.data(), &n, pivots_.data(), B.data(), &n, &info, 1);
+  dgetrs_(transposed ? "T" : "N", &n, &nrhs, factors_.data(), &n, pivots_.data(), B.data(), &n, &info, 1);
   check(info, "dgetrs");
 }
 
-Eigen::VectorXd DenseLu::solve(const Eigen::VectorXd& r) const {
+Eigen::VectorXd DenseLu::solve(const Eigen::VectorXd& r, bool transposed) const {
   Eigen::MatrixXd x = r;
-  solve_in_place(x);
+  solve_in_place(x, transposed);
   return x.col(0);
 }
 

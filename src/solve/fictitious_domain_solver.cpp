@@ -446,7 +446,7 @@ std::optional<BasicSolution<dim>> coarse_solve(const State<dim>& st, const Basic
   coarse.f = st.f, coarse.f_vectorized = st.f_vectorized;
   SolverOptions coarse_options = options;
   coarse_options.error_estimate = false;
-  if constexpr (dim == 2) coarse_options.condition_number = false;
+  coarse_options.condition_number = false;
   if (options.multipliers > 0)
     coarse_options.multipliers =
         std::max(minimum_multipliers, int(std::lround(options.multipliers / (dim == 2 ? 2.0 : 4.0))));
@@ -695,7 +695,6 @@ void newton(const State<dim>& st, BoundarySetup<dim>& setup, const SolverOptions
   sol.schur_storage = setup.storage;
   if (!setup.storage_warning.empty()) sol.warnings.push_back(setup.storage_warning);
   for (const NewtonStep& step : sol.newton.history) sol.inner_iterations += step.inner_iterations;
-  if (options.condition_number && dim == 2) sol.condition_number = setup.schur->condition_number(sol.newton.active);
   // Distributed: every rank ran the same steps on the same numbers; rank 0's λ, α, active set and outcome
   // are the answer, so that no later decision can differ between ranks.
   const Distribution& distribution = st.execution.distribution();
@@ -1036,10 +1035,12 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
     junction_warning<dim>(boundary, *current, sol);
     sol.delta = boundary.delta();
     sol.flux_balance = boundary.flux_balance(setup.shift);
-    SolverOptions pass_options = options;
-    pass_options.condition_number = options.condition_number && last;  // of the final matrix only
-    newton<dim>(st, setup, pass_options, start, sol);                  // 5
+    newton<dim>(st, setup, options, start, sol);  // 5
     clock.mark("newton");
+    if (options.condition_number && last) {  // of the final matrix only
+      sol.condition_number = setup.schur->condition_number(sol.newton.active, setup.mode ? &*setup.mode : nullptr);
+      clock.mark("condition");
+    }
     st.execution.throw_if_interrupted();
     return setup;
   };

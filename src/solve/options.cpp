@@ -344,10 +344,10 @@ void more_solver_specs(std::vector<OptionSpec>& specs) {
   }
   {
     OptionSpec c = member(std::string("solver"), std::string("condition_number"), OptionType::boolean,
-                          &SolverOptions::condition_number, "compute cond(S) of the final Newton matrix (green only)");
+                          &SolverOptions::condition_number,
+                          "compute cond₂(S) of the final Newton matrix (dense Schur complement only)");
     c.rule = "true or false";
     c.violation = [](const OptionValue&, int) { return std::string(); };
-    c.dims = {2};
     specs.push_back(c);
   }
 }

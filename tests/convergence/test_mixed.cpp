@@ -44,7 +44,7 @@ fictus::SolverOptions options(fictus::Variant variant) {
   o.variant = variant;
   o.threads = 2;
   o.error_estimate = false;  // the rates of the solve itself
-  if constexpr (dim == 2) o.condition_number = false;
+  o.condition_number = false;
   return o;
 }
 

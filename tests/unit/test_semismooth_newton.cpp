@@ -263,3 +263,52 @@ TEST(NewtonMixedConditions, FixedRowsHoldAndSignoriniRowsChoose) {
   conditions.kind.pop_back();
   EXPECT_THROW(fictus::solve_semismooth_newton(schur, b0, c0, g, o), std::invalid_argument);
 }
+
+// cond₂(S_𝒜) by Lanczos from the kept LU against all singular values (Eigen's SVD): on the matrices above
+// (bordered and not, prepared through an update, so factored anew for the transposed solves), and on a
+// matrix of given singular values 1e-6 … 1 whose two largest and two smallest lie 0.1 % apart, where the
+// Lanczos process needs the most steps to tell them apart. Each estimate is never above the truth.
+TEST(NewtonFactorization, ConditionNumberIsThatOfTheSingularValues) {
+  const auto exact = [](const Eigen::MatrixXd& S) {
+    const Eigen::BDCSVD<Eigen::MatrixXd> svd(S);
+    const Eigen::VectorXd& s = svd.singularValues();
+    return s(0) / s(s.size() - 1);
+  };
+  const int m = 200;
+  Eigen::MatrixXd S_B(m, m), S_C(m, m);
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      S_B(i, j) = (i == j ? 4.0 : 0.0) + std::sin(0.37 * i + 1.3 * j) / (1.0 + std::abs(i - j));
+      S_C(i, j) = (i == j ? 3.0 : 0.0) + std::cos(0.11 * i - 0.7 * j) / (1.0 + std::abs(i - j));
+    }
+  fictus::ConstantMode mode;
+  mode.trace_B = Eigen::VectorXd::LinSpaced(m, 1.0, 2.0);
+  mode.trace_C = Eigen::VectorXd::LinSpaced(m, -0.5, 0.5);
+  mode.arc_weights = Eigen::VectorXd::Constant(m, 1.0 / m);
+  const fictus::ExplicitSchur schur(S_B, S_C);
+  for (const fictus::ConstantMode* bordering : std::array<const fictus::ConstantMode*, 2>{nullptr, &mode}) {
+    fictus::ActiveSet active(m, 1);
+    for (int i = 0; i < m; i += 3) active[std::size_t(i)] = 0;
+    schur.factorization(active, bordering);
+    active[5] ^= 1, active[40] ^= 1;
+    EXPECT_TRUE(schur.factorization(active, bordering).updated());
+    const double want = exact(schur.newton_matrix(active, bordering));
+    const double got = *schur.condition_number(active, bordering);
+    EXPECT_LE(got, want * (1 + 1e-12));
+    EXPECT_NEAR(got, want, 1e-9 * want) << (bordering ? "bordered" : "not bordered");
+  }
+  // U Σ Vᵀ with orthogonal U, V from the QR of two fixed matrices.
+  Eigen::MatrixXd P(m, m), R(m, m);
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) P(i, j) = std::sin(1.7 * i * j + i), R(i, j) = std::cos(0.9 * i * j - j);
+  const Eigen::MatrixXd U = Eigen::HouseholderQR<Eigen::MatrixXd>(P).householderQ(),
+                        V = Eigen::HouseholderQR<Eigen::MatrixXd>(R).householderQ();
+  Eigen::VectorXd sigma =
+      Eigen::VectorXd::LinSpaced(m, 0.0, -6.0).unaryExpr([](double e) { return std::pow(10.0, e); });
+  sigma(1) = 0.999 * sigma(0), sigma(m - 2) = 1.001 * sigma(m - 1);
+  const Eigen::MatrixXd S = U * sigma.asDiagonal() * V.transpose();
+  const fictus::ExplicitSchur spread(S, S_C);
+  const double got = *spread.condition_number(fictus::ActiveSet(m, 1), nullptr);
+  EXPECT_LE(got, 1e6 * (1 + 1e-9));
+  EXPECT_NEAR(got, exact(S), 1e-8 * exact(S));
+}

@@ -19,9 +19,9 @@ class DenseLu {
   void compute(Eigen::MatrixXd&& A);
   bool empty() const { return pivots_.empty(); }
   Eigen::Index size() const { return factors_.rows(); }
-  /// B ← A⁻¹B (B has size() rows).
-  void solve_in_place(Eigen::MatrixXd& B) const;
-  Eigen::VectorXd solve(const Eigen::VectorXd& r) const;
+  /// B ← A⁻¹B, or A⁻ᵀB when `transposed` (B has size() rows).
+  void solve_in_place(Eigen::MatrixXd& B, bool transposed = false) const;
+  Eigen::VectorXd solve(const Eigen::VectorXd& r, bool transposed = false) const;
   /// An estimate of 1/κ₁(A) (LAPACK's dgecon, O(m²) after the factorization).
   double reciprocal_condition() const;
 

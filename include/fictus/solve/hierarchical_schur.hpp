@@ -66,7 +66,7 @@ class HierarchicalSchur final : public SchurComplement {
   LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, Eigen::VectorXd& lambda,
                           double relative_tolerance) const;
   std::size_t fast_solves() const override { return 0; }
-  std::optional<double> condition_number(const ActiveSet&) const override { return std::nullopt; }
+  std::optional<double> condition_number(const ActiveSet&, const ConstantMode*) const override { return std::nullopt; }
   const SchurStorage& storage() const;
   /// Block LUs of the preconditioner made so far.
   int factorizations() const;
@@ -100,8 +100,8 @@ class RefinedSchur final : public SchurComplement {
   LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
                           Eigen::VectorXd& lambda, double& alpha) const override;
   std::size_t fast_solves() const override { return exact_.fast_solves(); }
-  std::optional<double> condition_number(const ActiveSet& active) const override {
-    return approximate_.condition_number(active);
+  std::optional<double> condition_number(const ActiveSet& active, const ConstantMode* mode) const override {
+    return approximate_.condition_number(active, mode);
   }
 
  private:
@@ -126,7 +126,7 @@ class SettlingSchur final : public SchurComplement {
   LinearSolveReport solve(const ActiveSet& active, const Eigen::VectorXd& d, const ConstantMode* mode,
                           Eigen::VectorXd& lambda, double& alpha) const override;
   std::size_t fast_solves() const override { return 0; }
-  std::optional<double> condition_number(const ActiveSet&) const override { return std::nullopt; }
+  std::optional<double> condition_number(const ActiveSet&, const ConstantMode*) const override { return std::nullopt; }
 
  private:
   const HierarchicalSchur& approximate_;
