@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Dense against hierarchical Schur storage, one table from the runs' results.json and points.csv.
 
-Usage: compare_schur_storage.py DIR...   (each DIR/o_<N>_<kind> from `fictus solve ... --schur_storage <kind>`)
+Usage: compare_schur_storage.py DIR...   (each DIR/o_<N>_<kind> from `fictus solve ... --schur_storage <kind>
+--no-condition`: cond(S) is computed with the dense storage only, and would weigh on its total alone)
 Prints a markdown table: per N and kind, the phases that differ, the storage, Newton's work, peak memory,
 and λ and the contact set against the dense run of the same N.
 """

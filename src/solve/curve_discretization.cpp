@@ -159,6 +159,7 @@ void CurveDiscretization::make_shape(const Grid2& grid, const SolverOptions& opt
   const Curve& gamma = *gamma_;
   const double h = grid.h(), width = grid.box().width(0);
   check_simple(gamma, "geometry");
+  check_regular(gamma, "geometry");
   if (signed_area(gamma) <= 0)
     throw std::invalid_argument("geometry: the curve must be counter-clockwise (ω on its left)");
   if (const BoxClearance c = box_clearance(gamma, grid.box(), "geometry"); c.distance < 2 * h) {

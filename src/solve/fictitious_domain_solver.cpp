@@ -1037,10 +1037,6 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
     sol.flux_balance = boundary.flux_balance(setup.shift);
     newton<dim>(st, setup, options, start, sol);  // 5
     clock.mark("newton");
-    if (options.condition_number && last) {  // of the final matrix only
-      sol.condition_number = setup.schur->condition_number(sol.newton.active, setup.mode ? &*setup.mode : nullptr);
-      clock.mark("condition");
-    }
     st.execution.throw_if_interrupted();
     return setup;
   };
@@ -1101,6 +1097,17 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
       fitted.conditions.contact_side = std::move(side);
       current = &fitted;
       continue;
+    }
+    if (options.condition_number && setup.schur) {  // of the final Newton matrix: the solve whose results stand
+      sol.condition_number = setup.schur->condition_number(sol.newton.active, setup.mode ? &*setup.mode : nullptr);
+      if (const auto* dense = dynamic_cast<const ExplicitSchur*>(setup.schur.get())) {
+        sol.factorizations = dense->factorizations();  // its LU, where it factored S_𝒜 anew
+        if (!sol.condition_number)
+          sol.warnings.push_back(
+              "solver.condition_number: the final Newton matrix is singular to working precision (its LU solves "
+              "are not finite); no condition number");
+      }
+      clock.mark("condition");
     }
     if (!keep) setup.schur.reset(), setup.exact.reset();  // S_B, S_C and the kept LU: freed before the field
     break;
@@ -1199,14 +1206,14 @@ bool compressed(const BasicProblem<dim>& problem, const SolverOptions& options, 
 template <int dim>
 std::size_t estimated_peak_bytes(const BasicProblem<dim>& problem, const SolverOptions& options) {
   const auto [nodes, m] = nodes_and_multipliers(problem, options);
-  // Dense: S_B, S_C and the LU's copy (2-D: and the condition number's). Compressed: S_B and S_C as
+  // Dense: S_B, S_C and the LU's copy. Compressed: S_B and S_C as
   // measured on the sphere (16m²·0.44 at m = 3217, ·0.25 at m = 7238, ·0.16 at m = 12 868:
   // 2600·m^1.27 bytes) and the preconditioner's blocks of 256 points (three matrices), both shared out
   // over the ranks.
   const double P = process_distribution()->size(), arrays = dim == 2 ? 3 : 4;
   const double schur = compressed(problem, options, m)
                            ? (std::min(16 * m * m, 2600 * std::pow(m, 1.27)) + 3 * 8 * 256 * m) / P
-                           : (dim == 2 ? 4 : 3) * 8 * m * m;
+                           : 3 * 8 * m * m;
   // On P ranks (one rank's peak, measured at 3-D N = 384 on 2 and 4 ranks, bench/results): 0.8 arrays on
   // every rank (the boundary setup) and 2.4 split, FFTW-MPI's transposes included.
   const double grid = P > 1 ? 8 * nodes * (0.8 + 2.4 / P) : arrays * 8 * nodes;

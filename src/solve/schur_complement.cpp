@@ -157,10 +157,10 @@ void NewtonFactorization::prepare(const ActiveSet& active, const ConstantMode* m
   rows_ = std::move(rows);
 }
 
-double NewtonFactorization::condition_number(const ActiveSet& active, const ConstantMode* mode, double tolerance,
-                                             int max_steps) {
-  prepare(active, mode);
-  if (updated()) factor(active, mode);  // the solves with S_𝒜ᵀ need its own LU
+std::optional<double> NewtonFactorization::condition_number(const ActiveSet& active, const ConstantMode* mode,
+                                                            double tolerance, int max_steps) {
+  // The solves with S_𝒜ᵀ need the LU of S_𝒜 itself, not an update of another's.
+  if (base_.empty() || base_ != active || !same_mode(mode_, mode)) factor(active, mode);
   const Eigen::Index m = S_B_.rows(), n = m + (mode ? 1 : 0);
   const auto product = [&](const Eigen::VectorXd& x) {  // S_𝒜 x
     Eigen::VectorXd sb = S_B_ * x.head(m), sc = S_C_ * x.head(m), y;
@@ -180,9 +180,9 @@ double NewtonFactorization::condition_number(const ActiveSet& active, const Cons
   };
   // √λ_max(HᵀH) for H given as `half` (x ↦ Hx) and Hᵀ as `other`, by the Lanczos process on HᵀH with full
   // reorthogonalization (twice: the steps are few, and lost orthogonality would repeat a Ritz value).
-  // The power method on the same products settled 0.3 % low on the ellipsoid's non-smooth matrix at
-  // m = 906; Lanczos agrees with the singular values to 1e-11 there.
-  const auto largest_singular_value = [&](const auto& half, const auto& other) {
+  // It stops when the residual of the largest Ritz pair (θ, Q_k y), β_k·|y_k|, is at most tolerance·θ:
+  // then θ ≤ λ_max ≤ θ(1 + tolerance). Not finite (a singular LU): nothing.
+  const auto largest_singular_value = [&](const auto& half, const auto& other) -> std::optional<double> {
     const int steps = int(std::min<Eigen::Index>(max_steps, n));
     Eigen::MatrixXd Q(n, steps);
     Eigen::VectorXd alpha(steps), beta(steps), q(n);
@@ -191,24 +191,26 @@ double NewtonFactorization::condition_number(const ActiveSet& active, const Cons
     double theta = 0.0;
     for (int k = 0; k < steps; ++k) {
       Eigen::VectorXd w = other(half(Q.col(k)));
+      if (!w.allFinite()) return std::nullopt;
       alpha(k) = Q.col(k).dot(w);
       for (int pass = 0; pass < 2; ++pass) w -= Q.leftCols(k + 1) * (Q.leftCols(k + 1).transpose() * w);
       beta(k) = w.norm();
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ritz;
-      ritz.computeFromTridiagonal(alpha.head(k + 1), beta.head(k), Eigen::EigenvaluesOnly);
-      const double next = ritz.eigenvalues()(k);
-      if (!std::isfinite(next)) return std::sqrt(std::max(theta, 0.0));
-      const bool settled = std::abs(next - theta) <= tolerance * next || beta(k) <= 1e-14 * next;
-      theta = next;
-      if (settled || k + 1 == steps) break;
-      Q.col(k + 1) = w / beta(k);
+      ritz.computeFromTridiagonal(alpha.head(k + 1), beta.head(k), Eigen::ComputeEigenvectors);
+      if (ritz.info() != Eigen::Success) return std::nullopt;
+      theta = ritz.eigenvalues()(k);
+      const double residual = beta(k) * std::abs(ritz.eigenvectors()(k, k));
+      if (residual <= tolerance * theta || beta(k) <= 1e-14 * theta) break;
+      if (k + 1 < steps) Q.col(k + 1) = w / beta(k);
     }
     return std::sqrt(std::max(theta, 0.0));
   };
-  const double largest = largest_singular_value(product, transposed_product);  // σ_max
-  const double inverse = largest_singular_value([&](const Eigen::VectorXd& x) { return lu_.solve(x, true); },
-                                                [&](const Eigen::VectorXd& y) { return lu_.solve(y); });  // 1/σ_min
-  return largest * inverse;
+  const std::optional<double> largest = largest_singular_value(product, transposed_product);  // σ_max
+  const std::optional<double> inverse =
+      largest_singular_value([&](const Eigen::VectorXd& x) { return lu_.solve(x, true); },
+                             [&](const Eigen::VectorXd& y) { return lu_.solve(y); });  // 1/σ_min
+  if (!largest || !inverse || !std::isfinite(*largest * *inverse)) return std::nullopt;
+  return *largest * *inverse;
 }
 
 Eigen::VectorXd NewtonFactorization::update_solve(const Eigen::VectorXd& r) const {

@@ -102,6 +102,12 @@ bool segments_meet(Point2 a, Point2 b, Point2 c, Point2 d, double closeness);
 /// quarter of the spacing to a corner is left out, so that no piece is shorter than that.
 void check_simple(const Curve& curve, const std::string& what, int samples = 4096);
 
+/// Throws std::invalid_argument("<what>: the curve has a cusp near (x, y) …") where a curve other than
+/// a polygon has no normal: p′(t) is not finite, or below 1e-9 of its mean, at one of `samples` points
+/// equally spaced in t, or the unit tangent reverses (turns by more than 172°) between two neighbouring
+/// samples or across one (the astroid's cusps, whose offset curve has no finite speed).
+void check_regular(const Curve& curve, const std::string& what, int samples = 4096);
+
 /// check_simple() of the closed polygon through `vertices` (the closing edge implied).
 void check_simple_polygon(const std::vector<Point2>& vertices, const std::string& what);
 

@@ -181,11 +181,11 @@ class NewtonFactorization {
   int factorizations() const { return factorizations_; }
   /// κ₂(S_𝒜) = σ_max/σ_min by the Lanczos process: σ_max² as the largest eigenvalue of S_𝒜ᵀS_𝒜
   /// (products with the blocks), 1/σ_min² as that of S_𝒜⁻¹S_𝒜⁻ᵀ (solves with the LU; S_𝒜 is factored
-  /// anew where it was prepared through an update). Each is the largest Ritz value, never above the
-  /// eigenvalue; the steps stop when it changes by less than `tolerance` (relative), at most `max_steps`
-  /// of O(m²) each. Agrees with all singular values to 1e-11 (docs/math.md, "The condition number").
-  double condition_number(const ActiveSet& active, const ConstantMode* mode, double tolerance = 1e-10,
-                          int max_steps = 100);
+  /// anew unless it is the one factored). Each stops when its Ritz residual is at most `tolerance` of the
+  /// Ritz value (never above the eigenvalue), at most `max_steps` steps of O(m²) each. Empty where the
+  /// solves are not finite (S_𝒜 singular to working precision). docs/math.md, "The condition number".
+  std::optional<double> condition_number(const ActiveSet& active, const ConstantMode* mode, double tolerance = 1e-9,
+                                         int max_steps = 100);
 
  private:
   void factor(const ActiveSet& active, const ConstantMode* mode);

@@ -58,7 +58,7 @@ struct SolverOptions {
   bool flux_balance = true;      // 3-D non-smooth: readings that keep the discrete flux balance (surface_kink.hpp)
   bool far_field = true;         // 3-D green: interpolate the far pairs of S, then Newton on the exact S from there
   int nested_start = 160;        // 3-D: from this N on, Newton starts from the active set of a solve on the N/2 grid
-  bool condition_number = true;  // of the final Newton matrix (2-D green path only)
+  bool condition_number = true;  // cond₂ of the final Newton matrix (dense Schur complement)
   bool error_estimate = true;    // estimate the errors from the same problem solved on the grid of N/2
   int fit_contact = -1;          // solves more, the points placed to the contact boundary the one before located;
                                  // −1: automatic (2 with the smooth variant in 2-D, else 0; docs/math.md)
