@@ -181,7 +181,7 @@ std::optional<double> NewtonFactorization::condition_number(const ActiveSet& act
   // √λ_max(HᵀH) for H given as `half` (x ↦ Hx) and Hᵀ as `other`, by the Lanczos process on HᵀH with full
   // reorthogonalization (twice: the steps are few, and lost orthogonality would repeat a Ritz value).
   // It stops when the residual of the largest Ritz pair (θ, Q_k y), β_k·|y_k|, is at most tolerance·θ:
-  // then θ ≤ λ_max ≤ θ(1 + tolerance). Not finite (a singular LU): nothing.
+  // θ is then that close to an eigenvalue, and never above λ_max. Not finite (a singular LU): nothing.
   const auto largest_singular_value = [&](const auto& half, const auto& other) -> std::optional<double> {
     const int steps = int(std::min<Eigen::Index>(max_steps, n));
     Eigen::MatrixXd Q(n, steps);

@@ -311,4 +311,8 @@ TEST(NewtonFactorization, ConditionNumberIsThatOfTheSingularValues) {
   const double got = *spread.condition_number(fictus::ActiveSet(m, 1), nullptr);
   EXPECT_LE(got, 1e6 * (1 + 1e-9));
   EXPECT_NEAR(got, exact(S), 1e-8 * exact(S));
+  // Singular (a zero row): the LU's solves are not finite, so there is no value.
+  Eigen::MatrixXd Z = S;
+  Z.row(7).setZero();
+  EXPECT_FALSE(fictus::ExplicitSchur(Z, S_C).condition_number(fictus::ActiveSet(m, 1), nullptr).has_value());
 }
