@@ -142,6 +142,29 @@ TEST(SemismoothNewton, SolvesASmallVariationalInequalityWithAKnownAnswer) {
 
 }  // namespace
 
+namespace {
+
+/// Blocks S_B, S_C (diagonally dominant, not symmetric) and a bordering for the NewtonFactorization tests.
+struct NewtonBlocks {
+  Eigen::MatrixXd S_B, S_C;
+  fictus::ConstantMode mode;
+};
+
+NewtonBlocks newton_blocks(int m) {
+  NewtonBlocks b{Eigen::MatrixXd(m, m), Eigen::MatrixXd(m, m), {}};
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      b.S_B(i, j) = (i == j ? 4.0 : 0.0) + std::sin(0.37 * i + 1.3 * j) / (1.0 + std::abs(i - j));
+      b.S_C(i, j) = (i == j ? 3.0 : 0.0) + std::cos(0.11 * i - 0.7 * j) / (1.0 + std::abs(i - j));
+    }
+  b.mode.trace_B = Eigen::VectorXd::LinSpaced(m, 1.0, 2.0);
+  b.mode.trace_C = Eigen::VectorXd::LinSpaced(m, -0.5, 0.5);
+  b.mode.arc_weights = Eigen::VectorXd::Constant(m, 1.0 / m);
+  return b;
+}
+
+}  // namespace
+
 // The kept LU with low-rank updates (NewtonFactorization) against a fresh LU of each S_𝒜: a sequence
 // of active sets that changes a few rows of the factored one (solved through the update, which keeps
 // the columns of rows changed before), more than update_fraction of them (factored anew), and back;
@@ -149,16 +172,7 @@ TEST(SemismoothNewton, SolvesASmallVariationalInequalityWithAKnownAnswer) {
 // a wrong column or sign.)
 TEST(NewtonFactorization, UpdatesSolveAsAFreshLu) {
   const int m = 200;
-  Eigen::MatrixXd S_B(m, m), S_C(m, m);
-  for (int i = 0; i < m; ++i)
-    for (int j = 0; j < m; ++j) {
-      S_B(i, j) = (i == j ? 4.0 : 0.0) + std::sin(0.37 * i + 1.3 * j) / (1.0 + std::abs(i - j));
-      S_C(i, j) = (i == j ? 3.0 : 0.0) + std::cos(0.11 * i - 0.7 * j) / (1.0 + std::abs(i - j));
-    }
-  fictus::ConstantMode mode;
-  mode.trace_B = Eigen::VectorXd::LinSpaced(m, 1.0, 2.0);
-  mode.trace_C = Eigen::VectorXd::LinSpaced(m, -0.5, 0.5);
-  mode.arc_weights = Eigen::VectorXd::Constant(m, 1.0 / m);
+  const auto [S_B, S_C, mode] = newton_blocks(m);
   const fictus::ExplicitSchur schur(S_B, S_C);
   const int cap = int(fictus::NewtonFactorization::update_fraction * m);  // 25 rows
   for (const fictus::ConstantMode* bordering : std::array<const fictus::ConstantMode*, 2>{nullptr, &mode}) {
@@ -275,16 +289,7 @@ TEST(NewtonFactorization, ConditionNumberIsThatOfTheSingularValues) {
     return s(0) / s(s.size() - 1);
   };
   const int m = 200;
-  Eigen::MatrixXd S_B(m, m), S_C(m, m);
-  for (int i = 0; i < m; ++i)
-    for (int j = 0; j < m; ++j) {
-      S_B(i, j) = (i == j ? 4.0 : 0.0) + std::sin(0.37 * i + 1.3 * j) / (1.0 + std::abs(i - j));
-      S_C(i, j) = (i == j ? 3.0 : 0.0) + std::cos(0.11 * i - 0.7 * j) / (1.0 + std::abs(i - j));
-    }
-  fictus::ConstantMode mode;
-  mode.trace_B = Eigen::VectorXd::LinSpaced(m, 1.0, 2.0);
-  mode.trace_C = Eigen::VectorXd::LinSpaced(m, -0.5, 0.5);
-  mode.arc_weights = Eigen::VectorXd::Constant(m, 1.0 / m);
+  const auto [S_B, S_C, mode] = newton_blocks(m);
   const fictus::ExplicitSchur schur(S_B, S_C);
   for (const fictus::ConstantMode* bordering : std::array<const fictus::ConstantMode*, 2>{nullptr, &mode}) {
     fictus::ActiveSet active(m, 1);
