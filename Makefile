@@ -7,7 +7,7 @@ JOBS ?= 2
 LEVELS ?= 7-12
 DEBIAN_PACKAGES = cmake g++ make pkg-config libfftw3-dev libopenblas-openmp-dev libeigen3-dev libcli11-dev \
                   nlohmann-json3-dev libfmt-dev zlib1g-dev libgtest-dev libbenchmark-dev \
-                  libmuparser-dev libtomlplusplus-dev libcgal-dev python3 python3-dev python3-numpy python3-matplotlib \
+                  libmuparser-dev libtomlplusplus-dev libcgal-dev libspectra-dev python3 python3-dev python3-numpy python3-matplotlib \
                   python3-vtk9 python3-pytest pybind11-dev clang-format \
                   python3-venv python3-pip python3-setuptools python3-wheel \
                   libopenmpi-dev openmpi-bin libfftw3-mpi-dev

@@ -1,8 +1,11 @@
 #include "fictus/solve/schur_complement.hpp"
 
+#include <Spectra/SymEigsSolver.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <string>
 #include <utility>
 
@@ -46,6 +49,16 @@ void ImplicitSchur::apply(const Eigen::VectorXd& lambda, Eigen::VectorXd& sb, Ei
 }
 
 namespace {
+
+/// x ↦ HᵀHx for Spectra's eigensolvers (symmetric, of size n).
+struct GramOperator {
+  using Scalar = double;
+  Eigen::Index n;
+  std::function<void(const double*, double*)> apply;
+  Eigen::Index rows() const { return n; }
+  Eigen::Index cols() const { return n; }
+  void perform_op(const double* x, double* y) const { apply(x, y); }
+};
 
 /// y = S_𝒜 x from sb = S_B λ and sc = S_C λ, x = (λ, α) when bordered by `mode`.
 void select_newton_rows(const ActiveSet& active, const ConstantMode* mode, const Eigen::VectorXd& x,
@@ -158,7 +171,7 @@ void NewtonFactorization::prepare(const ActiveSet& active, const ConstantMode* m
 }
 
 std::optional<double> NewtonFactorization::condition_number(const ActiveSet& active, const ConstantMode* mode,
-                                                            double tolerance, int max_steps) {
+                                                            double tolerance, int max_restarts) {
   // The solves with S_𝒜ᵀ need the LU of S_𝒜 itself, not an update of another's.
   if (base_.empty() || base_ != active || !same_mode(mode_, mode)) factor(active, mode);
   const Eigen::Index m = S_B_.rows(), n = m + (mode ? 1 : 0);
@@ -178,32 +191,32 @@ std::optional<double> NewtonFactorization::condition_number(const ActiveSet& act
     }
     return x;
   };
-  // √λ_max(HᵀH) for H given as `half` (x ↦ Hx) and Hᵀ as `other`, by the Lanczos process on HᵀH with full
-  // reorthogonalization (twice: the steps are few, and lost orthogonality would repeat a Ritz value).
-  // It stops when the residual of the largest Ritz pair (θ, Q_k y), β_k·|y_k|, is at most tolerance·θ:
-  // θ is then that close to an eigenvalue, and never above λ_max. Not finite (a singular LU): nothing.
+  // √λ_max(HᵀH) for H given as `half` (x ↦ Hx) and Hᵀ as `other`: the largest eigenvalue of HᵀH by
+  // Spectra's implicitly restarted Lanczos (its fixed start vector: the same on every rank), to `tolerance`
+  // relative in its residual. Not finite (a singular LU) or not converged: nothing.
   const auto largest_singular_value = [&](const auto& half, const auto& other) -> std::optional<double> {
-    const int steps = int(std::min<Eigen::Index>(max_steps, n));
-    Eigen::MatrixXd Q(n, steps);
-    Eigen::VectorXd alpha(steps), beta(steps), q(n);
-    for (Eigen::Index i = 0; i < n; ++i) q(i) = 1.0 + 0.5 * std::sin(double(i));  // fixed: the same on every rank
-    Q.col(0) = q.normalized();
-    double theta = 0.0;
-    for (int k = 0; k < steps; ++k) {
-      Eigen::VectorXd w = other(half(Q.col(k)));
-      if (!w.allFinite()) return std::nullopt;
-      alpha(k) = Q.col(k).dot(w);
-      for (int pass = 0; pass < 2; ++pass) w -= Q.leftCols(k + 1) * (Q.leftCols(k + 1).transpose() * w);
-      beta(k) = w.norm();
-      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ritz;
-      ritz.computeFromTridiagonal(alpha.head(k + 1), beta.head(k), Eigen::ComputeEigenvectors);
-      if (ritz.info() != Eigen::Success) return std::nullopt;
-      theta = ritz.eigenvalues()(k);
-      const double residual = beta(k) * std::abs(ritz.eigenvectors()(k, k));
-      if (residual <= tolerance * theta || beta(k) <= 1e-14 * theta) break;
-      if (k + 1 < steps) Q.col(k + 1) = w / beta(k);
+    bool finite = true;
+    GramOperator op{n, [&](const double* x, double* y) {
+                      const Eigen::VectorXd out = other(half(Eigen::Map<const Eigen::VectorXd>(x, n)));
+                      finite = finite && out.allFinite();
+                      Eigen::Map<Eigen::VectorXd>(y, n) = finite ? out : Eigen::VectorXd::Zero(n);
+                    }};
+    if (n < 3) {  // Spectra needs n ≥ 3: HᵀH in full
+      Eigen::MatrixXd M(n, n);
+      for (Eigen::Index j = 0; j < n; ++j) op.perform_op(Eigen::VectorXd::Unit(n, j).eval().data(), M.col(j).data());
+      if (!finite) return std::nullopt;
+      return std::sqrt(std::max(
+          Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(M, Eigen::EigenvaluesOnly).eigenvalues()(n - 1), 0.0));
     }
-    return std::sqrt(std::max(theta, 0.0));
+    try {  // Spectra throws where the operator is degenerate (the zeros that stand in for a non-finite solve)
+      Spectra::SymEigsSolver<GramOperator> lanczos(op, 1, std::min<Eigen::Index>(n, 20));
+      lanczos.init();
+      lanczos.compute(Spectra::SortRule::LargestAlge, max_restarts, tolerance);
+      if (!finite || lanczos.info() != Spectra::CompInfo::Successful) return std::nullopt;
+      return std::sqrt(std::max(lanczos.eigenvalues()(0), 0.0));
+    } catch (const std::runtime_error&) {
+      return std::nullopt;
+    }
   };
   const std::optional<double> largest = largest_singular_value(product, transposed_product);  // σ_max
   const std::optional<double> inverse =

@@ -179,13 +179,13 @@ class NewtonFactorization {
   /// Whether the prepared S_𝒜 is solved through an update (else by its own LU).
   bool updated() const { return !rows_.empty(); }
   int factorizations() const { return factorizations_; }
-  /// κ₂(S_𝒜) = σ_max/σ_min by the Lanczos process: σ_max² as the largest eigenvalue of S_𝒜ᵀS_𝒜
-  /// (products with the blocks), 1/σ_min² as that of S_𝒜⁻¹S_𝒜⁻ᵀ (solves with the LU; S_𝒜 is factored
-  /// anew unless it is the one factored). Each stops when its Ritz residual is at most `tolerance` of the
-  /// Ritz value (never above the eigenvalue), at most `max_steps` steps of O(m²) each. Empty where the
-  /// solves are not finite (S_𝒜 singular to working precision). docs/math.md, "The condition number".
+  /// κ₂(S_𝒜) = σ_max/σ_min by Spectra's implicitly restarted Lanczos: σ_max² as the largest eigenvalue
+  /// of S_𝒜ᵀS_𝒜 (products with the blocks), 1/σ_min² as that of S_𝒜⁻¹S_𝒜⁻ᵀ (solves with the LU; S_𝒜 is
+  /// factored anew unless it is the one factored), each to `tolerance` relative in its residual, at most
+  /// `max_restarts` restarts of 20 steps of O(m²). Empty where the solves are not finite (S_𝒜 singular to
+  /// working precision) or Spectra does not converge. docs/math.md, "The condition number".
   std::optional<double> condition_number(const ActiveSet& active, const ConstantMode* mode, double tolerance = 1e-9,
-                                         int max_steps = 100);
+                                         int max_restarts = 100);
 
  private:
   void factor(const ActiveSet& active, const ConstantMode* mode);
