@@ -4,9 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <functional>
-#include <string>
+#include <stdexcept>
 #include <utility>
 
 namespace fictus {
@@ -172,9 +171,16 @@ void NewtonFactorization::prepare(const ActiveSet& active, const ConstantMode* m
 
 std::optional<double> NewtonFactorization::condition_number(const ActiveSet& active, const ConstantMode* mode,
                                                             double tolerance, int max_restarts) {
+  const Eigen::Index m = S_B_.rows(), n = m + (mode ? 1 : 0);
+  if (n < 3) {  // Spectra needs n ≥ 3: the singular values of S_𝒜 in full
+    Eigen::MatrixXd S;
+    fill_newton_matrix(S_B_, S_C_, active, mode, S);
+    const Eigen::VectorXd s = Eigen::JacobiSVD<Eigen::MatrixXd>(S).singularValues();
+    const double kappa = s(0) / s(n - 1);
+    return std::isfinite(kappa) ? std::optional<double>(kappa) : std::nullopt;
+  }
   // The solves with S_𝒜ᵀ need the LU of S_𝒜 itself, not an update of another's.
   if (base_.empty() || base_ != active || !same_mode(mode_, mode)) factor(active, mode);
-  const Eigen::Index m = S_B_.rows(), n = m + (mode ? 1 : 0);
   const auto product = [&](const Eigen::VectorXd& x) {  // S_𝒜 x
     Eigen::VectorXd sb = S_B_ * x.head(m), sc = S_C_ * x.head(m), y;
     select_newton_rows(active, mode, x, sb, sc, y);
@@ -201,13 +207,6 @@ std::optional<double> NewtonFactorization::condition_number(const ActiveSet& act
                       finite = finite && out.allFinite();
                       Eigen::Map<Eigen::VectorXd>(y, n) = finite ? out : Eigen::VectorXd::Zero(n);
                     }};
-    if (n < 3) {  // Spectra needs n ≥ 3: HᵀH in full
-      Eigen::MatrixXd M(n, n);
-      for (Eigen::Index j = 0; j < n; ++j) op.perform_op(Eigen::VectorXd::Unit(n, j).eval().data(), M.col(j).data());
-      if (!finite) return std::nullopt;
-      return std::sqrt(std::max(
-          Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(M, Eigen::EigenvaluesOnly).eigenvalues()(n - 1), 0.0));
-    }
     try {  // Spectra throws where the operator is degenerate (the zeros that stand in for a non-finite solve)
       Spectra::SymEigsSolver<GramOperator> lanczos(op, 1, std::min<Eigen::Index>(n, 20));
       lanczos.init();

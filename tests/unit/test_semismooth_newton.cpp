@@ -320,4 +320,8 @@ TEST(NewtonFactorization, ConditionNumberIsThatOfTheSingularValues) {
   Eigen::MatrixXd Z = S;
   Z.row(7).setZero();
   EXPECT_FALSE(fictus::ExplicitSchur(Z, S_C).condition_number(fictus::ActiveSet(m, 1), nullptr).has_value());
+  // Fewer than 3 unknowns (Spectra's least): the singular values in full.
+  const Eigen::MatrixXd T{{2.0, 1.0}, {0.0, 0.5}};
+  EXPECT_NEAR(*fictus::ExplicitSchur(T, T).condition_number(fictus::ActiveSet(2, 1), nullptr), exact(T),
+              1e-12 * exact(T));
 }
