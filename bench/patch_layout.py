@@ -13,6 +13,7 @@ against the fitted-mesh reference of tests/references/NAME.json (contact area: t
 the reference gives one, else contact_fraction × area_gamma).
 
   /usr/bin/python3 bench/patch_layout.py NAME VARIANT N,N,... [fictus solve options...]
+  /usr/bin/python3 bench/patch_layout.py FILE.toml VARIANT N,N,... [options...]   (no fitted reference)
   e.g. /usr/bin/python3 bench/patch_layout.py spheroid3d smooth 128,160,192,256
        /usr/bin/python3 bench/patch_layout.py spheroid3d smooth 128,160,192 --fit_contact 2
   LAYOUTS="1.0" … for the default layout alone.
@@ -20,6 +21,11 @@ the reference gives one, else contact_fraction × area_gamma).
 Runs `build/apps/fictus solve tests/references/NAME.toml --N N --variant VARIANT --multipliers m
 --error_estimate false --threads 2 --out FOLDER --files results.json --quiet` (plus the options
 given), FOLDER a temporary one; prints one line per run and a table.
+
+A problem FILE.toml without a fitted reference (e.g. bench/neumann_ellipsoid.toml) gives the same
+table with m₀ the solver's own default m: ∫û's relative error where the file gives `exact`
+(errors.integral_u), else each quantity relative to its mean over the layouts (so the columns measure
+the spread alone).
 """
 import json, os, subprocess, sys, tempfile
 import numpy as np
@@ -30,26 +36,41 @@ factors = [float(v) for v in os.environ.get("LAYOUTS", "0.91,0.94,0.97,1.0,1.03,
 move_box = os.environ.get("MOVE", "layout") == "box"
 shifts = np.random.default_rng(20261207).uniform(-0.5, 0.5, size=(6, 3))
 cases = shifts if move_box else factors
-ref = json.load(open(os.path.join(root, "tests", "references", name + ".json")))["values"]
-area = ref["contact_area"] if "contact_area" in ref else ref["contact_fraction"] * ref["area_gamma"]
+problem = name if name.endswith(".toml") else os.path.join(root, "tests", "references", name + ".toml")
+ref = None if name.endswith(".toml") else json.load(open(os.path.join(root, "tests", "references", name + ".json")))["values"]
+area = None if ref is None else ref["contact_area"] if "contact_area" in ref else ref["contact_fraction"] * ref["area_gamma"]
+relative_u = False  # a FILE.toml with `exact`: ∫û's column is its error
+
+
+def solve(folder, N, options):
+    subprocess.run([os.path.join(root, "build", "apps", "fictus"), "solve", problem, "--N", str(N), "--variant", variant,
+                    "--error_estimate", "false", "--threads", "2", "--out", folder, "--files", "results.json", "--quiet"] +
+                   options + extra, check=True, stderr=subprocess.DEVNULL)
+    return json.load(open(os.path.join(folder, "results.json")))
+
 quantities = ("contact area", "∫û", "∫|∇û|²", "force")
 rows = {}
 with tempfile.TemporaryDirectory() as folder:
     for N in sizes:
-        m0 = ref["area_gamma"] * (N / (5 if variant == "smooth" else 4)) ** 2
+        if ref is None:
+            m0 = solve(folder, N, [])["multipliers"]
+        else:
+            m0 = ref["area_gamma"] * (N / (5 if variant == "smooth" else 4)) ** 2
         for case in cases:
             if move_box:  # the default m; the box [0, 1]³ moved by a fraction of a cell
                 m = round(m0)
                 place = ["--box", ",".join(f"{v:.15g}" for d in range(3) for v in (case[d] / N, 1 + case[d] / N))]
             else:
                 m, place = round(case * m0), []
-            subprocess.run([os.path.join(root, "build", "apps", "fictus"), "solve",
-                            os.path.join(root, "tests", "references", name + ".toml"), "--N", str(N), "--variant",
-                            variant, "--multipliers", str(m), "--error_estimate", "false", "--threads", "2", "--out", folder,
-                            "--files", "results.json", "--quiet"] + place + extra, check=True, stderr=subprocess.DEVNULL)
-            r = json.load(open(os.path.join(folder, "results.json")))
-            row = (r["contact"]["measure"] / area - 1, r["domain"]["integral_u"] / ref["int_u"] - 1,
-                   r["domain"]["integral_grad2"] / ref["int_grad2"] - 1, r["contact"]["force"] / ref["force"] - 1)
+            r = solve(folder, N, ["--multipliers", str(m)] + place)
+            if ref is None:  # the values themselves, made relative to their means below
+                exact = (r.get("errors") or {}).get("integral_u")
+                relative_u = exact is not None
+                row = (r["contact"]["measure"], exact / r["domain"]["integral_u"] if relative_u else
+                       r["domain"]["integral_u"], r["domain"]["integral_grad2"], r["contact"]["force"])
+            else:
+                row = (r["contact"]["measure"] / area - 1, r["domain"]["integral_u"] / ref["int_u"] - 1,
+                       r["domain"]["integral_grad2"] / ref["int_grad2"] - 1, r["contact"]["force"] / ref["force"] - 1)
             rows.setdefault(N, []).append(row)
             print(f"N = {N}, m = {m}: " + ", ".join(f"{q} {v:+.3e}" for q, v in zip(quantities, row)), flush=True)
 print(f"\n{name}, {variant} {' '.join(extra)}: relative errors over {len(cases)} {'box positions' if move_box else 'layouts'} (mean / sd / largest)\n")
@@ -57,5 +78,9 @@ print("| N | " + " | ".join(quantities) + " |")
 print("|---|" + "---|" * len(quantities))
 for N, values in rows.items():
     a = np.array(values)
+    for j in range(4 if ref is None else 0):  # no reference: deviations from the mean over the layouts
+        mean = a[:, j].mean()
+        if not (j == 1 and relative_u) and mean != 0:
+            a[:, j] = a[:, j] / mean - 1
     cells = [f"{a[:, j].mean():+.2e} / {a[:, j].std(ddof=1):.1e} / {a[abs(a[:, j]).argmax(), j]:+.2e}" for j in range(4)]
     print(f"| {N} | " + " | ".join(cells) + " |")

@@ -1229,7 +1229,9 @@ double estimated_seconds(const BasicProblem<dim>& problem, const SolverOptions& 
   // Green's table, final solve, errors) costs about 9e-9 s per node·log2(nodes) on one thread, the
   // Schur blocks 2.3e-6 s per pair of points, each Newton step one dense LU of 1e-10·m³ s (8 steps
   // assumed); GMRES about 2.5 m iterations of 2.5 fast solves of 4.6e-10 s per node·log2(nodes).
-  // Threads divide it, up to the cores there are.
+  // Threads divide it, up to the cores there are. cond₂ of the final Newton matrix (dense storage only)
+  // adds about 1.2e-7·m² s in either dimension (Lanczos with products and LU solves, at most a few hundred;
+  // 3-D m = 906 … 4632, bench/results/2026-12-07-condition-number.md).
   const double threads = std::clamp(double(Execution(options.threads).threads()), 1.0,
                                     double(std::max(1u, std::thread::hardware_concurrency())));
   double seconds = 0;
@@ -1250,6 +1252,8 @@ double estimated_seconds(const BasicProblem<dim>& problem, const SolverOptions& 
     const double newton = kept_compressed ? 4.5e-9 * n_log_n : 1.5e-11 * m * m * m + 8e-9 * n_log_n;
     seconds = options.inner == InnerSolver::green ? grid + blocks + newton : grid + 2.5 * m * 2.5 * 2.3e-10 * n_log_n;
   }
+  if (options.condition_number && options.inner == InnerSolver::green && !compressed(problem, options, m))
+    seconds += 1.2e-7 * m * m;
   return seconds * 2 / threads;
 }
 

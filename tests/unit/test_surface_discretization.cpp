@@ -403,6 +403,14 @@ TEST(SurfaceSolver, EstimatesFollowTheSchurStorage) {
   EXPECT_NEAR(dense, 8.16, 0.15 * 8.16);
   EXPECT_NEAR(automatic, 5.07, 0.15 * 5.07);
   EXPECT_LT(fictus::estimated_seconds(p, o), dense_seconds);
+  {  // cond₂ of the Newton matrix costs the dense path about 1.2e-7·m² s (m = 12 868: 20 s), the
+     // compressed one nothing (it has no LU of S_𝒜, and no value)
+    fictus::SolverOptions without = o;
+    without.condition_number = false;
+    EXPECT_EQ(fictus::estimated_seconds(p, without), fictus::estimated_seconds(p, o));
+    without.schur_storage = fictus::SchurStorageKind::dense;
+    EXPECT_NEAR(dense_seconds - fictus::estimated_seconds(p, without), 1.2e-7 * 12868.0 * 12868, 1.0);
+  }
   // The times of the same solves (bench/results/2026-11-28-pruned-products.md): 143 s dense, 93 s
   // compressed, to within the machine's own variation between runs and sessions.
   EXPECT_NEAR(dense_seconds, 143, 0.3 * 143);
