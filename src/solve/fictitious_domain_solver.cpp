@@ -1230,14 +1230,16 @@ double estimated_seconds(const BasicProblem<dim>& problem, const SolverOptions& 
   // Schur blocks 2.3e-6 s per pair of points, each Newton step one dense LU of 1e-10·m³ s (8 steps
   // assumed); GMRES about 2.5 m iterations of 2.5 fast solves of 4.6e-10 s per node·log2(nodes).
   // Threads divide it, up to the cores there are. cond₂ of the final Newton matrix (dense storage only)
-  // adds about 1.2e-7·m² s in either dimension (Lanczos with products and LU solves, at most a few hundred;
-  // 3-D m = 906 … 4632, bench/results/2026-12-07-condition-number.md).
+  // adds about 1.2e-7·m² s for Lanczos (products and LU solves; 3-D m = 906 … 4632 on 2 threads,
+  // bench/results/2026-12-07-condition-number.md) and one more LU of S_𝒜, counted always: it is made
+  // where Newton's last step went through an update, which the estimate cannot know.
   const double threads = std::clamp(double(Execution(options.threads).threads()), 1.0,
                                     double(std::max(1u, std::thread::hardware_concurrency())));
-  double seconds = 0;
+  double seconds = 0, lu = 0;  // one dense LU of m × m
   if constexpr (dim == 2) {
-    const double grid = 4.5e-9 * n_log_n, pairs = 1.15e-6 * m * m, lus = 8 * 0.5e-10 * m * m * m;
-    seconds = options.inner == InnerSolver::green ? grid + pairs + lus : grid + 2.5 * m * 2.5 * 2.3e-10 * n_log_n;
+    lu = 0.5e-10 * m * m * m;
+    const double grid = 4.5e-9 * n_log_n, pairs = 1.15e-6 * m * m;
+    seconds = options.inner == InnerSolver::green ? grid + pairs + 8 * lu : grid + 2.5 * m * 2.5 * 2.3e-10 * n_log_n;
   } else {
     // 3-D, on 2 threads (the non-smooth sphere of bench/sphere_contact.toml, N = 128 … 768,
     // bench/results/2026-11-28-pruned-products.md): the grid work 5.9e-9 s per node·log2(nodes) and,
@@ -1246,14 +1248,15 @@ double estimated_seconds(const BasicProblem<dim>& problem, const SolverOptions& 
     // 6.7e-5·m·log2(m); Newton one LU of 1.5e-11·m³ and about 18 fast solves (8e-9 per
     // node·log2(nodes)), compressed its fast solves and GMRES on S̃ in 4.5e-9.
     const bool kept_compressed = compressed(problem, options, m);
+    lu = 1.5e-11 * m * m * m;
     const double grid = 5.9e-9 * n_log_n + 3.2e-3 * m;
     const double blocks =
         kept_compressed ? 6.7e-5 * m * std::log2(std::max(m, 2.0)) : (options.far_field ? 1.2e-7 : 2e-6) * m * m;
-    const double newton = kept_compressed ? 4.5e-9 * n_log_n : 1.5e-11 * m * m * m + 8e-9 * n_log_n;
+    const double newton = kept_compressed ? 4.5e-9 * n_log_n : lu + 8e-9 * n_log_n;
     seconds = options.inner == InnerSolver::green ? grid + blocks + newton : grid + 2.5 * m * 2.5 * 2.3e-10 * n_log_n;
   }
   if (options.condition_number && options.inner == InnerSolver::green && !compressed(problem, options, m))
-    seconds += 1.2e-7 * m * m;
+    seconds += 1.2e-7 * m * m + lu;
   return seconds * 2 / threads;
 }
 
