@@ -169,15 +169,17 @@ json domain_json(const DomainQuantities& d) {
 }
 
 json estimate_json(const ErrorEstimate& e) {
-  return e.skipped.empty() ? json{{"N", e.N},
-                                  {"l2_omega", e.l2_omega},
-                                  {"rel_l2_omega", e.rel_l2_omega},
-                                  {"force", e.force},
-                                  {"measure", e.measure},
-                                  {"energy", e.energy},
-                                  {"integral_u", e.integral_u},
-                                  {"seconds", e.seconds}}
-                           : json{{"skipped", e.skipped}, {"seconds", e.seconds}};
+  if (!e.skipped.empty()) return json{{"skipped", e.skipped}, {"seconds", e.seconds}};
+  json j{{"N", e.N},
+         {"l2_omega", e.l2_omega},
+         {"rel_l2_omega", e.rel_l2_omega},
+         {"force", e.force},
+         {"measure", e.measure},
+         {"energy", e.energy},
+         {"integral_u", e.integral_u},
+         {"seconds", e.seconds}};
+  if (!e.caveat.empty()) j["caveat"] = e.caveat;
+  return j;
 }
 
 json nested_start_json(const NestedStart& n) {

@@ -189,6 +189,7 @@ py::object estimate(const BasicSolution<dim>& s) {
   }
   d["N"] = e.N, d["l2_omega"] = e.l2_omega, d["rel_l2_omega"] = e.rel_l2_omega, d["force"] = e.force;
   d["measure"] = e.measure, d["energy"] = e.energy, d["integral_u"] = e.integral_u, d["seconds"] = e.seconds;
+  if (!e.caveat.empty()) d["caveat"] = e.caveat;
   return std::move(d);
 }
 

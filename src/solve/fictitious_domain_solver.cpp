@@ -850,11 +850,39 @@ DomainQuantities domain_quantities(const State<dim>& st, const BoundaryDiscretiz
   return q;
 }
 
+/// Where the solve on the grid of N/2 left the path of this one's method, which Richardson's rule assumes:
+/// patches or arcs of another size in cells (the default rule moved there, or m raised to its minimum),
+/// Γ at another δ/s (an offset given that does not fit there), or fewer fitted solves (a fit failed
+/// there). Empty when it kept to it. `fine_offset`: this solve's δ/s (its options are filled in later).
+template <int dim>
+std::string estimate_caveat(const BasicSolution<dim>& coarse, const BasicSolution<dim>& fine, double fine_offset) {
+  constexpr double cells_tolerance = 0.1, offset_tolerance = 0.02;  // rounding of m moves s/h by far less
+  std::string caveat;
+  const auto add = [&caveat](const std::string& part) { caveat += (caveat.empty() ? "" : "; ") + part; };
+  char text[160];
+  const double fine_cells = fine.spacing() / fine.grid.h(), coarse_cells = coarse.spacing() / coarse.grid.h();
+  if (std::abs(coarse_cells / fine_cells - 1) > cells_tolerance) {
+    std::snprintf(text, sizeof text, "its spacing is %.3g h against %.3g h here", coarse_cells, fine_cells);
+    add(text);
+  }
+  if (coarse.options.variant == Variant::smooth &&
+      std::abs(coarse.options.offset / fine_offset - 1) > offset_tolerance) {
+    std::snprintf(text, sizeof text, "its Γ lies at δ = %.3g s against %.3g s here", coarse.options.offset,
+                  fine_offset);
+    add(text);
+  }
+  const int fine_passes = fine.contact_fit ? fine.contact_fit->passes : 0;
+  const int coarse_passes = coarse.contact_fit ? coarse.contact_fit->passes : 0;
+  if (coarse_passes < fine_passes) add("its fit to the contact boundary made fewer passes");
+  return caveat;
+}
+
 /// Step 10: the error estimate from the solve on the grid of N/2 (docs/math.md, "The error estimate"):
 /// Richardson's |Q_N − Q_{N/2}|/(2^p − 1), p = 2 for û, the force and the energy, p = 1 for the contact
 /// measure (whole points enter and leave the contact set).
 template <int dim>
-ErrorEstimate error_estimate(const BasicSolution<dim>& coarse, const BasicSolution<dim>& fine, double difference2) {
+ErrorEstimate error_estimate(const BasicSolution<dim>& coarse, const BasicSolution<dim>& fine, double difference2,
+                             double fine_offset) {
   constexpr double second_order = 3, first_order = 1;  // 2^p − 1
   ErrorEstimate e;
   e.N = coarse.grid.nx();
@@ -865,13 +893,19 @@ ErrorEstimate error_estimate(const BasicSolution<dim>& coarse, const BasicSoluti
   e.energy = std::abs(fine.domain->energy - coarse.domain->energy) / second_order;
   e.integral_u = std::abs(fine.domain->integral_u - coarse.domain->integral_u) / second_order;
   e.measure = std::abs(contact_summary(fine).measure - contact_summary(coarse).measure) / first_order;
+  e.caveat = estimate_caveat(coarse, fine, fine_offset);
   return e;
 }
 
 /// The warning of the estimate (docs/math.md, "The error estimate").
 template <int dim>
 void estimate_warning_line(BasicSolution<dim>& sol) {
-  if (!sol.estimate || !sol.estimate->skipped.empty() || !(sol.estimate->rel_l2_omega > estimate_warning)) return;
+  if (!sol.estimate || !sol.estimate->skipped.empty()) return;
+  if (!sol.estimate->caveat.empty())
+    sol.warnings.push_back("solver.error_estimate: the solve at N = " + std::to_string(sol.estimate->N) +
+                           " does not follow this grid's rule (" + sol.estimate->caveat +
+                           "): the estimate compares two discretizations, read it as an order of magnitude");
+  if (!(sol.estimate->rel_l2_omega > estimate_warning)) return;
   char line[320];
   std::snprintf(line, sizeof line,
                 "domain.N: the estimated error of u is %.2g %% of its L2(omega) norm (from the solve at N = %d): "
@@ -942,7 +976,7 @@ void quantities_step(const State<dim>& st, const BoundaryDiscretization<dim>& bo
   }
   if (from) {
     const double seconds = sol.estimate->seconds;
-    sol.estimate = error_estimate<dim>(*from, sol, difference2);
+    sol.estimate = error_estimate<dim>(*from, sol, difference2, boundary.spacing().offset);
     sol.estimate->seconds = seconds;
   } else if (sol.estimate && sol.estimate->skipped.empty()) {
     sol.estimate->skipped = "the solve on the grid of N/2 made no field";

@@ -198,6 +198,35 @@ TEST(ContactSummary, MeasureForceAndGapsFromThePoints) {
   EXPECT_EQ(c.max_gap, max_gap);
 }
 
+// The error estimate says when the solve on the grid of N/2 could not follow this grid's rule: here an
+// offset of 2 (δ = 0.061) fits the ellipse's margin of 0.1 at N = 256 but not at N = 128, where m/2 doubles
+// s and δ; with an offset of 1 both grids keep δ/s and s/h.
+TEST(ContactSummary, TheEstimateNamesACoarseSolveOffTheRule) {
+  const fictus::Problem problem = fictus::paper_problem(256);
+  const auto solve_with = [&problem](double offset) {
+    fictus::SolverOptions o = options_for(fictus::Variant::smooth, fictus::InnerSolver::green, 256);
+    o.multipliers = 64, o.offset = offset, o.error_estimate = true;
+    return fictus::solve(problem, o);
+  };
+  const fictus::Solution off = solve_with(2.0), on = solve_with(1.0);
+  for (const fictus::Solution* s : {&off, &on}) {
+    ASSERT_TRUE(s->newton.converged && s->estimate);
+    ASSERT_TRUE(s->estimate->skipped.empty()) << s->estimate->skipped;
+    EXPECT_EQ(s->estimate->N, 128);
+  }
+  EXPECT_EQ(off.options.offset, 2.0);
+  EXPECT_NE(off.estimate->caveat.find("against 2 s here"), std::string::npos) << off.estimate->caveat;
+  EXPECT_EQ(off.estimate->caveat.find("spacing"), std::string::npos) << off.estimate->caveat;  // m/2: s/h kept
+  const auto warned = [](const fictus::Solution& s) {
+    for (const std::string& w : s.warnings)
+      if (w.rfind("solver.error_estimate: the solve at N = 128 does not follow", 0) == 0) return true;
+    return false;
+  };
+  EXPECT_TRUE(warned(off));
+  EXPECT_TRUE(on.estimate->caveat.empty()) << on.estimate->caveat;
+  EXPECT_FALSE(warned(on));
+}
+
 }  // namespace
 
 // The estimates before a solve: memory and time grow like the grid (N² and N² log N) once the grid

@@ -108,6 +108,8 @@ struct ErrorEstimate {
   double integral_u = 0;    // |∫û − ∫u|
   double seconds = 0;       // the coarse solve (shared with the nested start where there is one)
   std::string skipped;      // non-empty: no estimate, and why
+  std::string caveat;       // non-empty: where the solve of N/2 left this one's rule (m, δ, the fit), so that
+                            // the two grids are not one method's path and the estimate is rougher
 };
 
 /// Neighbouring points of γ: consecutive points of a curve, patches sharing a triangle edge of a surface.
