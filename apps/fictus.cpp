@@ -205,12 +205,15 @@ void print_summary(const fictus::BasicSolution<dim>& s) {
   if (s.domain)
     std::printf("over omega: int u %.9g, int |grad u|^2 %.9g, energy %.9g\n", s.domain->integral_u,
                 s.domain->integral_grad2, s.domain->energy);
-  if (s.estimate && s.estimate->skipped.empty())
+  if (s.estimate && s.estimate->skipped.empty()) {
     std::printf(
         "estimated errors (from N = %d): u %.2e relative in L2(omega), force %.2e, contact %s %.2e, energy %.2e\n",
         s.estimate->N, s.estimate->rel_l2_omega, s.estimate->force, dim == 2 ? "length" : "area", s.estimate->measure,
         s.estimate->energy);
-  else if (s.estimate)
+    if (!s.estimate->caveat.empty())  // (no warning: on coarse grids it is common)
+      std::printf("  an order of magnitude only: the solve at N = %d did not follow this grid's rule (%s)\n",
+                  s.estimate->N, s.estimate->caveat.c_str());
+  } else if (s.estimate)
     std::printf("no error estimate (%s)\n", s.estimate->skipped.c_str());
   if (s.errors)
     std::printf("relative errors: L2(omega) %.3e, H1(omega) %.3e (semi %.3e), L2(gamma) %.3e\n", s.errors->rel_l2_omega,

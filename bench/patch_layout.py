@@ -16,7 +16,8 @@ the reference gives one, else contact_fraction × area_gamma).
   /usr/bin/python3 bench/patch_layout.py FILE.toml VARIANT N,N,... [options...]   (no fitted reference)
   e.g. /usr/bin/python3 bench/patch_layout.py spheroid3d smooth 128,160,192,256
        /usr/bin/python3 bench/patch_layout.py spheroid3d smooth 128,160,192 --fit_contact 2
-  LAYOUTS="1.0" … for the default layout alone.
+  LAYOUTS="1.0" … for the default layout alone; FICTUS=path/to/fictus for another binary (two code paths
+  compared in one session).
 
 Runs `build/apps/fictus solve tests/references/NAME.toml --N N --variant VARIANT --multipliers m
 --error_estimate false --threads 2 --out FOLDER --files results.json --quiet` (plus the options
@@ -44,7 +45,7 @@ relative_u = False  # a FILE.toml with `exact`: ∫û's column is its error
 
 
 def solve(folder, N, options):
-    subprocess.run([os.path.join(root, "build", "apps", "fictus"), "solve", problem, "--N", str(N), "--variant", variant,
+    subprocess.run([os.environ.get("FICTUS", os.path.join(root, "build", "apps", "fictus")), "solve", problem, "--N", str(N), "--variant", variant,
                     "--error_estimate", "false", "--threads", "2", "--out", folder, "--files", "results.json", "--quiet"] +
                    options + extra, check=True, stderr=subprocess.DEVNULL)
     return json.load(open(os.path.join(folder, "results.json")))

@@ -900,12 +900,7 @@ ErrorEstimate error_estimate(const BasicSolution<dim>& coarse, const BasicSoluti
 /// The warning of the estimate (docs/math.md, "The error estimate").
 template <int dim>
 void estimate_warning_line(BasicSolution<dim>& sol) {
-  if (!sol.estimate || !sol.estimate->skipped.empty()) return;
-  if (!sol.estimate->caveat.empty())
-    sol.warnings.push_back("solver.error_estimate: the solve at N = " + std::to_string(sol.estimate->N) +
-                           " does not follow this grid's rule (" + sol.estimate->caveat +
-                           "): the estimate compares two discretizations, read it as an order of magnitude");
-  if (!(sol.estimate->rel_l2_omega > estimate_warning)) return;
+  if (!sol.estimate || !sol.estimate->skipped.empty() || !(sol.estimate->rel_l2_omega > estimate_warning)) return;
   char line[320];
   std::snprintf(line, sizeof line,
                 "domain.N: the estimated error of u is %.2g %% of its L2(omega) norm (from the solve at N = %d): "

@@ -230,17 +230,34 @@ double contact_area_inside(const BasicSolution<3>& s, const std::vector<Neighbou
     neighbours[std::size_t(k1)].push_back(std::size_t(k2));
     neighbours[std::size_t(k2)].push_back(std::size_t(k1));
   }
+  // The end beyond `from` (seen from `back`) that the cubic takes: the first along the polyline at least
+  // half the segment's length from `from`, within three steps. A nearer one would set the cubic's slope
+  // by a segment whose direction is mostly the ends' scatter. None (the line branches, ends or turns
+  // back first): no bulge.
+  constexpr std::size_t none = std::size_t(-1);
+  const auto beyond = [&](std::size_t from, std::size_t back, double length) {
+    std::size_t previous = from, current = back;
+    for (int step = 0; step < 3; ++step) {
+      if (neighbours[previous].size() != 2) return none;
+      const std::size_t next = neighbours[previous][0] == current ? neighbours[previous][1] : neighbours[previous][0];
+      if (next == from || next == back) return none;
+      if (norm(ends[next] - ends[from]) >= 0.5 * length) return next;
+      current = previous, previous = next;
+    }
+    return none;
+  };
   double bulges = 0;
   for (std::size_t g = 0; g < s.contact_boundary_lines.size(); ++g) {
     const std::size_t i = std::size_t(s.contact_boundary_lines[g][0]), j = std::size_t(s.contact_boundary_lines[g][1]);
-    if (neighbours[i].size() != 2 || neighbours[j].size() != 2) continue;
-    const std::size_t h = neighbours[i][0] == j ? neighbours[i][1] : neighbours[i][0];
-    const std::size_t k = neighbours[j][0] == i ? neighbours[j][1] : neighbours[j][0];
-    if (h != j && k != i && h != k) bulges += bulge(ends[h], ends[i], ends[j], ends[k], segments[g].across);
+    const double length = norm(ends[j] - ends[i]);
+    const std::size_t h = beyond(i, j, length), k = beyond(j, i, length);
+    if (h != none && k != none && h != k) bulges += bulge(ends[h], ends[i], ends[j], ends[k], segments[g].across);
   }
-  std::vector<bool> located(std::size_t(s.gamma.m), false);  // patches of a located pair
+  std::vector<bool> located(std::size_t(s.gamma.m), false);  // patches of a located pair (as resolve_contact's)
   for (const NeighbourPair& p : pairs)
-    if (s.in_contact(p.i) != s.in_contact(p.j)) located[std::size_t(p.i)] = located[std::size_t(p.j)] = true;
+    if (s.condition(p.i) == PointCondition::signorini && s.condition(p.j) == PointCondition::signorini &&
+        s.in_contact(p.i) != s.in_contact(p.j))
+      located[std::size_t(p.i)] = located[std::size_t(p.j)] = true;
   const double reach = 1.5 * s.spacing();
   // Each located patch looks only at the segments that can come within the reach of its triangles'
   // corners (the same answer as looking at all: its corners lie within `radius` of its point).
