@@ -220,8 +220,9 @@ double signed_distance(const Point<dim>& x, const std::vector<const Segment<dim>
 /// triangle's corner is signed_distance within 1.5·s; elsewhere a triangle counts by its patch (in
 /// contact or not). Each triangle counts by the share where the linear interpolant of ψ is negative;
 /// only the patches of the located pairs are looked at. The boundary is a smooth curve, not its
-/// polyline: each segment whose ends have one other neighbour each adds the bulge of the cubic through
-/// the four ends (the chords of a curve of geodesic curvature κ cut off κℓ³/12 each).
+/// polyline: each segment adds the bulge of the cubic through its ends and, beyond each, the first end
+/// along the polyline at least half its length away (the chords of a curve of geodesic curvature κ cut
+/// off κℓ³/12 each); none where the line branches, ends or closes on itself before such an end.
 double contact_area_inside(const BasicSolution<3>& s, const std::vector<NeighbourPair>& pairs) {
   const std::vector<Point3>& ends = s.contact_boundary;
   const std::vector<Segment<3>> segments = located_segments(s);
