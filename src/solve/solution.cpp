@@ -118,6 +118,13 @@ double contact_end_fraction(double q, double r, double d) {
 
 namespace {
 
+/// Whether a contact end lies between the pair's points: both Signorini, one active and one free.
+template <int dim>
+bool located_pair(const BasicSolution<dim>& s, const NeighbourPair& p) {
+  return s.condition(p.i) == PointCondition::signorini && s.condition(p.j) == PointCondition::signorini &&
+         s.in_contact(p.i) != s.in_contact(p.j);
+}
+
 /// The share of a triangle where the linear interpolant of ψ (its values at the corners) is negative.
 double negative_share(const std::array<double, 3>& psi) {
   const int negative = int(psi[0] < 0) + int(psi[1] < 0) + int(psi[2] < 0);
@@ -254,11 +261,9 @@ double contact_area_inside(const BasicSolution<3>& s, const std::vector<Neighbou
     const std::size_t h = beyond(i, j, length), k = beyond(j, i, length);
     if (h != none && k != none && h != k) bulges += bulge(ends[h], ends[i], ends[j], ends[k], segments[g].across);
   }
-  std::vector<bool> located(std::size_t(s.gamma.m), false);  // patches of a located pair (as resolve_contact's)
+  std::vector<bool> located(std::size_t(s.gamma.m), false);  // patches of a located pair
   for (const NeighbourPair& p : pairs)
-    if (s.condition(p.i) == PointCondition::signorini && s.condition(p.j) == PointCondition::signorini &&
-        s.in_contact(p.i) != s.in_contact(p.j))
-      located[std::size_t(p.i)] = located[std::size_t(p.j)] = true;
+    if (located_pair(s, p)) located[std::size_t(p.i)] = located[std::size_t(p.j)] = true;
   const double reach = 1.5 * s.spacing();
   // Each located patch looks only at the segments that can come within the reach of its triangles'
   // corners (the same answer as looking at all: its corners lie within `radius` of its point).
@@ -341,9 +346,8 @@ void resolve_contact(BasicSolution<dim>& s) {
   std::map<int, std::vector<int>> at_corner;  // 3-D: a mesh vertex → the located ends whose border has it
   const std::vector<NeighbourPair> pairs = neighbour_pairs<dim>(s);
   for (const NeighbourPair& p : pairs) {
-    if (s.condition(p.i) != PointCondition::signorini || s.condition(p.j) != PointCondition::signorini) continue;
-    const bool i_active = s.in_contact(p.i), j_active = s.in_contact(p.j);
-    if (i_active == j_active) continue;
+    if (!located_pair(s, p)) continue;
+    const bool i_active = s.in_contact(p.i);
     const int a = i_active ? p.i : p.j, b = i_active ? p.j : p.i;
     const double q = s.normal_derivative[std::size_t(a)], r = s.trace[std::size_t(b)] - s.g[std::size_t(b)];
     const double theta = contact_end_fraction(q, r, p.distance);

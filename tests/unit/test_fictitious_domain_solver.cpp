@@ -201,7 +201,7 @@ TEST(ContactSummary, MeasureForceAndGapsFromThePoints) {
 // The error estimate says when the solve on the grid of N/2 could not follow this grid's rule: here an
 // offset of 2 (δ = 0.061) fits the ellipse's margin of 0.1 at N = 256 but not at N = 128, where m/2 doubles
 // s and δ; with an offset of 1 both grids keep δ/s and s/h.
-TEST(ContactSummary, TheEstimateNamesACoarseSolveOffTheRule) {
+TEST(ErrorEstimate, NamesACoarseSolveOffTheRule) {
   const fictus::Problem problem = fictus::paper_problem(256);
   const auto solve_with = [&problem](double offset) {
     fictus::SolverOptions o = options_for(fictus::Variant::smooth, fictus::InnerSolver::green, 256);
