@@ -51,6 +51,45 @@ ContactSummary contact_summary(const BasicSolution<dim>& s) {
   return c;
 }
 
+namespace {
+
+/// Cubes of side `size` holding indices, for the searches near a point.
+template <int dim>
+class Buckets {
+ public:
+  explicit Buckets(double size) : size_(size) {}
+  std::array<long, dim> cell(const Point<dim>& x) const {
+    std::array<long, dim> c;
+    for (int d = 0; d < dim; ++d) c[std::size_t(d)] = long(std::floor(x[d] / size_));
+    return c;
+  }
+  void add(const std::array<long, dim>& c, int index) { cells_[c].push_back(index); }
+  const std::vector<int>* at(const std::array<long, dim>& c) const {
+    const auto it = cells_.find(c);
+    return it == cells_.end() ? nullptr : &it->second;
+  }
+  /// Calls visit(c) for the cells within `rings` cells of c (in every coordinate).
+  template <typename Visit>
+  static void around(const std::array<long, dim>& c, long rings, Visit&& visit) {
+    std::array<long, dim> k = c;
+    for (int d = 0; d < dim; ++d) k[std::size_t(d)] = c[std::size_t(d)] - rings;
+    while (true) {
+      visit(k);
+      int d = 0;
+      while (d < dim && ++k[std::size_t(d)] > c[std::size_t(d)] + rings)
+        k[std::size_t(d)] = c[std::size_t(d)] - rings, ++d;
+      if (d == dim) return;
+    }
+  }
+  double size() const { return size_; }
+
+ private:
+  double size_;
+  std::map<std::array<long, dim>, std::vector<int>> cells_;
+};
+
+}  // namespace
+
 template <>
 std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<2>& b) {
   const Collocation& c = b.collocation;
@@ -65,18 +104,27 @@ std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<2>& b) {
 
 template <>
 std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<3>& b) {
-  // Vertices by their coordinates rounded to 1e-9 of the surface's extent (a triangulation made face by
-  // face computes a shared vertex once per face, equal only to round-off), then each edge with its
-  // triangles' patches: an edge between two patches is part of their border.
+  // A triangulation made face by face computes a shared vertex once per face, equal only to round-off:
+  // copies within 1e-9 of the surface's extent are one vertex (looked up in cubes of that side, so that
+  // copies on two sides of a cube's face still meet). Then each edge with its triangles' patches: an
+  // edge between two patches is part of their border.
   const PatchedSurface& s = b.gamma;
   double extent = 0;
   for (const Triangle3& t : s.triangles)
     for (const Point3& p : {t.a, t.b, t.c}) extent = std::max({extent, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
   const double unit = 1e-9 * std::max(extent, 1e-300);
-  std::map<std::tuple<long long, long long, long long>, int> vertex;
-  const auto id = [&vertex, unit](const Point3& p) {
-    const auto key = std::make_tuple(std::llround(p.x / unit), std::llround(p.y / unit), std::llround(p.z / unit));
-    return vertex.emplace(key, int(vertex.size())).first->second;
+  Buckets<3> cells(unit);
+  std::vector<Point3> vertices;
+  const auto id = [&](const Point3& p) {
+    const std::array<long, 3> c = cells.cell(p);
+    int found = -1;
+    Buckets<3>::around(c, 1, [&](const std::array<long, 3>& k) {
+      if (const std::vector<int>* in = found < 0 ? cells.at(k) : nullptr)
+        for (int v : *in)
+          if (norm(vertices[std::size_t(v)] - p) <= unit) found = v;
+    });
+    if (found < 0) found = int(vertices.size()), vertices.push_back(p), cells.add(c, found);
+    return found;
   };
   std::map<std::pair<int, int>, std::pair<int, double>> edge_patch;  // edge → (first patch, length)
   std::map<std::pair<int, int>, NeighbourPair> border;               // (patch i < j) → their pair
@@ -164,10 +212,14 @@ double bulge(const Point3& h, const Point3& a, const Point3& b, const Point3& k,
 
 /// A piece of the located contact boundary: a segment between two consecutive ends (3-D), or one end
 /// joined to no other (a = b; every end in 2-D), with the unit normal across it towards the contact side
-/// (that of the active points of its ends).
+/// (that of the active points of its ends). Where a patch's ends all sit at its point (a patch in contact
+/// among free ones whose flux reading is ≤ 0, θ = 0 on every side; or a free one among patches in contact
+/// whose gap is ≤ 0, θ = 1), the set it bounds has shrunk to that point: `around` is then −1 (free all
+/// around) or +1 (in contact all around) and `across` is 0.
 template <int dim>
 struct Segment {
   Point<dim> a, b, across;
+  double around = 0;
 };
 
 template <int dim>
@@ -175,13 +227,29 @@ Point<dim> unit(const Point<dim>& v) {
   return norm(v) > 0 ? (1 / norm(v)) * v : v;
 }
 
-/// The segments of s's located boundary: its lines, then the ends on none.
+/// The segments of s's located boundary (`pairs`: its neighbour pairs): its lines, then the ends on none.
 template <int dim>
-std::vector<Segment<dim>> located_segments(const BasicSolution<dim>& s) {
+std::vector<Segment<dim>> located_segments(const BasicSolution<dim>& s, const std::vector<NeighbourPair>& pairs) {
   const std::vector<Point<dim>>& ends = s.contact_boundary;
   const auto towards = [&](std::size_t k) {  // from the free point to the active one: never 0
     const std::array<int, 2>& pair = s.contact_boundary_pairs[k];
     return unit<dim>(s.points()[std::size_t(pair[0])] - s.points()[std::size_t(pair[1])]);
+  };
+  // The patches whose every neighbour is across a located end that sits at the patch's point: the end's
+  // `around` is −1 at a patch in contact, +1 at a free one, 0 elsewhere.
+  std::vector<int> neighbours(std::size_t(s.n_points()), 0), collapsed(std::size_t(s.n_points()), 0);
+  for (const NeighbourPair& p : pairs) ++neighbours[std::size_t(p.i)], ++neighbours[std::size_t(p.j)];
+  for (std::size_t k = 0; k < ends.size(); ++k)
+    for (int i : s.contact_boundary_pairs[k]) {
+      const Point<dim>& x = s.points()[std::size_t(i)];
+      const double d = norm(s.points()[std::size_t(s.contact_boundary_pairs[k][0])] -
+                            s.points()[std::size_t(s.contact_boundary_pairs[k][1])]);
+      if (norm(ends[k] - x) <= 1e-12 * d) ++collapsed[std::size_t(i)];
+    }
+  const auto around = [&](std::size_t k) {
+    for (int i : s.contact_boundary_pairs[k])
+      if (collapsed[std::size_t(i)] == neighbours[std::size_t(i)]) return s.in_contact(i) ? -1.0 : 1.0;
+    return 0.0;
   };
   std::vector<Segment<dim>> segments;
   std::vector<bool> joined(ends.size(), false);
@@ -190,11 +258,16 @@ std::vector<Segment<dim>> located_segments(const BasicSolution<dim>& s) {
     joined[i] = joined[j] = true;
     const Point<dim> along = ends[j] - ends[i], toward = towards(i) + towards(j);
     const double length2 = dot(along, along);
+    if (around(i) != 0 && around(i) == around(j)) {
+      segments.push_back({ends[i], ends[j], Point<dim>{}, around(i)});
+      continue;
+    }
     segments.push_back(
         {ends[i], ends[j], unit<dim>(length2 > 0 ? toward - (dot(toward, along) / length2) * along : toward)});
   }
   for (std::size_t k = 0; k < ends.size(); ++k)
-    if (!joined[k]) segments.push_back({ends[k], ends[k], towards(k)});
+    if (!joined[k]) segments.push_back(around(k) != 0 ? Segment<dim>{ends[k], ends[k], Point<dim>{}, around(k)}
+                                                       : Segment<dim>{ends[k], ends[k], towards(k)});
   return segments;
 }
 
@@ -208,7 +281,8 @@ Point<dim> offset_from(const Point<dim>& x, const Segment<dim>& g) {
 
 /// ψ at x: the distance to the nearest of the `candidates`, negative on its contact side; where several
 /// are nearest (beyond a vertex of the polyline), the sum of their unit normals towards the contact side
-/// decides. `outside` where none comes within `reach`.
+/// decides, with a shrunken set's `around` (Segment) for its whole side. `outside` where none comes
+/// within `reach`.
 template <int dim>
 double signed_distance(const Point<dim>& x, const std::vector<const Segment<dim>*>& candidates, double reach,
                        double outside) {
@@ -218,7 +292,7 @@ double signed_distance(const Point<dim>& x, const std::vector<const Segment<dim>
   double side = 0;  // Σ over the nearest segments of offset·normal
   for (const Segment<dim>* g : candidates) {
     const Point<dim> offset = offset_from(x, *g);
-    if (norm(offset) <= nearest + 1e-12 * reach) side += dot(offset, g->across);
+    if (norm(offset) <= nearest + 1e-12 * reach) side += dot(offset, g->across) + g->around * norm(offset);
   }
   return side > 0 ? -nearest : nearest;
 }
@@ -232,7 +306,7 @@ double signed_distance(const Point<dim>& x, const std::vector<const Segment<dim>
 /// off κℓ³/12 each); none where the line branches, ends or closes on itself before such an end.
 double contact_area_inside(const BasicSolution<3>& s, const std::vector<NeighbourPair>& pairs) {
   const std::vector<Point3>& ends = s.contact_boundary;
-  const std::vector<Segment<3>> segments = located_segments(s);
+  const std::vector<Segment<3>> segments = located_segments(s, pairs);
   std::vector<std::vector<std::size_t>> neighbours(ends.size());
   for (const auto& [k1, k2] : s.contact_boundary_lines) {
     neighbours[std::size_t(k1)].push_back(std::size_t(k2));
@@ -295,40 +369,6 @@ double contact_area_inside(const BasicSolution<3>& s, const std::vector<Neighbou
   return area + bulges;
 }
 
-/// Cubes of side `size` holding indices, for the searches near a point.
-template <int dim>
-class Buckets {
- public:
-  explicit Buckets(double size) : size_(size) {}
-  std::array<long, dim> cell(const Point<dim>& x) const {
-    std::array<long, dim> c;
-    for (int d = 0; d < dim; ++d) c[std::size_t(d)] = long(std::floor(x[d] / size_));
-    return c;
-  }
-  void add(const std::array<long, dim>& c, int index) { cells_[c].push_back(index); }
-  const std::vector<int>* at(const std::array<long, dim>& c) const {
-    const auto it = cells_.find(c);
-    return it == cells_.end() ? nullptr : &it->second;
-  }
-  /// Calls visit(c) for the cells within `rings` cells of c (in every coordinate).
-  template <typename Visit>
-  static void around(const std::array<long, dim>& c, long rings, Visit&& visit) {
-    std::array<long, dim> k = c;
-    for (int d = 0; d < dim; ++d) k[std::size_t(d)] = c[std::size_t(d)] - rings;
-    while (true) {
-      visit(k);
-      int d = 0;
-      while (d < dim && ++k[std::size_t(d)] > c[std::size_t(d)] + rings)
-        k[std::size_t(d)] = c[std::size_t(d)] - rings, ++d;
-      if (d == dim) return;
-    }
-  }
-  double size() const { return size_; }
-
- private:
-  double size_;
-  std::map<std::array<long, dim>, std::vector<int>> cells_;
-};
 
 }  // namespace
 
@@ -361,12 +401,19 @@ void resolve_contact(BasicSolution<dim>& s) {
                                  theta * (s.points()[std::size_t(b)] - s.points()[std::size_t(a)]));
   }
   // Two ends whose borders meet at a vertex of the triangulation are consecutive along the contact
-  // boundary: a segment joins them (where more meet, as at a patch corner, each to the next).
+  // boundary: a segment joins them. Where more meet (a saddle: patches in contact and free alternate
+  // around the vertex), the two ends of each patch in contact there are joined, so that the contact
+  // sets on the two sides stay apart; an end left over (beside a part under another condition) is not.
   std::set<std::array<int, 2>> lines;
   for (auto& [corner, ends] : at_corner) {
     std::sort(ends.begin(), ends.end());
     ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
-    for (std::size_t k = 0; k + 1 < ends.size(); ++k) lines.insert({ends[k], ends[k + 1]});
+    if (ends.size() == 2) lines.insert({ends[0], ends[1]});
+    if (ends.size() <= 2) continue;
+    std::map<int, std::vector<int>> by_active;
+    for (int k : ends) by_active[s.contact_boundary_pairs[std::size_t(k)][0]].push_back(k);
+    for (const auto& [active, own] : by_active)
+      if (own.size() == 2) lines.insert({own[0], own[1]});
   }
   s.contact_boundary_lines.assign(lines.begin(), lines.end());
   // On a surface the measure is the area inside the located boundary (docs/math.md, "The contact set").
@@ -386,7 +433,7 @@ std::function<double(const Point<dim>&)> contact_side(const BasicSolution<dim>& 
   };
   const double spacing = s.spacing();
   auto side = std::make_shared<Side>(
-      Side{located_segments(s), s.points(), {}, Buckets<dim>(spacing), Buckets<dim>(spacing), 1.5 * spacing});
+      Side{located_segments(s, neighbour_pairs<dim>(s)), s.points(), {}, Buckets<dim>(spacing), Buckets<dim>(spacing), 1.5 * spacing});
   for (int i = 0; i < s.n_points(); ++i) {  // the Signorini points (a located end lies between two)
     side->active.push_back(char(s.in_contact(i)));
     if (s.condition(i) == PointCondition::signorini)

@@ -6,8 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
+#include <numeric>
 
+#include "fictus/boundary/collocation.hpp"
+#include "fictus/boundary/shapes.hpp"
 #include "fictus/boundary/surface_integrals.hpp"
 #include "fictus/solve/solution.hpp"
 
@@ -156,6 +160,149 @@ TEST(ContactSet, StarOfOnePatchWithSharpCorners) {
             << ", the patch's " << s.gamma.area[a] << "\n";
   EXPECT_EQ(s.contact_boundary.size(), around.size());
   EXPECT_NEAR(s.contact_measure / fan, 1, 0.015);
+}
+
+}  // namespace
+
+namespace {
+
+/// The located ends' degrees in s's contact-boundary lines.
+std::vector<int> line_degrees(const fictus::SurfaceSolution& s) {
+  std::vector<int> degree(s.contact_boundary.size(), 0);
+  for (const auto& [k1, k2] : s.contact_boundary_lines) ++degree[std::size_t(k1)], ++degree[std::size_t(k2)];
+  return degree;
+}
+
+/// Only the patches in `active` in contact, each with ∂u/∂n = 1; the free ones' gaps put the ends half way.
+void set_islands(fictus::SurfaceSolution& s, const std::vector<int>& active) {
+  const std::size_t m = std::size_t(s.gamma.m);
+  s.newton.active.assign(m, 0);
+  s.trace.assign(m, s.spacing() / 3), s.g.assign(m, 0.0), s.normal_derivative.assign(m, 0.0);
+  for (int a : active) s.newton.active[std::size_t(a)] = 1, s.normal_derivative[std::size_t(a)] = 1.0;
+}
+
+// A triangulation made face by face computes a vertex shared by several triangles once per triangle,
+// equal only to round-off. Copies that differ by up to a quarter of 1e-9 of the surface's extent (far
+// more than round-off, far less than an edge) must still be one vertex: the same neighbours, borders and
+// corners. Before, vertices were keyed by their coordinates rounded to that unit, and copies on the two
+// sides of a rounding boundary were two vertices (here 383 of the 1,740 neighbour pairs went missing).
+TEST(ContactSet, SharedCornersDoNotDependOnRoundOff) {
+  fictus::SurfaceSolution s = on_sphere(600, radius / 40);
+  const std::vector<fictus::NeighbourPair> exact = fictus::neighbour_pairs<3>(s);
+  unsigned state = 12345;
+  const auto jitter = [&state] {  // in ±2e-10: a quarter of the unit of 1e-9 × the extent 0.8
+    state = state * 1103515245u + 12345u;
+    return 2e-10 * ((state >> 8) / double(1u << 24) * 2 - 1);
+  };
+  for (fictus::Triangle3& t : s.gamma.triangles)
+    for (fictus::Point3* p : {&t.a, &t.b, &t.c}) *p = *p + fictus::Point3{jitter(), jitter(), jitter()};
+  const std::vector<fictus::NeighbourPair> moved = fictus::neighbour_pairs<3>(s);
+  ASSERT_EQ(moved.size(), exact.size());
+  int changed = 0;
+  for (std::size_t k = 0; k < exact.size(); ++k) {
+    EXPECT_EQ(moved[k].i, exact[k].i);
+    EXPECT_EQ(moved[k].j, exact[k].j);
+    if (std::abs(moved[k].border - exact[k].border) > 1e-8 || moved[k].corners.size() != exact[k].corners.size())
+      ++changed;
+  }
+  EXPECT_EQ(changed, 0);
+}
+
+// Four patches around one vertex, two opposite ones in contact and the others free (a saddle of the gap):
+// four ends meet there. Each must join one other, not a chain of three segments, so that every end has
+// two neighbours on the lines, and the area is that of the two contact islands each on its own. Before,
+// the four were chained in index order: two ends had three neighbours and the area was 28 % too large.
+TEST(ContactSet, FourEndsAtAVertexMakeTwoSegments) {
+  fictus::SurfaceSolution s = on_sphere(600, radius / 40);
+  const std::vector<fictus::NeighbourPair> pairs = fictus::neighbour_pairs<3>(s);
+  std::map<int, std::vector<std::size_t>> at;  // vertex → the pairs whose border has it
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    std::vector<int> corners = pairs[k].corners;
+    std::sort(corners.begin(), corners.end());
+    corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+    for (int c : corners) at[c].push_back(k);
+  }
+  int a = -1, c = -1;  // two patches at a vertex of four, sharing no border there
+  for (const auto& [vertex, here] : at) {
+    std::map<int, int> count;
+    for (std::size_t k : here) ++count[pairs[k].i], ++count[pairs[k].j];
+    if (here.size() != 4 || count.size() != 4) continue;
+    if (!std::all_of(count.begin(), count.end(), [](const auto& e) { return e.second == 2; })) continue;
+    a = pairs[here[0]].i;
+    for (const auto& [patch, n] : count) {
+      bool beside = patch == a;
+      for (std::size_t k : here) beside = beside || (pairs[k].i == a && pairs[k].j == patch) || (pairs[k].j == a && pairs[k].i == patch);
+      if (!beside) c = patch;
+    }
+    break;
+  }
+  ASSERT_GE(a, 0) << "no vertex with four patches";
+  ASSERT_GE(c, 0);
+  const auto area = [&](const std::vector<int>& active) {
+    set_islands(s, active);
+    fictus::resolve_contact(s);
+    return s.contact_measure;
+  };
+  const double alone = area({a}) + area({c}), both = area({a, c});
+  const std::vector<int> degree = line_degrees(s);
+  std::cout << "patches " << a << " and " << c << ": " << s.contact_boundary.size() << " ends, area " << both
+            << " against " << alone << " each on its own\n";
+  EXPECT_EQ(std::count(degree.begin(), degree.end(), 2), std::ptrdiff_t(degree.size()));
+  EXPECT_NEAR(both, alone, 1e-6 * alone);
+}
+
+// A patch in contact among free ones whose flux reading is 0 puts every end at its point (θ = 0): the
+// contact set shrinks to that point and its area is 0. Likewise a free patch among contact ones whose
+// gap is 0: the whole surface is in contact. Before, the tied segments' normals nearly cancelled and
+// their remainder decided the side near the point: the area was 2.9 times the patch's, and 2.9 patches
+// short of the whole surface.
+TEST(ContactSet, AnIslandWhoseEndsCoincideHasNoArea) {
+  fictus::SurfaceSolution s = on_sphere(600, radius / 40);
+  const int a = 17;
+  set_islands(s, {a});
+  s.normal_derivative[std::size_t(a)] = 0;
+  fictus::resolve_contact(s);
+  EXPECT_GE(s.contact_boundary.size(), 5u);
+  EXPECT_LT(s.contact_measure, 1e-6 * s.gamma.area[std::size_t(a)]);
+  std::vector<int> all(std::size_t(s.gamma.m));
+  std::iota(all.begin(), all.end(), 0);
+  all.erase(all.begin() + a);
+  set_islands(s, all);
+  s.trace[std::size_t(a)] = 0;
+  fictus::resolve_contact(s);
+  double total = 0;
+  for (double w : s.gamma.area) total += w;
+  EXPECT_NEAR(s.contact_measure, total, 1e-6 * s.gamma.area[std::size_t(a)]);
+}
+
+// The same on a curve: a point in contact between two free ones, its flux reading 0, puts both ends at
+// itself, and the contact side (which the contact fit follows) is empty around it; with the reading 1
+// and the neighbours' gaps putting the ends half way, it is the arc between them. The point is where the
+// star is concave: there the two ends' normals, which nearly cancel, summed to the contact side before.
+TEST(ContactSet, AnIslandWhoseEndsCoincideOnACurve) {
+  const fictus::StarCurve star({0.5, 0.5}, [](double t) { return 0.3 + 0.08 * std::cos(5 * t); });
+  const fictus::ArcLengthTable table(star);
+  fictus::Solution s(fictus::Grid2(fictus::Box2{{0, 0}, {1, 1}}, 64));
+  s.collocation = fictus::make_collocation(star, table, 60);
+  const std::size_t m = 60;
+  std::size_t a = 0;  // the point nearest the concave middle t = π/5
+  for (std::size_t i = 0; i < m; ++i)
+    if (std::abs(s.collocation.t[i] - std::numbers::pi / 5) < std::abs(s.collocation.t[a] - std::numbers::pi / 5)) a = i;
+  s.newton.active.assign(m, 0), s.newton.active[a] = 1;
+  s.g.assign(m, 0.0), s.normal_derivative.assign(m, 0.0);
+  s.trace.assign(m, s.spacing() / 3);  // √θ/(1 − θ)^{3/2} = 2 = q·d/(1.5·r): θ about ½ with q = 1
+  const auto side_at = [&](double f) {  // the contact side at the fraction f of the way to a neighbour
+    const double t = s.collocation.t[a], next = s.collocation.t[f > 0 ? a + 1 : a - 1];
+    return fictus::contact_side<2>(s)(star.position(t + std::abs(f) * (next - t)));
+  };
+  s.normal_derivative[a] = 1;
+  fictus::resolve_contact(s);
+  for (double f : {0.0, 0.3, -0.3}) EXPECT_EQ(side_at(f), 1.0) << f;
+  for (double f : {0.7, -0.7}) EXPECT_EQ(side_at(f), 0.0) << f;
+  s.normal_derivative[a] = 0;
+  fictus::resolve_contact(s);
+  ASSERT_EQ(s.contact_boundary.size(), 2u);
+  for (double f : {0.05, -0.05, 0.3, -0.3, 0.7, -0.7}) EXPECT_EQ(side_at(f), 0.0) << f;
 }
 
 }  // namespace
