@@ -9,7 +9,6 @@
 #include <map>
 #include <memory>
 #include <set>
-#include <tuple>
 
 namespace fictus {
 
@@ -118,11 +117,13 @@ std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<3>& b) {
   const auto id = [&](const Point3& p) {
     const std::array<long, 3> c = cells.cell(p);
     int found = -1;
-    Buckets<3>::around(c, 1, [&](const std::array<long, 3>& k) {
+    const auto look = [&](const std::array<long, 3>& k) {
       if (const std::vector<int>* in = found < 0 ? cells.at(k) : nullptr)
         for (int v : *in)
           if (norm(vertices[std::size_t(v)] - p) <= unit) found = v;
-    });
+    };
+    look(c);  // most copies fall in the first copy's cube
+    if (found < 0) Buckets<3>::around(c, 1, look);
     if (found < 0) found = int(vertices.size()), vertices.push_back(p), cells.add(c, found);
     return found;
   };
@@ -235,17 +236,19 @@ std::vector<Segment<dim>> located_segments(const BasicSolution<dim>& s, const st
     const std::array<int, 2>& pair = s.contact_boundary_pairs[k];
     return unit<dim>(s.points()[std::size_t(pair[0])] - s.points()[std::size_t(pair[1])]);
   };
-  // The patches whose every neighbour is across a located end that sits at the patch's point: the end's
-  // `around` is −1 at a patch in contact, +1 at a free one, 0 elsewhere.
+  // The patches whose every Signorini neighbour is across a located end that sits at the patch's point
+  // (θ = 0 or 1 give the points themselves): the end's `around` is −1 at a patch in contact, +1 at a
+  // free one, 0 elsewhere.
   std::vector<int> neighbours(std::size_t(s.n_points()), 0), collapsed(std::size_t(s.n_points()), 0);
-  for (const NeighbourPair& p : pairs) ++neighbours[std::size_t(p.i)], ++neighbours[std::size_t(p.j)];
-  for (std::size_t k = 0; k < ends.size(); ++k)
-    for (int i : s.contact_boundary_pairs[k]) {
-      const Point<dim>& x = s.points()[std::size_t(i)];
-      const double d = norm(s.points()[std::size_t(s.contact_boundary_pairs[k][0])] -
-                            s.points()[std::size_t(s.contact_boundary_pairs[k][1])]);
-      if (norm(ends[k] - x) <= 1e-12 * d) ++collapsed[std::size_t(i)];
-    }
+  for (const NeighbourPair& p : pairs)
+    if (s.condition(p.i) == PointCondition::signorini && s.condition(p.j) == PointCondition::signorini)
+      ++neighbours[std::size_t(p.i)], ++neighbours[std::size_t(p.j)];
+  for (std::size_t k = 0; k < ends.size(); ++k) {
+    const std::array<int, 2>& pair = s.contact_boundary_pairs[k];
+    const double d = norm(s.points()[std::size_t(pair[0])] - s.points()[std::size_t(pair[1])]);
+    for (int i : pair)
+      if (norm(ends[k] - s.points()[std::size_t(i)]) <= 1e-12 * d) ++collapsed[std::size_t(i)];
+  }
   const auto around = [&](std::size_t k) {
     for (int i : s.contact_boundary_pairs[k])
       if (collapsed[std::size_t(i)] == neighbours[std::size_t(i)]) return s.in_contact(i) ? -1.0 : 1.0;
@@ -266,8 +269,9 @@ std::vector<Segment<dim>> located_segments(const BasicSolution<dim>& s, const st
         {ends[i], ends[j], unit<dim>(length2 > 0 ? toward - (dot(toward, along) / length2) * along : toward)});
   }
   for (std::size_t k = 0; k < ends.size(); ++k)
-    if (!joined[k]) segments.push_back(around(k) != 0 ? Segment<dim>{ends[k], ends[k], Point<dim>{}, around(k)}
-                                                       : Segment<dim>{ends[k], ends[k], towards(k)});
+    if (!joined[k])
+      segments.push_back(around(k) != 0 ? Segment<dim>{ends[k], ends[k], Point<dim>{}, around(k)}
+                                        : Segment<dim>{ends[k], ends[k], towards(k)});
   return segments;
 }
 
@@ -369,7 +373,6 @@ double contact_area_inside(const BasicSolution<3>& s, const std::vector<Neighbou
   return area + bulges;
 }
 
-
 }  // namespace
 
 template <int dim>
@@ -397,23 +400,37 @@ void resolve_contact(BasicSolution<dim>& s) {
     }
     for (int corner : p.corners) at_corner[corner].push_back(int(s.contact_boundary.size()));
     s.contact_boundary_pairs.push_back({a, b});
-    s.contact_boundary.push_back(s.points()[std::size_t(a)] +
-                                 theta * (s.points()[std::size_t(b)] - s.points()[std::size_t(a)]));
+    const Point<dim>& xa = s.points()[std::size_t(a)];
+    const Point<dim>& xb = s.points()[std::size_t(b)];
+    s.contact_boundary.push_back(theta == 1 ? xb : xa + theta * (xb - xa));
   }
   // Two ends whose borders meet at a vertex of the triangulation are consecutive along the contact
   // boundary: a segment joins them. Where more meet (a saddle: patches in contact and free alternate
-  // around the vertex), the two ends of each patch in contact there are joined, so that the contact
-  // sets on the two sides stay apart; an end left over (beside a part under another condition) is not.
+  // around the vertex), the ends are grouped by the sector in contact they bound (patches in contact
+  // that border each other at the vertex are one sector), so that the sectors stay apart; a group of two
+  // is joined, a larger one (a patch that comes round twice) chained, and an end alone (its sector
+  // bounded by a part under another condition) is not joined there.
+  std::map<int, std::vector<std::array<int, 2>>> touching;  // a vertex → the pairs in contact whose border has it
+  for (const NeighbourPair& p : pairs)
+    if (s.in_contact(p.i) && s.in_contact(p.j))
+      for (int corner : p.corners) touching[corner].push_back({p.i, p.j});
   std::set<std::array<int, 2>> lines;
   for (auto& [corner, ends] : at_corner) {
     std::sort(ends.begin(), ends.end());
     ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
     if (ends.size() == 2) lines.insert({ends[0], ends[1]});
     if (ends.size() <= 2) continue;
-    std::map<int, std::vector<int>> by_active;
-    for (int k : ends) by_active[s.contact_boundary_pairs[std::size_t(k)][0]].push_back(k);
-    for (const auto& [active, own] : by_active)
-      if (own.size() == 2) lines.insert({own[0], own[1]});
+    std::map<int, int> sector;  // a patch in contact → the sector's first patch (a union-find)
+    const std::function<int(int)> root = [&](int p) {
+      const auto it = sector.emplace(p, p).first;
+      return it->second == p ? p : it->second = root(it->second);
+    };
+    if (const auto it = touching.find(corner); it != touching.end())
+      for (const auto& [p, q] : it->second) sector[root(p)] = root(q);
+    std::map<int, std::vector<int>> by_sector;
+    for (int k : ends) by_sector[root(s.contact_boundary_pairs[std::size_t(k)][0])].push_back(k);
+    for (const auto& [first, own] : by_sector)
+      for (std::size_t k = 0; k + 1 < own.size(); ++k) lines.insert({own[k], own[k + 1]});
   }
   s.contact_boundary_lines.assign(lines.begin(), lines.end());
   // On a surface the measure is the area inside the located boundary (docs/math.md, "The contact set").
@@ -432,8 +449,12 @@ std::function<double(const Point<dim>&)> contact_side(const BasicSolution<dim>& 
     double reach;
   };
   const double spacing = s.spacing();
-  auto side = std::make_shared<Side>(
-      Side{located_segments(s, neighbour_pairs<dim>(s)), s.points(), {}, Buckets<dim>(spacing), Buckets<dim>(spacing), 1.5 * spacing});
+  auto side = std::make_shared<Side>(Side{located_segments(s, neighbour_pairs<dim>(s)),
+                                          s.points(),
+                                          {},
+                                          Buckets<dim>(spacing),
+                                          Buckets<dim>(spacing),
+                                          1.5 * spacing});
   for (int i = 0; i < s.n_points(); ++i) {  // the Signorini points (a located end lies between two)
     side->active.push_back(char(s.in_contact(i)));
     if (s.condition(i) == PointCondition::signorini)

@@ -162,10 +162,6 @@ TEST(ContactSet, StarOfOnePatchWithSharpCorners) {
   EXPECT_NEAR(s.contact_measure / fan, 1, 0.015);
 }
 
-}  // namespace
-
-namespace {
-
 /// The located ends' degrees in s's contact-boundary lines.
 std::vector<int> line_degrees(const fictus::SurfaceSolution& s) {
   std::vector<int> degree(s.contact_boundary.size(), 0);
@@ -231,7 +227,8 @@ TEST(ContactSet, FourEndsAtAVertexMakeTwoSegments) {
     a = pairs[here[0]].i;
     for (const auto& [patch, n] : count) {
       bool beside = patch == a;
-      for (std::size_t k : here) beside = beside || (pairs[k].i == a && pairs[k].j == patch) || (pairs[k].j == a && pairs[k].i == patch);
+      for (std::size_t k : here)
+        beside = beside || (pairs[k].i == a && pairs[k].j == patch) || (pairs[k].j == a && pairs[k].i == patch);
       if (!beside) c = patch;
     }
     break;
@@ -287,10 +284,11 @@ TEST(ContactSet, AnIslandWhoseEndsCoincideOnACurve) {
   const std::size_t m = 60;
   std::size_t a = 0;  // the point nearest the concave middle t = π/5
   for (std::size_t i = 0; i < m; ++i)
-    if (std::abs(s.collocation.t[i] - std::numbers::pi / 5) < std::abs(s.collocation.t[a] - std::numbers::pi / 5)) a = i;
+    if (std::abs(s.collocation.t[i] - std::numbers::pi / 5) < std::abs(s.collocation.t[a] - std::numbers::pi / 5))
+      a = i;
   s.newton.active.assign(m, 0), s.newton.active[a] = 1;
   s.g.assign(m, 0.0), s.normal_derivative.assign(m, 0.0);
-  s.trace.assign(m, s.spacing() / 3);  // √θ/(1 − θ)^{3/2} = 2 = q·d/(1.5·r): θ about ½ with q = 1
+  s.trace.assign(m, s.spacing() / 3);   // √θ/(1 − θ)^{3/2} = 2 = q·d/(1.5·r): θ about ½ with q = 1
   const auto side_at = [&](double f) {  // the contact side at the fraction f of the way to a neighbour
     const double t = s.collocation.t[a], next = s.collocation.t[f > 0 ? a + 1 : a - 1];
     return fictus::contact_side<2>(s)(star.position(t + std::abs(f) * (next - t)));
