@@ -165,6 +165,20 @@ double contact_end_fraction(double q, double r, double d) {
   return 0.5 * (lo + hi);
 }
 
+double contact_end_fraction(double q, double r, double d, double beyond) {
+  if (!(beyond < std::numeric_limits<double>::infinity())) return contact_end_fraction(q, r, d);
+  if (!(q > 0)) return 0.0;
+  if (!(r > 0) || !(d > 0)) return 1.0;
+  const double target = q / r;
+  double lo = 0, hi = 1;  // the ratio increases from 0 to ∞ on (0, 1)
+  for (int k = 0; k < 60; ++k) {
+    const double theta = 0.5 * (lo + hi), alpha = theta * d, beta = (1 - theta) * d, e = beta + beyond;
+    const double ratio = 3 * (alpha + 0.5 * e) * std::sqrt(alpha * (alpha + e)) / std::pow(beta * beyond, 1.5);
+    (ratio < target ? lo : hi) = theta;
+  }
+  return 0.5 * (lo + hi);
+}
+
 namespace {
 
 /// Whether a contact end lies between the pair's points: both Signorini, one active and one free.
@@ -373,6 +387,55 @@ double contact_area_inside(const BasicSolution<3>& s, const std::vector<Neighbou
   return area + bulges;
 }
 
+/// For each located end of s: how far past its free point, along its pair's direction from the active
+/// point, the located boundary lies again (infinity where it does not within 4 pair distances). On a curve:
+/// the next end along it; on a surface: where the ray in the free point's tangent plane first crosses a
+/// segment of the polyline (the end's own segments aside).
+template <int dim>
+std::vector<double> free_band_beyond(const BasicSolution<dim>& s) {
+  const std::vector<Point<dim>>& ends = s.contact_boundary;
+  std::vector<double> beyond(ends.size(), std::numeric_limits<double>::infinity());
+  if constexpr (dim == 2) {
+    const int m = s.n_points();
+    if (m < 3) return beyond;
+    std::map<std::array<int, 2>, std::size_t> end_of;  // (free, active) → the end between them
+    for (std::size_t k = 0; k < ends.size(); ++k)
+      end_of[{s.contact_boundary_pairs[k][1], s.contact_boundary_pairs[k][0]}] = k;
+    for (std::size_t k = 0; k < ends.size(); ++k) {
+      const int a = s.contact_boundary_pairs[k][0], b = s.contact_boundary_pairs[k][1];
+      const int step = (a + 1) % m == b ? 1 : -1;
+      const Point2& xb = s.points()[std::size_t(b)];
+      const double far = 4 * norm(xb - s.points()[std::size_t(a)]);
+      for (int p = b, q = (b + step + m) % m; q != a; p = q, q = (q + step + m) % m) {
+        if (s.condition(q) != PointCondition::signorini || norm(s.points()[std::size_t(q)] - xb) > far) break;
+        if (!s.in_contact(q)) continue;
+        if (const auto it = end_of.find({p, q}); it != end_of.end()) beyond[k] = norm(ends[it->second] - xb);
+        break;
+      }
+    }
+  } else {
+    for (std::size_t k = 0; k < ends.size(); ++k) {
+      const int a = s.contact_boundary_pairs[k][0], b = s.contact_boundary_pairs[k][1];
+      const Point3& xb = s.points()[std::size_t(b)];
+      const Point3 n = s.normals()[std::size_t(b)], pair = xb - s.points()[std::size_t(a)];
+      const double far = 4 * norm(pair);
+      const Point3 along = unit<3>(pair - dot(pair, n) * n), side = cross(n, along);
+      for (const auto& [i, j] : s.contact_boundary_lines) {
+        if (std::size_t(i) == k || std::size_t(j) == k) continue;
+        const Point3 p = ends[std::size_t(i)] - xb, q = ends[std::size_t(j)] - xb;
+        if (std::min(norm(p), norm(q)) > far + norm(q - p)) continue;
+        const double py = dot(p, side), qy = dot(q, side);
+        if ((py > 0 && qy > 0) || (py < 0 && qy < 0) || py == qy) continue;
+        const double lambda = py / (py - qy);
+        const Point3 x = p + lambda * (q - p);
+        const double t = dot(x, along);  // the crossing's distance along the ray, if it lies near the plane
+        if (t > 0 && t < beyond[k] && std::abs(dot(x, n)) < 0.5 * t) beyond[k] = t;
+      }
+    }
+  }
+  return beyond;
+}
+
 }  // namespace
 
 template <int dim>
@@ -388,22 +451,27 @@ void resolve_contact(BasicSolution<dim>& s) {
   s.contact_boundary_pairs.clear();
   std::map<int, std::vector<int>> at_corner;  // 3-D: a mesh vertex → the located ends whose border has it
   const std::vector<NeighbourPair> pairs = neighbour_pairs<dim>(s);
+  std::vector<const NeighbourPair*> located;  // each end's pair
+  std::vector<double> theta;
   for (const NeighbourPair& p : pairs) {
     if (!located_pair(s, p)) continue;
     const bool i_active = s.in_contact(p.i);
     const int a = i_active ? p.i : p.j, b = i_active ? p.j : p.i;
-    const double q = s.normal_derivative[std::size_t(a)], r = s.trace[std::size_t(b)] - s.g[std::size_t(b)];
-    const double theta = contact_end_fraction(q, r, p.distance);
-    if constexpr (dim == 2) {  // the end moves the border between the arcs, each owning d in proportion
-      const double owned = p.distance * part[std::size_t(a)] / (part[std::size_t(a)] + part[std::size_t(b)]);
-      measure += (theta * p.distance - owned) * p.border;
-    }
-    for (int corner : p.corners) at_corner[corner].push_back(int(s.contact_boundary.size()));
+    for (int corner : p.corners) at_corner[corner].push_back(int(located.size()));
+    located.push_back(&p);
     s.contact_boundary_pairs.push_back({a, b});
-    const Point<dim>& xa = s.points()[std::size_t(a)];
-    const Point<dim>& xb = s.points()[std::size_t(b)];
-    s.contact_boundary.push_back(theta == 1 ? xb : xa + theta * (xb - xa));
+    theta.push_back(contact_end_fraction(s.normal_derivative[std::size_t(a)],
+                                         s.trace[std::size_t(b)] - s.g[std::size_t(b)], p.distance));
   }
+  const auto place = [&] {
+    s.contact_boundary.clear();
+    for (std::size_t k = 0; k < located.size(); ++k) {
+      const Point<dim>& xa = s.points()[std::size_t(s.contact_boundary_pairs[k][0])];
+      const Point<dim>& xb = s.points()[std::size_t(s.contact_boundary_pairs[k][1])];
+      s.contact_boundary.push_back(theta[k] == 1 ? xb : xa + theta[k] * (xb - xa));
+    }
+  };
+  place();
   // Two ends whose borders meet at a vertex of the triangulation are consecutive along the contact
   // boundary: a segment joins them. Where more meet (a saddle: patches in contact and free alternate
   // around the vertex), the ends are grouped by the sector in contact they bound (patches in contact
@@ -433,6 +501,32 @@ void resolve_contact(BasicSolution<dim>& s) {
       for (std::size_t k = 0; k + 1 < own.size(); ++k) lines.insert({own[k], own[k + 1]});
   }
   s.contact_boundary_lines.assign(lines.begin(), lines.end());
+  // Where the located boundary comes back within a few spacings past a free point, the free part there is
+  // a band that the two ends close: each end's law takes the band's width (docs/math.md, "The contact
+  // set"). The ends move each other, so a few sweeps; the next end counts fully up to d and not at all from
+  // 4d on (its distance b taken as b/(1 − (b/4d)²)), so that the ends move continuously with the readings.
+  for (int sweep = 0; sweep < 4 && !located.empty(); ++sweep) {
+    const std::vector<double> beyond = free_band_beyond(s);
+    double moved = 0;
+    for (std::size_t k = 0; k < located.size(); ++k) {
+      const double d = located[k]->distance, far = 4 * d, b = beyond[k];
+      const double width = b < far ? b / (1 - (b / far) * (b / far)) : std::numeric_limits<double>::infinity();
+      const int a = s.contact_boundary_pairs[k][0], f = s.contact_boundary_pairs[k][1];
+      const double next = contact_end_fraction(s.normal_derivative[std::size_t(a)],
+                                               s.trace[std::size_t(f)] - s.g[std::size_t(f)], d, width);
+      moved = std::max(moved, std::abs(next - theta[k]));
+      theta[k] = next;
+    }
+    place();
+    if (moved < 1e-9) break;
+  }
+  if constexpr (dim == 2)  // each end moves the border between the arcs, each owning d in proportion
+    for (std::size_t k = 0; k < located.size(); ++k) {
+      const std::size_t a = std::size_t(s.contact_boundary_pairs[k][0]),
+                        b = std::size_t(s.contact_boundary_pairs[k][1]);
+      const double d = located[k]->distance, owned = d * part[a] / (part[a] + part[b]);
+      measure += (theta[k] * d - owned) * located[k]->border;
+    }
   // On a surface the measure is the area inside the located boundary (docs/math.md, "The contact set").
   if constexpr (dim == 3) measure = contact_area_inside(s, pairs);
   s.contact_measure = std::clamp(measure, 0.0, total);

@@ -233,6 +233,13 @@ std::vector<NeighbourPair> neighbour_pairs(const SolutionBoundary<dim>& boundary
 /// through both values: √θ/(1 − θ)^{3/2} = q·d/(1.5·r).
 double contact_end_fraction(double q, double r, double d);
 
+/// The same where the free side is a band that another end closes a distance `beyond` past the free
+/// point (docs/math.md, "The contact set"). Along the line, with the ends at 0 and e = (1 − θ)d + beyond,
+/// the local solution Im (z(z − e))^{3/2} has the gap K·(x(e − x))^{3/2}/3 on the band and
+/// ∂u/∂n = K·|x − e/2|·√(x(x − e)) beyond it; through both values
+/// 3(α + e/2)√(α(α + e)) / (β·beyond)^{3/2} = q/r, α = θd, β = (1 − θ)d. As beyond → ∞ this is the law above.
+double contact_end_fraction(double q, double r, double d, double beyond);
+
 /// Sets solution.contact_boundary, contact_boundary_lines, contact_boundary_pairs and contact_measure from
 /// the per-point values.
 template <int dim>
