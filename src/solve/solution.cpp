@@ -168,7 +168,7 @@ double contact_end_fraction(double q, double r, double d) {
 double contact_end_fraction(double q, double r, double d, double beyond) {
   if (!(beyond < std::numeric_limits<double>::infinity())) return contact_end_fraction(q, r, d);
   if (!(q > 0)) return 0.0;
-  if (!(r > 0) || !(d > 0)) return 1.0;
+  if (!(r > 0) || !(d > 0) || !(beyond > 0)) return 1.0;  // beyond = 0: the band closes at the free point
   const double target = q / r;
   double lo = 0, hi = 1;  // the ratio increases from 0 to ∞ on (0, 1)
   for (int k = 0; k < 60; ++k) {
@@ -388,9 +388,11 @@ double contact_area_inside(const BasicSolution<3>& s, const std::vector<Neighbou
 }
 
 /// For each located end of s: how far past its free point, along its pair's direction from the active
-/// point, the located boundary lies again (infinity where it does not within 4 pair distances). On a curve:
-/// the next end along it; on a surface: where the ray in the free point's tangent plane first crosses a
-/// segment of the polyline (the end's own segments aside).
+/// point, the located boundary lies again (infinity where it does not; resolve_contact ignores distances
+/// from 4 pair distances on). On a curve: the next end along it that is not at its active point (a contact
+/// set shrunk to a point does not close a band), before a point under another condition. On a surface:
+/// where the ray from the free point along the pair (in its tangent plane) first crosses, at 30° or more,
+/// the plane through a segment of the polyline and the normal (the end's own segments aside).
 template <int dim>
 std::vector<double> free_band_beyond(const BasicSolution<dim>& s) {
   const std::vector<Point<dim>>& ends = s.contact_boundary;
@@ -407,10 +409,14 @@ std::vector<double> free_band_beyond(const BasicSolution<dim>& s) {
       const Point2& xb = s.points()[std::size_t(b)];
       const double far = 4 * norm(xb - s.points()[std::size_t(a)]);
       for (int p = b, q = (b + step + m) % m; q != a; p = q, q = (q + step + m) % m) {
-        if (s.condition(q) != PointCondition::signorini || norm(s.points()[std::size_t(q)] - xb) > far) break;
-        if (!s.in_contact(q)) continue;
-        if (const auto it = end_of.find({p, q}); it != end_of.end()) beyond[k] = norm(ends[it->second] - xb);
-        break;
+        if (s.condition(q) != PointCondition::signorini) break;
+        const auto it = s.in_contact(q) ? end_of.find({p, q}) : end_of.end();
+        // An end at its active point (θ = 0: a contact set shrunk to the point) does not close the band.
+        if (it != end_of.end() && norm(ends[it->second] - s.points()[std::size_t(q)]) > 0) {
+          beyond[k] = norm(ends[it->second] - xb);  // the taper in resolve_contact takes it to ∞ from 4d
+          break;
+        }
+        if (norm(s.points()[std::size_t(q)] - xb) > far) break;
       }
     }
   } else {
@@ -426,6 +432,9 @@ std::vector<double> free_band_beyond(const BasicSolution<dim>& s) {
         if (std::min(norm(p), norm(q)) > far + norm(q - p)) continue;
         const double py = dot(p, side), qy = dot(q, side);
         if ((py > 0 && qy > 0) || (py < 0 && qy < 0) || py == qy) continue;
+        // Only a segment that crosses the ray at 30° or more: one that runs along it (ends of another pair
+        // beside the same free point, near it) does not close a band there.
+        if (std::abs(py - qy) < 0.5 * norm(q - p)) continue;
         const double lambda = py / (py - qy);
         const Point3 x = p + lambda * (q - p);
         const double t = dot(x, along);  // the crossing's distance along the ray, if it lies near the plane
@@ -503,19 +512,24 @@ void resolve_contact(BasicSolution<dim>& s) {
   s.contact_boundary_lines.assign(lines.begin(), lines.end());
   // Where the located boundary comes back within a few spacings past a free point, the free part there is
   // a band that the two ends close: each end's law takes the band's width (docs/math.md, "The contact
-  // set"). The ends move each other, so a few sweeps; the next end counts fully up to d and not at all from
-  // 4d on (its distance b taken as b/(1 − (b/4d)²)), so that the ends move continuously with the readings.
-  for (int sweep = 0; sweep < 4 && !located.empty(); ++sweep) {
+  // set"). The ends move each other, so sweeps until they settle (at most eight). Each takes the geometric
+  // mean of the free side's length before and after it: the two ends of a band narrower than a spacing
+  // share a free point whose gap fixes only the product of their distances from it, and undamped they
+  // would swing from sweep to sweep. The distance to the next end is tapered from 0 to 4d (taken as
+  // beyond/(1 − (beyond/4d)²), infinite from 4d on), so that the ends move continuously with the readings.
+  for (int sweep = 0; sweep < 8 && !located.empty(); ++sweep) {
     const std::vector<double> beyond = free_band_beyond(s);
     double moved = 0;
     for (std::size_t k = 0; k < located.size(); ++k) {
-      const double d = located[k]->distance, far = 4 * d, b = beyond[k];
-      const double width = b < far ? b / (1 - (b / far) * (b / far)) : std::numeric_limits<double>::infinity();
-      const int a = s.contact_boundary_pairs[k][0], f = s.contact_boundary_pairs[k][1];
-      const double next = contact_end_fraction(s.normal_derivative[std::size_t(a)],
-                                               s.trace[std::size_t(f)] - s.g[std::size_t(f)], d, width);
-      moved = std::max(moved, std::abs(next - theta[k]));
-      theta[k] = next;
+      const double d = located[k]->distance, far = 4 * d, band = beyond[k];
+      if (!(band < far)) continue;  // no band: the lone end's θ, as placed
+      const int active = s.contact_boundary_pairs[k][0], free = s.contact_boundary_pairs[k][1];
+      const double next = contact_end_fraction(s.normal_derivative[std::size_t(active)],
+                                               s.trace[std::size_t(free)] - s.g[std::size_t(free)], d,
+                                               band / (1 - (band / far) * (band / far)));
+      const double damped = 1 - std::sqrt((1 - theta[k]) * (1 - next));
+      moved = std::max(moved, std::abs(damped - theta[k]));
+      theta[k] = damped;
     }
     place();
     if (moved < 1e-9) break;
