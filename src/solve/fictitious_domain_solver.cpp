@@ -1069,6 +1069,7 @@ BasicSolution<dim> FictitiousDomainSolver<dim>::solve(const BasicContactData<dim
     st.execution.throw_if_interrupted();
     return setup;
   };
+  sol.options.fit_contact = options.fit_contact;  // resolve_contact's rule for the ends depends on it
   for (int pass = 0;; ++pass) {
     const std::size_t pass_begins = sol.timings.phases.size();
     const bool last = pass >= options.fit_contact;
