@@ -20,6 +20,20 @@
 
 namespace {
 
+/// A reference of tests/references: its problem file's text and its fitted-mesh solution (NAME.json).
+struct StoredReference {
+  std::string text;
+  nlohmann::json json;
+};
+
+StoredReference read_reference(const std::string& name) {
+  const std::string dir = std::string(FICTUS_SOURCE_DIR) + "/tests/references/";
+  std::ifstream file(dir + name + ".toml"), json_file(dir + name + ".json");
+  std::stringstream text;
+  text << file.rdbuf();
+  return {text.str(), nlohmann::json::parse(json_file)};
+}
+
 struct ReferenceCase {
   std::string name;
   fictus::Variant variant;
@@ -227,11 +241,7 @@ TEST(ReferencesMixed, PeanutConvergesToTheFittedMeshSolution) {
 // dof spacing, so about 0.585 in the limit. Before its indicator was corrected at the vertex dofs
 // (vertex_indicator.idp) it said 0.5263, and fictus seemed 10–11 % too large.
 TEST(References3d, EllipsoidConvergesToTheFittedMeshSolution) {
-  const std::string dir = std::string(FICTUS_SOURCE_DIR) + "/tests/references/";
-  std::ifstream file(dir + "ellipsoid3d.toml"), json_file(dir + "ellipsoid3d.json");
-  std::stringstream text;
-  text << file.rdbuf();
-  const nlohmann::json reference = nlohmann::json::parse(json_file);
+  const auto [text, reference] = read_reference("ellipsoid3d");
   const double ref_u = reference["values"]["int_u"], ref_u2 = reference["values"]["int_u2"],
                ref_grad2 = reference["values"]["int_grad2"];
   const double ref_area = double(reference["values"]["contact_fraction"]) * double(reference["values"]["area_gamma"]);
@@ -241,7 +251,7 @@ TEST(References3d, EllipsoidConvergesToTheFittedMeshSolution) {
   const double reference_pointwise = reference["changes"]["max_u_interior"];
   double previous_pointwise = 1;
   for (int N : {96, 128, 160}) {
-    fictus::SurfaceProblemSpec spec = fictus::parse_surface_problem_text(text.str(), "ellipsoid3d");
+    fictus::SurfaceProblemSpec spec = fictus::parse_surface_problem_text(text, "ellipsoid3d");
     // The file's f and g, compiled (muParser would spend most of the time): checked to agree.
     const fictus::ScalarField3 f = [](double x, double y, double) { return -4 + 0.5 * x * y; };
     const fictus::ScalarField3 g = [](double x, double y, double z) {
@@ -316,11 +326,8 @@ TEST(References3d, EllipsoidConvergesToTheFittedMeshSolution) {
 // than the whole patches' at 128 (+6.0 %, +3.0 %), every located end within 0.3 s
 // of the contact circle (measured: 0.16 s at most; 0.14 s with 5h), the force and ∫u.
 TEST(References3d, SpheroidContactSetAndForce) {
-  const std::string dir = std::string(FICTUS_SOURCE_DIR) + "/tests/references/";
-  std::ifstream file(dir + "spheroid3d.toml"), json_file(dir + "spheroid3d.json");
-  std::stringstream text;
-  text << file.rdbuf();
-  const nlohmann::json values = nlohmann::json::parse(json_file)["values"];
+  const auto [text, reference] = read_reference("spheroid3d");
+  const nlohmann::json& values = reference["values"];
   const double ref_area = values["contact_area"], ref_force = values["force"], ref_u = values["int_u"],
                t_end = values["contact_end_t"];
   const fictus::Point3 center{0.49, 0.51, 0.5}, axis{2.0 / 7, 3.0 / 7, 6.0 / 7};
@@ -354,7 +361,7 @@ TEST(References3d, SpheroidContactSetAndForce) {
   for (fictus::Variant variant : {fictus::Variant::smooth, fictus::Variant::nonsmooth}) {
     const bool smooth = variant == fictus::Variant::smooth;
     for (int N : {96, 128}) {
-      fictus::SurfaceProblemSpec spec = fictus::parse_surface_problem_text(text.str(), "spheroid3d");
+      fictus::SurfaceProblemSpec spec = fictus::parse_surface_problem_text(text, "spheroid3d");
       for (const fictus::Point3& x : {fictus::Point3{0.3, 0.6, 0.45}, fictus::Point3{0.61, 0.42, 0.7}}) {
         ASSERT_NEAR(f(x.x, x.y, x.z), spec.problem.f(x.x, x.y, x.z), 1e-13);
         ASSERT_NEAR(g(x.x, x.y, x.z), spec.problem.g(x.x, x.y, x.z), 1e-13);
@@ -405,18 +412,15 @@ TEST(References3d, SpheroidContactSetAndForce) {
 // N = 128), the ends' distance along the axis from each circle (measured: means within 0.066 s, rms within
 // 0.11 s), the force and ∫u.
 TEST(References3d, PeanutContactBands) {
-  const std::string dir = std::string(FICTUS_SOURCE_DIR) + "/tests/references/";
-  std::ifstream file(dir + "peanut3d.toml"), json_file(dir + "peanut3d.json");
-  std::stringstream text;
-  text << file.rdbuf();
-  const nlohmann::json values = nlohmann::json::parse(json_file)["values"];
+  const auto [text, reference] = read_reference("peanut3d");
+  const nlohmann::json& values = reference["values"];
   const double ref_area = values["contact_area"], ref_force = values["force"], ref_u = values["int_u"];
   std::vector<double> circles;
   for (double t : values["contact_ends_t"]) circles.push_back(t);
   ASSERT_EQ(circles.size(), 4u);
   const fictus::Point3 center{0.49, 0.51, 0.5}, axis{2.0 / 7, 3.0 / 7, 6.0 / 7};
   for (int N : {128, 160}) {
-    fictus::SurfaceProblemSpec spec = fictus::parse_surface_problem_text(text.str(), "peanut3d");
+    fictus::SurfaceProblemSpec spec = fictus::parse_surface_problem_text(text, "peanut3d");
     spec.problem.N = N;
     spec.options.threads = 2;
     spec.options.error_estimate = false;
@@ -457,11 +461,7 @@ TEST(References3d, PeanutContactBands) {
 // curved elements fitted exactly to γ with the junction curves as element edges; ∫u to 2e-5 relative,
 // the fluxes through the parts to 1e-4, pointwise u to 1.3e-4 in ω). The smooth variant at N = 96, 128.
 TEST(References3d, MixedEllipsoidConvergesToTheFittedMeshSolution) {
-  const std::string dir = std::string(FICTUS_SOURCE_DIR) + "/tests/references/";
-  std::ifstream file(dir + "ellipsoid3d_mixed.toml"), json_file(dir + "ellipsoid3d_mixed.json");
-  std::stringstream text;
-  text << file.rdbuf();
-  const nlohmann::json reference = nlohmann::json::parse(json_file);
+  const auto [text, reference] = read_reference("ellipsoid3d_mixed");
   const nlohmann::json& values = reference["values"];
   const double ref_u = values["int_u"], ref_grad2 = values["int_grad2"], ref_dirichlet = values["flux_dirichlet"],
                ref_force = values["flux_signorini"], ref_contact = values["contact_area"];
@@ -471,7 +471,7 @@ TEST(References3d, MixedEllipsoidConvergesToTheFittedMeshSolution) {
   double previous_pointwise = 1;
   std::array<double, 3> previous_part_errors{};
   for (int N : {96, 128}) {
-    fictus::SurfaceProblemSpec spec = fictus::parse_surface_problem_text(text.str(), "ellipsoid3d_mixed");
+    fictus::SurfaceProblemSpec spec = fictus::parse_surface_problem_text(text, "ellipsoid3d_mixed");
     // The file's f and g, compiled (muParser would spend most of the time): checked to agree.
     const fictus::ScalarField3 f = [](double x, double y, double) { return -4 + 0.5 * x * y; };
     const fictus::ScalarField3 g = [](double x, double y, double z) {

@@ -177,6 +177,23 @@ void set_islands(fictus::SurfaceSolution& s, const std::vector<int>& active) {
   for (int a : active) s.newton.active[std::size_t(a)] = 1, s.normal_derivative[std::size_t(a)] = 1.0;
 }
 
+/// Statuses and readings of the local solution Im (z(z − e))^{3/2} across a free band of width e on s's
+/// points, x_of(point) the distance along γ from the band's first end: gap (x(e − x))^{3/2}/3 on the band,
+/// ∂u/∂n = |x − e/2|·√(x(x − e)) outside it.
+template <int dim, typename Distance>
+void set_free_band(fictus::BasicSolution<dim>& s, Distance x_of, double width) {
+  const std::size_t m = std::size_t(s.n_points());
+  s.newton.active.assign(m, 0);
+  s.trace.assign(m, 0.0), s.g.assign(m, 0.0), s.normal_derivative.assign(m, 0.0);
+  for (std::size_t i = 0; i < m; ++i) {
+    const double x = x_of(s.points()[i]);
+    if (x > 0 && x < width)
+      s.trace[i] = std::pow(x * (width - x), 1.5) / 3;
+    else
+      s.newton.active[i] = 1, s.normal_derivative[i] = std::abs(x - width / 2) * std::sqrt(x * (x - width));
+  }
+}
+
 // A triangulation made face by face computes a vertex shared by several triangles once per triangle,
 // equal only to round-off. Copies that differ by up to a quarter of 1e-9 of the surface's extent (far
 // more than round-off, far less than an edge) must still be one vertex: the same neighbours, borders and
@@ -311,21 +328,12 @@ TEST(ContactSet, AnIslandWhoseEndsCoincideOnACurve) {
 // free area was 33 % too small (ends up to 0.65 spacings off).
 TEST(ContactSet, ANarrowFreeBandClosedAtBothEnds) {
   fictus::SurfaceSolution s = on_sphere(600, radius / 40);
-  const std::size_t m = std::size_t(s.gamma.m);
   const fictus::Point3 n{0.48, 0.6, -0.64};
   const double width = 1.4 * s.spacing(), lower = 1.2, upper = lower + width / radius;  // polar angles about n
   const auto x_of = [&](const fictus::Point3& p) {  // distance along γ from the band's lower circle
     return radius * (std::acos(std::clamp(dot(p - center, n) / radius, -1.0, 1.0)) - lower);
   };
-  s.newton.active.assign(m, 0);
-  s.trace.assign(m, 0.0), s.g.assign(m, 0.0), s.normal_derivative.assign(m, 0.0);
-  for (std::size_t i = 0; i < m; ++i) {
-    const double x = x_of(s.gamma.point[i]);
-    if (x > 0 && x < width)
-      s.trace[i] = std::pow(x * (width - x), 1.5) / 3;
-    else
-      s.newton.active[i] = 1, s.normal_derivative[i] = std::abs(x - width / 2) * std::sqrt(x * (x - width));
-  }
+  set_free_band(s, x_of, width);
   fictus::resolve_contact(s);
   double total = 0, farthest = 0;
   for (double w : s.gamma.area) total += w;
@@ -351,24 +359,15 @@ TEST(ContactSet, NarrowFreeArcsClosedAtBothEnds) {
   const fictus::ArcLengthTable table(circle);
   fictus::Solution s(fictus::Grid2(fictus::Box2{{0, 0}, {1, 1}}, 64));
   s.collocation = fictus::make_collocation(circle, table, 60);
-  const std::size_t m = 60;
   for (double spacings : {0.6, 1.0, 1.4, 2.5}) {
     // The free arc's first end, by its angle: point 10 lies 0.13 spacings past the arc's middle.
     const fictus::Point2 x10 = s.collocation.point[10];
     const double width = spacings * s.spacing(),
                  start = std::atan2(x10.y - 0.5, x10.x - 0.5) - (width / 2 + 0.13 * s.spacing()) / radius;
-    s.newton.active.assign(m, 0);
-    s.trace.assign(m, 0.0), s.g.assign(m, 0.0), s.normal_derivative.assign(m, 0.0);
     const auto x_of = [&](const fictus::Point2& p) {
       return radius * std::remainder(std::atan2(p.y - 0.5, p.x - 0.5) - start, 2 * std::numbers::pi);
     };
-    for (std::size_t i = 0; i < m; ++i) {
-      const double x = x_of(s.collocation.point[i]);
-      if (x > 0 && x < width)
-        s.trace[i] = std::pow(x * (width - x), 1.5) / 3;
-      else
-        s.newton.active[i] = 1, s.normal_derivative[i] = std::abs(x - width / 2) * std::sqrt(x * (x - width));
-    }
+    set_free_band(s, x_of, width);
     fictus::resolve_contact(s);
     ASSERT_EQ(s.contact_boundary.size(), 2u);
     double farthest = 0;
