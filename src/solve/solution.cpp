@@ -461,7 +461,6 @@ void resolve_contact(BasicSolution<dim>& s) {
   std::map<int, std::vector<int>> at_corner;  // 3-D: a mesh vertex → the located ends whose border has it
   const std::vector<NeighbourPair> pairs = neighbour_pairs<dim>(s);
   std::vector<const NeighbourPair*> located;  // each end's pair
-  std::vector<double> theta;
   for (const NeighbourPair& p : pairs) {
     if (!located_pair(s, p)) continue;
     const bool i_active = s.in_contact(p.i);
@@ -469,9 +468,15 @@ void resolve_contact(BasicSolution<dim>& s) {
     for (int corner : p.corners) at_corner[corner].push_back(int(located.size()));
     located.push_back(&p);
     s.contact_boundary_pairs.push_back({a, b});
-    theta.push_back(contact_end_fraction(s.normal_derivative[std::size_t(a)],
-                                         s.trace[std::size_t(b)] - s.g[std::size_t(b)], p.distance));
   }
+  // End k's θ from its readings, the free side a band `beyond` past the free point (∞: none).
+  const auto law = [&](std::size_t k, double beyond) {
+    const std::size_t active = std::size_t(s.contact_boundary_pairs[k][0]),
+                      free = std::size_t(s.contact_boundary_pairs[k][1]);
+    return contact_end_fraction(s.normal_derivative[active], s.trace[free] - s.g[free], located[k]->distance, beyond);
+  };
+  std::vector<double> theta(located.size());
+  for (std::size_t k = 0; k < located.size(); ++k) theta[k] = law(k, std::numeric_limits<double>::infinity());
   const auto place = [&] {
     s.contact_boundary.clear();
     for (std::size_t k = 0; k < located.size(); ++k) {
@@ -527,10 +532,7 @@ void resolve_contact(BasicSolution<dim>& s) {
     for (std::size_t k = 0; k < located.size(); ++k) {
       const double d = located[k]->distance, far = 4 * d, band = beyond[k];
       if (!(band < far)) continue;  // no band: the lone end's θ, as placed
-      const int active = s.contact_boundary_pairs[k][0], free = s.contact_boundary_pairs[k][1];
-      const double next = contact_end_fraction(s.normal_derivative[std::size_t(active)],
-                                               s.trace[std::size_t(free)] - s.g[std::size_t(free)], d,
-                                               band / (1 - (band / far) * (band / far)));
+      const double next = law(k, band / (1 - (band / far) * (band / far)));
       const double damped = 1 - std::sqrt((1 - theta[k]) * (1 - next));
       moved = std::max(moved, std::abs(damped - theta[k]));
       theta[k] = damped;
